@@ -1,0 +1,3 @@
+from tanktool.cli.main import main
+
+main()

@@ -1,0 +1,125 @@
+"""The ``tanktool`` command group.
+
+Commands live in one module each and are imported only when invoked, so that
+``tanktool --help`` stays instant.  Errors derived from TanktoolError become one
+line on stderr and exit status 2 (``-v`` shows the traceback).
+"""
+
+from __future__ import annotations
+
+import importlib
+import logging
+import re
+import sys
+import traceback
+
+import click
+
+from .. import __version__
+from ..errors import TanktoolError
+
+#: command name -> (module, function, one-line help shown by ``tanktool --help``)
+COMMANDS = {
+    "import-arena": ("tanktool.cli.import_arena", "import_arena", "Turn an arena model into an arena bundle (walls, spawns, preview)."),
+    "import-vehicle": ("tanktool.cli.import_vehicle", "import_vehicle", "Turn a vehicle model into a vehicle bundle (hull points, sphere tree, mass)."),
+    "build-navgrid": ("tanktool.cli.build_navgrid", "build_navgrid", "Build an arena's wall quadtree and AI navigation grid, and plot them."),
+    "check": ("tanktool.cli.check", "check", "Validate arena and vehicle bundles like a linter."),
+    "play": ("tanktool.cli.play", "play", "Play a match (window, or --headless for scripted matches)."),
+}
+
+
+class UserError(click.ClickException):
+    """A TanktoolError shown as one line: ``error: <file>:<place>: <what>``."""
+
+    def __init__(self, message: str, exit_code: int = 2) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code
+
+    def show(self, file=None) -> None:
+        click.echo(f"error: {self.format_message()}", err=True)
+
+
+class LazyGroup(click.Group):
+    def invoke(self, ctx: click.Context):
+        try:
+            return super().invoke(ctx)
+        except TanktoolError as e:
+            if ctx.obj and ctx.obj.get("verbose"):
+                traceback.print_exc()
+            raise UserError(str(e), e.exit_code) from e
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return [name for name in COMMANDS if self._available(name)]
+
+    @staticmethod
+    def _available(name: str) -> bool:
+        return importlib.util.find_spec(COMMANDS[name][0]) is not None
+
+    def get_command(self, ctx: click.Context, name: str):
+        if name not in COMMANDS or not self._available(name):
+            return None
+        module, attr, _ = COMMANDS[name]
+        return getattr(importlib.import_module(module), attr)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        rows = [(name, COMMANDS[name][2]) for name in self.list_commands(ctx)]
+        if rows:
+            with formatter.section("Commands"):
+                formatter.write_dl(rows)
+
+
+@click.group(cls=LazyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="tanktool")
+@click.option("-v", "--verbose", count=True, help="More output; tracebacks on errors.")
+@click.option("-q", "--quiet", is_flag=True, help="Only errors; no progress bars.")
+@click.pass_context
+def cli(ctx: click.Context, verbose: int, quiet: bool) -> None:
+    """tanktool: arena-authoring pipeline and game for 3D tank combat.
+
+    \b
+    Typical flow:
+      tanktool import-arena arena.3ds -o arenas/mine
+      tanktool import-vehicle tank.3ds -o vehicles/mytank
+      tanktool build-navgrid arenas/mine
+      tanktool check arenas vehicles
+      tanktool play --arena arenas/mine
+    """
+    ctx.ensure_object(dict)
+    ctx.obj["verbose"] = verbose
+    ctx.obj["quiet"] = quiet
+    level = logging.ERROR if quiet else (logging.DEBUG if verbose > 1 else logging.INFO if verbose else logging.WARNING)
+    logging.basicConfig(level=level, format="%(message)s")
+
+
+def is_quiet() -> bool:
+    ctx = click.get_current_context(silent=True)
+    while ctx is not None:
+        if ctx.obj and "quiet" in ctx.obj:
+            return bool(ctx.obj["quiet"])
+        ctx = ctx.parent
+    return False
+
+
+def echo(message: str) -> None:
+    """Print an informational line unless ``-q`` was given."""
+    if not is_quiet():
+        click.echo(message)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console-script entry point: click's own handling plus a short line for bugs."""
+    args = sys.argv[1:] if argv is None else argv
+    try:
+        cli.main(args=args, prog_name="tanktool")
+    except SystemExit:
+        raise
+    except Exception as e:  # a bug, not bad input: say so briefly unless -v
+        if any(a == "--verbose" or re.fullmatch(r"-v+", a) for a in args):
+            traceback.print_exc()
+        else:
+            click.echo(f"internal error: {type(e).__name__}: {e} (run with -v for the traceback)", err=True)
+        sys.exit(3)
+
+
+if __name__ == "__main__":
+    main()

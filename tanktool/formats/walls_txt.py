@@ -1,0 +1,209 @@
+"""The 2002 wall list, ``walls.txt``.
+
+One wall a line, ``X1 Z1 X2 Z2 Direction``, whitespace separated, ``#`` starts a
+comment.  Direction (+1 or -1) picks the normal
+``n = Direction * (-(Z2-Z1), X2-X1) / length`` that points into free space.  The last
+four walls are the auxiliary bounding rectangle, written after a ``# auxiliary`` line;
+files without the marker are accepted when their last four walls form an
+axis-aligned rectangle enclosing the rest.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FormatError
+from .bundle import atomic_write_text
+
+AUX_MARKER = "# auxiliary"
+
+
+@dataclass
+class WallList:
+    """Walls in the (x, z) plane.
+
+    segments : (n, 2, 2) float64, ``segments[k] = [[x1, z1], [x2, z2]]``
+    direction : (n,) int8, +1 or -1
+    aux : (4, 2, 2) float64, the auxiliary bounding rectangle (may be None when
+          the file has none; :attr:`bounds` then falls back to the walls' extent)
+    lines : (n,) int, the 1-based line of each wall in the file it came from (0 if made in memory)
+    """
+
+    segments: np.ndarray
+    direction: np.ndarray
+    aux: np.ndarray | None = None
+    lines: np.ndarray | None = None
+    path: str | None = None
+
+    def __post_init__(self) -> None:
+        self.segments = np.asarray(self.segments, dtype=np.float64).reshape(-1, 2, 2)
+        self.direction = np.asarray(self.direction, dtype=np.int8).reshape(-1)
+        if self.lines is None:
+            self.lines = np.zeros(len(self.segments), dtype=np.int64)
+        if self.aux is not None:
+            self.aux = np.asarray(self.aux, dtype=np.float64).reshape(4, 2, 2)
+
+    def __len__(self) -> int:
+        return len(self.segments)
+
+    @property
+    def normals(self) -> np.ndarray:
+        """(n, 2) unit normals pointing into free space (zero for zero-length walls)."""
+        d = self.segments[:, 1] - self.segments[:, 0]
+        length = np.hypot(d[:, 0], d[:, 1])
+        n = np.stack([-d[:, 1], d[:, 0]], axis=1) * self.direction[:, None]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            n = np.where(length[:, None] > 0, n / length[:, None], 0.0)
+        return n
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 2) ``[[xmin, zmin], [xmax, zmax]]`` of the auxiliary rectangle."""
+        pts = (self.aux if self.aux is not None else self.segments).reshape(-1, 2)
+        if len(pts) == 0:
+            return np.zeros((2, 2))
+        return np.array([pts.min(axis=0), pts.max(axis=0)])
+
+    def all_segments(self) -> np.ndarray:
+        """Walls followed by the auxiliary walls, (n + 4, 2, 2)."""
+        if self.aux is None:
+            return self.segments
+        return np.concatenate([self.segments, self.aux])
+
+
+def aux_rectangle(xmin: float, zmin: float, xmax: float, zmax: float) -> np.ndarray:
+    """The four auxiliary walls of a bounding rectangle, counter-clockwise, (4, 2, 2)."""
+    c = [(xmin, zmin), (xmax, zmin), (xmax, zmax), (xmin, zmax)]
+    return np.array([[c[i], c[(i + 1) % 4]] for i in range(4)], dtype=np.float64)
+
+
+def aux_direction(aux: np.ndarray) -> np.ndarray:
+    """Directions making the auxiliary walls' normals point inwards."""
+    centre = aux.reshape(-1, 2).mean(axis=0)
+    d = aux[:, 1] - aux[:, 0]
+    n = np.stack([-d[:, 1], d[:, 0]], axis=1)
+    to_c = centre - aux[:, 0]
+    return np.where((n * to_c).sum(axis=1) >= 0, 1, -1).astype(np.int8)
+
+
+def _is_enclosing_rectangle(aux: np.ndarray, rest: np.ndarray) -> bool:
+    pts = aux.reshape(-1, 2)
+    xmin, zmin = pts.min(axis=0)
+    xmax, zmax = pts.max(axis=0)
+    if not (xmax > xmin and zmax > zmin):
+        return False
+    # each auxiliary wall axis-aligned and lying on the rectangle's border
+    for (x1, z1), (x2, z2) in aux:
+        horizontal = z1 == z2 and z1 in (zmin, zmax) and {x1, x2} == {xmin, xmax}
+        vertical = x1 == x2 and x1 in (xmin, xmax) and {z1, z2} == {zmin, zmax}
+        if not (horizontal or vertical):
+            return False
+    if len(rest):
+        r = rest.reshape(-1, 2)
+        eps = 1e-9 * max(1.0, float(np.abs(pts).max()))
+        if (r[:, 0] < xmin - eps).any() or (r[:, 0] > xmax + eps).any():
+            return False
+        if (r[:, 1] < zmin - eps).any() or (r[:, 1] > zmax + eps).any():
+            return False
+    return True
+
+
+def parse_walls(text: str, path: str = "<walls>") -> WallList:
+    """Parse the text of a wall list.  Raises FormatError naming ``path:line``."""
+    segs: list[list[float]] = []
+    dirs: list[int] = []
+    lines: list[int] = []
+    aux_start: int | None = None
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        stripped = raw.strip()
+        if stripped.lower().startswith(AUX_MARKER):
+            if aux_start is not None:
+                raise FormatError(f"{path}:{lineno}: second '{AUX_MARKER}' marker")
+            aux_start = len(segs)
+            continue
+        body = raw.split("#", 1)[0].split()
+        if not body:
+            continue
+        if len(body) != 5:
+            raise FormatError(
+                f"{path}:{lineno}: expected 5 fields 'X1 Z1 X2 Z2 Direction', got {len(body)}"
+            )
+        try:
+            vals = [float(v) for v in body[:4]]
+        except ValueError:
+            raise FormatError(f"{path}:{lineno}: expected numbers, got {' '.join(body[:4])!r}") from None
+        if not all(math.isfinite(v) for v in vals):
+            raise FormatError(f"{path}:{lineno}: coordinates must be finite, got {' '.join(body[:4])}")
+        try:
+            d = float(body[4])
+        except ValueError:
+            raise FormatError(f"{path}:{lineno}: Direction must be +1 or -1, got {body[4]!r}") from None
+        if d not in (1.0, -1.0):
+            raise FormatError(f"{path}:{lineno}: Direction must be +1 or -1, got {body[4]}")
+        segs.append(vals)
+        dirs.append(int(d))
+        lines.append(lineno)
+    seg = np.array(segs, dtype=np.float64).reshape(-1, 2, 2)
+    direction = np.array(dirs, dtype=np.int8)
+    line_arr = np.array(lines, dtype=np.int64)
+    if aux_start is not None:
+        if len(seg) - aux_start != 4:
+            raise FormatError(
+                f"{path}: expected 4 auxiliary walls after '{AUX_MARKER}', got {len(seg) - aux_start}"
+            )
+        aux = seg[aux_start:]
+        if not _is_enclosing_rectangle(aux, seg[:aux_start]):
+            raise FormatError(
+                f"{path}:{lines[aux_start]}: auxiliary walls must form an axis-aligned "
+                "rectangle enclosing every wall"
+            )
+        return WallList(seg[:aux_start], direction[:aux_start], aux, line_arr[:aux_start], path)
+    if len(seg) >= 4 and _is_enclosing_rectangle(seg[-4:], seg[:-4]):
+        return WallList(seg[:-4], direction[:-4], seg[-4:], line_arr[:-4], path)
+    return WallList(seg, direction, None, line_arr, path)
+
+
+def read_walls(path: str | os.PathLike) -> WallList:
+    """Read ``walls.txt``; errors name the file and line."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise FormatError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise FormatError(f"{path}: is a folder, expected a walls.txt file") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = data[: e.start].count(b"\n") + 1
+        raise FormatError(f"{path}:{line}: not UTF-8 text (byte offset {e.start})") from None
+    return parse_walls(text, str(path))
+
+
+def format_walls(walls: WallList, header: str | None = None) -> str:
+    """The text of a wall list; auxiliary walls last after ``# auxiliary``."""
+    out = []
+    if header:
+        out += [f"# {line}" for line in header.splitlines()]
+    out.append("# X1 Z1 X2 Z2 Direction")
+
+    def fmt(v: float) -> str:
+        s = f"{v:.4f}".rstrip("0").rstrip(".")
+        return "0" if s in ("-0", "") else s
+
+    for (p, q), d in zip(walls.segments, walls.direction):
+        out.append(f"{fmt(p[0])} {fmt(p[1])} {fmt(q[0])} {fmt(q[1])} {int(d)}")
+    if walls.aux is not None:
+        out.append(AUX_MARKER)
+        for (p, q), d in zip(walls.aux, aux_direction(walls.aux)):
+            out.append(f"{fmt(p[0])} {fmt(p[1])} {fmt(q[0])} {fmt(q[1])} {int(d)}")
+    return "\n".join(out) + "\n"
+
+
+def write_walls(path: str | os.PathLike, walls: WallList, header: str | None = None) -> None:
+    atomic_write_text(path, format_walls(walls, header))

@@ -1,0 +1,41 @@
+import pytest
+
+from tanktool.errors import FormatError
+from tanktool.formats.bundle import atomic_write_text, read_toml, sha256_file, staged_dir, write_toml
+
+
+def test_toml_round_trip(tmp_path):
+    p = tmp_path / "a.toml"
+    write_toml(p, {"name": "box", "bounds": [[0.0, 0.0], [1.0, 2.0]]})
+    assert read_toml(p) == {"name": "box", "bounds": [[0.0, 0.0], [1.0, 2.0]]}
+    assert len(sha256_file(p)) == 64
+
+
+def test_bad_toml_names_file(tmp_path):
+    p = tmp_path / "arena.toml"
+    p.write_text("name = \n")
+    with pytest.raises(FormatError, match="arena.toml: invalid TOML"):
+        read_toml(p)
+
+
+def test_staged_dir_leaves_nothing_on_failure(tmp_path):
+    target = tmp_path / "bundle"
+    with pytest.raises(RuntimeError):
+        with staged_dir(target) as d:
+            atomic_write_text(d / "x.txt", "half")
+            raise RuntimeError("boom")
+    assert not target.exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_staged_dir_refuses_then_forces(tmp_path):
+    target = tmp_path / "bundle"
+    with staged_dir(target) as d:
+        (d / "a").write_text("1")
+    with pytest.raises(FormatError, match="--force"):
+        with staged_dir(target):
+            pass
+    with staged_dir(target, force=True) as d:
+        (d / "b").write_text("2")
+    assert sorted(p.name for p in target.iterdir()) == ["b"]
+    assert [p.name for p in tmp_path.iterdir()] == ["bundle"]
