@@ -1,0 +1,1 @@
+"""matplotlib figures; each module imports matplotlib lazily (Agg when headless)."""
