@@ -73,7 +73,7 @@ def test_tree_levels_and_branching_options():
 def test_leaves_are_tighter_than_octree(tank_tree):
     pts, tree = tank_tree
     oc, orad = octree_spheres(pts, len(tree.leaves()))
-    assert len(orad) <= len(tree.leaves())
+    assert len(orad) >= len(tree.leaves())
     # every point inside some octree sphere as well: the baseline is conservative too
     d = np.linalg.norm(pts[:, None] - oc[None], axis=2) <= orad[None] + 1e-9
     assert d.any(axis=1).all()

@@ -373,36 +373,34 @@ def build_sphere_tree(points: np.ndarray, levels: int = 3, branching: int = 4, s
     return SphereTree(np.array(centers), np.array(radii), np.array(parent), np.array(level))
 
 
-def octree_spheres(points: np.ndarray, max_leaves: int) -> tuple[np.ndarray, np.ndarray]:
+def octree_spheres(points: np.ndarray, leaves: int) -> tuple[np.ndarray, np.ndarray]:
     """Hubbard's baseline: spheres circumscribing occupied octree cells.
 
-    Starts from the cube around the points and keeps splitting the occupied cell with
-    the largest sphere while the count of occupied leaves stays within
-    ``max_leaves``.  Returns (centres (m, 3), radii (m,)).
+    Starts from the cube around the points and splits the occupied cell with the
+    largest sphere, best first, until there are at least ``leaves`` occupied cells
+    (so the baseline never has fewer spheres than the tree it is compared with).
+    Returns (centres (m, 3), radii (m,)).
     """
     points = np.asarray(points, dtype=np.float64)
     lo, hi = points.min(axis=0), points.max(axis=0)
     half = max(float((hi - lo).max()) / 2, 1e-9)
-    centre = (lo + hi) / 2
-    heap: list[tuple[float, int, np.ndarray, float, np.ndarray]] = []
+    heap: list[tuple[float, int, np.ndarray, float, np.ndarray]] = [(-half, 0, (lo + hi) / 2, half, np.arange(len(points)))]
+    done: list[tuple[np.ndarray, float]] = []
     counter = 0
-    heapq.heappush(heap, (-half, counter, centre, half, np.arange(len(points))))
-    leaves: list[tuple[np.ndarray, float]] = []
-    while heap:
-        neg, _, c, h, idx = heapq.heappop(heap)
-        octant = ((points[idx] >= c).astype(np.int64) * np.array([1, 2, 4])).sum(axis=1)
-        kids = [idx[octant == o] for o in range(8)]
-        kids = [(o, k) for o, k in enumerate(kids) if len(k)]
-        if len(heap) + len(leaves) + len(kids) > max_leaves or len(np.unique(points[idx], axis=0)) < 2:
-            leaves.append((c, h))
+    while heap and len(heap) + len(done) < leaves:
+        _, _, c, h, idx = heapq.heappop(heap)
+        if len(np.unique(points[idx], axis=0)) < 2:
+            done.append((c, h))  # one point: nothing to split
             continue
-        for o, k in kids:
-            sign = np.array([1 if o & 1 else -1, 1 if o & 2 else -1, 1 if o & 4 else -1])
-            counter += 1
-            heapq.heappush(heap, (-h / 2, counter, c + sign * h / 2, h / 2, k))
-    cs = np.array([c for c, _ in leaves])
-    rs = np.array([h * np.sqrt(3.0) for _, h in leaves])
-    return cs, rs
+        octant = ((points[idx] >= c).astype(np.int64) * np.array([1, 2, 4])).sum(axis=1)
+        for o in range(8):
+            k = idx[octant == o]
+            if len(k):
+                sign = np.array([1 if o & 1 else -1, 1 if o & 2 else -1, 1 if o & 4 else -1])
+                counter += 1
+                heapq.heappush(heap, (-h / 2, counter, c + sign * h / 2, h / 2, k))
+    cells = done + [(c, h) for _, _, c, h, _ in heap]
+    return np.array([c for c, _ in cells]), np.array([h * np.sqrt(3.0) for _, h in cells])
 
 
 def contains_points(tree: SphereTree, points: np.ndarray, tol: float = 1e-9) -> np.ndarray:
@@ -486,3 +484,61 @@ def read_spheres(path: str | os.PathLike) -> SphereTree:
         raise FormatError(f"{path}: no spheres (expected at least the root line)")
     arr = np.array(rows, dtype=np.float64)
     return SphereTree(arr[:, 3:6], arr[:, 6], arr[:, 1].astype(np.int64), arr[:, 2].astype(np.int64))
+
+
+# ---------------------------------------------------------------------------
+# tightness
+
+
+def solid_inside(mesh):
+    """A vectorised inside test for a model: ``f((n, 3)) -> (n,) bool``.
+
+    Each connected part counts as solid: a closed part by ray parity (trimesh), an
+    open one by its convex hull — open shells have no inside of their own, and the
+    hull is what a collision would treat as the part.
+    """
+    m = mesh.copy()
+    m.merge_vertices()
+    parts = m.split(only_watertight=False) if len(m.faces) else []
+    tests = []
+    for part in parts:
+        if part.is_watertight and part.is_winding_consistent and part.volume > 0:
+            tests.append(part)
+        else:
+            try:
+                tests.append(part.convex_hull)
+            except Exception:  # a flat or tiny part encloses nothing
+                continue
+
+    def inside(points: np.ndarray) -> np.ndarray:
+        out = np.zeros(len(points), dtype=bool)
+        for part in tests:
+            lo, hi = part.bounds
+            cand = np.flatnonzero(~out & np.all((points >= lo) & (points <= hi), axis=1))
+            if len(cand):
+                out[cand] = part.contains(points[cand])
+        return out
+
+    return inside
+
+
+def excess_volume(centers: np.ndarray, radii: np.ndarray, inside, samples: int = 100_000,
+                  seed: int = 0) -> float:
+    """Volume of the union of spheres outside the model, over the model's volume.
+
+    Monte Carlo over the spheres' bounding box, which holds the whole model when the
+    spheres enclose its surface; ``inside`` is the model's inside test
+    (:func:`solid_inside`).
+    """
+    lo = (centers - radii[:, None]).min(axis=0)
+    hi = (centers + radii[:, None]).max(axis=0)
+    rng = np.random.default_rng(seed)
+    p = lo + rng.random((samples, 3)) * (hi - lo)
+    in_spheres = np.zeros(samples, dtype=bool)
+    for c, r in zip(centers, radii):
+        in_spheres |= np.sum((p - c) ** 2, axis=1) <= r * r
+    in_model = inside(p)
+    solid = int(in_model.sum())
+    if solid == 0:
+        return float("inf")
+    return float(np.sum(in_spheres & ~in_model)) / solid
