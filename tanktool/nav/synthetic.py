@@ -64,7 +64,9 @@ def random_arena(seed: int, size: float = 60.0, cells: int = 4, courtyard: bool 
             cx, cz = (a + 0.5) * step, (b + 0.5) * step
             rad = step * rng.uniform(0.15, 0.35)
             k = int(rng.choice([3, 4, 5, 7]))
-            ang = np.sort(rng.uniform(0, 2 * np.pi, k)) if k > 4 else rng.uniform(0, 2 * np.pi) + np.arange(k) * 2 * np.pi / k
+            # jittered but ordered angles with gaps < pi: a simple, star-shaped polygon
+            jitter = rng.uniform(0, 0.8, k) if k > 4 else np.zeros(k)
+            ang = rng.uniform(0, 2 * np.pi) + (np.arange(k) + jitter) * 2 * np.pi / k
             r = rad * rng.uniform(0.7, 1.0, k)
             pts = np.stack([cx + r * np.cos(ang), cz + r * np.sin(ang)], axis=1)
             loops.append((pts, False))

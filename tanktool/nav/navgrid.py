@@ -1,0 +1,600 @@
+"""The AI navigation grid (the 2002 "malla"): valid nodes, runs, reachable regions.
+
+Nodes sit at cell centres over the arena bounds: node (i, j) is at
+``x = origin_x + (j + 1/2) cell``, ``z = origin_z + (i + 1/2) cell``; a row (index i)
+is a line of constant z, a column (index j) one of constant x.
+
+**Free space.**  Orient every wall so that its normal (the side ``Direction`` picks)
+is on its left; the auxiliary rectangle is not a wall.  Walking along any line from
+outside the arena, count +1 for each wall crossed along its normal (entering free
+space) and -1 for each crossed against it.  A point is in free space when this count
+is positive walking from *both* ends of the line up to the point (the 2002 paper's
+two pointers walking a line's crossing list from both ends).  For walls made of closed
+loops with consistent normals -- the walls of any solid sliced at a height -- the count
+is the winding number of the oriented walls: 1 in free space, 0 in solids and outside,
+the same along every line, and shared edges of touching solids (opposite normals)
+cancel.  :func:`open_ends` lists the vertices where that fails (loose ends, flipped
+normals); there the two classifiers below can disagree, and nothing else can.
+
+A node is **valid** when it is in free space and its distance to every wall is at
+least the clearance (and not zero: a node on a wall is never valid).
+
+Two classifiers, which agree exactly on every node farther than rounding from a wall:
+
+* :func:`classify_reference`, the 2002 method: the line through each node and the
+  arena origin (the auxiliary rectangle's low corner), its crossings with every wall
+  sorted into a list and walked from both ends; clearance by brute force.
+* :func:`classify`, the vectorised default: the same count along each grid row (one
+  crossing list per row, a cumulative sum per node), and clearance by rasterising each
+  wall's capsule row by row and testing only the nodes under it with the same exact
+  distance kernel.  Crossings use a half-open rule on the row's z (an end point exactly
+  on the row counts as above it), so a line through a vertex is never counted twice.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..errors import ArenaError, FormatError
+from ..formats.walls_txt import WallList
+from ..geometry.segments import point_segment_dist2
+
+#: refuse grids larger than this (nodes); 25 M nodes is ~300 MB of arrays
+MAX_NODES = 25_000_000
+_FORMAT = "tanktool-navgrid-1"
+_FIELDS = ("valid", "row_index", "row_total", "col_index", "col_total", "reachable")
+
+Node = tuple[int, int]
+#: the four grid directions as (di, dj): +x (east, j+1), +z (i+1), -x, -z
+STEPS: dict[str, Node] = {"+x": (0, 1), "+z": (1, 0), "-x": (0, -1), "-z": (-1, 0)}
+
+
+@dataclass
+class NavGrid:
+    """A navigation grid.  Per-node arrays have shape ``(nz, nx)``.
+
+    row_index / row_total: 1-based position of the node in its row run of valid
+    nodes, and that run's length (0 for invalid nodes); col_* the same for columns.
+    """
+
+    origin: np.ndarray
+    cell: float
+    shape: tuple[int, int]
+    valid: np.ndarray
+    row_index: np.ndarray
+    row_total: np.ndarray
+    col_index: np.ndarray
+    col_total: np.ndarray
+    reachable: np.ndarray
+    clearance: float = float("nan")  # how it was built; kept in arena.toml, not in the npz
+    spawn_nodes: list[Node] = field(default_factory=list)
+
+    # ------------------------------------------------------------ geometry
+    @property
+    def nz(self) -> int:
+        return int(self.shape[0])
+
+    @property
+    def nx(self) -> int:
+        return int(self.shape[1])
+
+    @property
+    def node_x(self) -> np.ndarray:
+        """(nx,) x of each column of nodes."""
+        return node_coords(self.origin[0], self.cell, self.nx)
+
+    @property
+    def node_z(self) -> np.ndarray:
+        """(nz,) z of each row of nodes."""
+        return node_coords(self.origin[1], self.cell, self.nz)
+
+    def centre(self, i: int, j: int) -> tuple[float, float]:
+        """World (x, z) of node (i, j)."""
+        return (float(self.origin[0] + (j + 0.5) * self.cell), float(self.origin[1] + (i + 0.5) * self.cell))
+
+    def centres(self, nodes: np.ndarray) -> np.ndarray:
+        """(m, 2) world points of (m, 2) nodes ``[[i, j], ...]``."""
+        n = np.asarray(nodes).reshape(-1, 2)
+        return np.stack([self.origin[0] + (n[:, 1] + 0.5) * self.cell, self.origin[1] + (n[:, 0] + 0.5) * self.cell], axis=1)
+
+    def node_of(self, x: float, z: float) -> Node:
+        """The node whose cell contains (x, z), clamped into the grid."""
+        j = int(np.clip(math.floor((x - self.origin[0]) / self.cell), 0, self.nx - 1))
+        i = int(np.clip(math.floor((z - self.origin[1]) / self.cell), 0, self.nz - 1))
+        return (i, j)
+
+    def nodes_of(self, points: np.ndarray) -> np.ndarray:
+        """(m, 2) nodes of (m, 2) world points, clamped into the grid."""
+        p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        j = np.clip(np.floor((p[:, 0] - self.origin[0]) / self.cell), 0, self.nx - 1)
+        i = np.clip(np.floor((p[:, 1] - self.origin[1]) / self.cell), 0, self.nz - 1)
+        return np.stack([i, j], axis=1).astype(np.int64)
+
+    def inside(self, i: int, j: int) -> bool:
+        return 0 <= i < self.nz and 0 <= j < self.nx
+
+    def is_valid(self, node: Node) -> bool:
+        i, j = node
+        return self.inside(i, j) and bool(self.valid[i, j])
+
+    def neighbours4(self, i: int, j: int) -> list[Node]:
+        """The valid 4-neighbours of (i, j), in the order +x, +z, -x, -z."""
+        out = []
+        for di, dj in STEPS.values():
+            a, b = i + di, j + dj
+            if self.inside(a, b) and self.valid[a, b]:
+                out.append((a, b))
+        return out
+
+    @property
+    def bounds(self) -> np.ndarray:
+        return np.array([self.origin, self.origin + self.cell * np.array([self.nx, self.nz])])
+
+    # ------------------------------------------------------------ save / load
+    def save(self, path: str | os.PathLike) -> None:
+        """``navgrid.npz``: origin, cell, shape, valid, row/col index/total, reachable."""
+        from ..formats.bundle import atomic_write_bytes
+
+        atomic_write_bytes(path, self.to_bytes())
+
+    def to_bytes(self) -> bytes:
+        buf = io.BytesIO()
+        np.savez_compressed(
+            buf, format=np.array(_FORMAT), origin=np.asarray(self.origin, dtype=np.float64),
+            cell=np.array(float(self.cell)), shape=np.array(self.shape, dtype=np.int64),
+            valid=self.valid, row_index=self.row_index, row_total=self.row_total,
+            col_index=self.col_index, col_total=self.col_total, reachable=self.reachable,
+        )
+        return buf.getvalue()
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> "NavGrid":
+        """Read a ``navgrid.npz``; anything malformed raises FormatError naming the file."""
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                missing = [k for k in ("origin", "cell", "shape", *_FIELDS[:-1]) if k not in z.files]
+                if missing:
+                    raise FormatError(f"{path}: not a navgrid file (missing {', '.join(missing)})")
+                shape = tuple(int(v) for v in z["shape"])
+                arrays = {k: z[k] for k in _FIELDS if k in z.files}
+                origin = z["origin"].astype(np.float64)
+                cell = float(z["cell"])
+        except FileNotFoundError:
+            raise FormatError(f"{path}: no such file") from None
+        except (OSError, ValueError, KeyError) as e:
+            raise FormatError(f"{path}: cannot read navgrid: {e}") from None
+        if len(shape) != 2 or origin.shape != (2,) or not cell > 0:
+            raise FormatError(f"{path}: bad origin/cell/shape")
+        for k, a in arrays.items():
+            if a.shape != shape:
+                raise FormatError(f"{path}: {k} has shape {a.shape}, expected {shape}")
+        if "reachable" not in arrays:  # files written before regions existed
+            arrays["reachable"] = arrays["valid"].copy()
+        return cls(
+            origin, cell, shape, arrays["valid"].astype(bool),
+            *(arrays[k].astype(np.int32) for k in ("row_index", "row_total", "col_index", "col_total")),
+            arrays["reachable"].astype(bool),
+        )
+
+
+# ====================================================================== geometry
+def node_coords(origin: float, cell: float, n: int) -> np.ndarray:
+    """Coordinates of n node centres along one axis.  Both classifiers use these."""
+    return origin + (np.arange(n) + 0.5) * cell
+
+
+def grid_shape(bounds: np.ndarray, cell: float) -> tuple[int, int]:
+    """(nz, nx) for cells of size ``cell`` covering ``bounds``; refuses absurd grids."""
+    b = np.asarray(bounds, dtype=np.float64).reshape(2, 2)
+    if not (math.isfinite(cell) and cell > 0):
+        raise ArenaError(f"cell must be a positive number of metres, got {cell}")
+    ext = b[1] - b[0]
+    if not (ext > 0).all():
+        raise ArenaError(f"arena bounds {b.tolist()} have no area")
+    nxf, nzf = ext / cell
+    if nxf * nzf > MAX_NODES:
+        raise ArenaError(
+            f"cell {cell} m over {ext[0]:g} x {ext[1]:g} m makes {nxf * nzf:,.0f} nodes "
+            f"(limit {MAX_NODES:,}); use a larger --cell"
+        )
+    # a whisker of tolerance so that 20 m / 0.5 m is 40 cells, not 41
+    nx = max(1, int(math.ceil(nxf - 1e-9)))
+    nz = max(1, int(math.ceil(nzf - 1e-9)))
+    return (nz, nx)
+
+
+def on_wall_tolerance(bounds: np.ndarray) -> float:
+    """Nodes closer than this to a wall count as on it (never valid)."""
+    b = np.asarray(bounds, dtype=np.float64).reshape(2, 2)
+    return 1e-9 * max(1.0, float(np.max(np.abs(b))))
+
+
+def _oriented(walls: WallList) -> tuple[np.ndarray, np.ndarray]:
+    """Wall end points (A, B) swapped where needed so free space is on the left of A->B."""
+    s = walls.segments
+    flip = walls.direction < 0
+    A = np.where(flip[:, None], s[:, 1], s[:, 0])
+    B = np.where(flip[:, None], s[:, 0], s[:, 1])
+    return A, B
+
+
+def open_ends(walls: WallList) -> np.ndarray:
+    """(k, 2) vertices where the oriented walls do not close up.
+
+    With free space on the left of every wall, each vertex of a closed, consistently
+    oriented wall set has as many walls leaving it as arriving.  Zero-length walls
+    are ignored.
+    """
+    A, B = _oriented(walls)
+    keep = np.any(A != B, axis=1)
+    A, B = A[keep], B[keep]
+    if len(A) == 0:
+        return np.zeros((0, 2))
+    pts = np.concatenate([A, B])
+    verts, inv = np.unique(pts, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    bal = np.bincount(inv[: len(A)], minlength=len(verts)) - np.bincount(inv[len(A):], minlength=len(verts))
+    return verts[bal != 0]
+
+
+# ================================================================ free space
+def row_crossings(A: np.ndarray, B: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Crossings of oriented walls with the horizontal lines ``z`` (ascending).
+
+    Returns ``(row, x, sign)``: for each crossing, the index into ``z``, where it
+    crosses, and +1 when walking +x crosses the wall along its normal.  Half-open
+    rule: a wall crosses line z when exactly one end point has ``z_end > z``.
+    """
+    lo = np.minimum(A[:, 1], B[:, 1])
+    hi = np.maximum(A[:, 1], B[:, 1])
+    # rows with lo <= z < hi, i.e. exactly one end strictly above
+    r0 = np.searchsorted(z, lo, side="left")
+    r1 = np.searchsorted(z, hi, side="left")
+    cnt = np.maximum(r1 - r0, 0)
+    w = np.repeat(np.arange(len(A)), cnt)
+    row = np.repeat(r0, cnt) + (np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    a, b, zz = A[w], B[w], z[row]
+    x = a[:, 0] + (zz - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    # free space on the left of a->b: going up (b above) the left is -x, so walking +x
+    # crosses against the normal
+    sign = np.where(b[:, 1] > zz, -1, 1).astype(np.int32)
+    return row, x, sign
+
+
+def free_space(walls: WallList, origin: np.ndarray, cell: float, shape: tuple[int, int], rows: slice = slice(None)) -> np.ndarray:
+    """Free-space mask of the nodes of ``rows`` by the row-scan count (from both ends)."""
+    nz, nx = shape
+    z = node_coords(origin[1], cell, nz)[rows]
+    x_nodes = node_coords(origin[0], cell, nx)
+    A, B = _oriented(walls)
+    row, x, sign = row_crossings(A, B, z)
+    # +sign for every node strictly right of the crossing: scatter at the first such
+    # node and take a running sum along the row
+    j = np.searchsorted(x_nodes, x, side="right")
+    acc = np.bincount(row * (nx + 1) + j, weights=sign, minlength=len(z) * (nx + 1))
+    acc = acc.reshape(len(z), nx + 1).astype(np.int32)
+    left = np.cumsum(acc, axis=1)
+    total = left[:, -1:]
+    left = left[:, :nx]
+    # walking in from the +x end the count is sum(-sign) over crossings right of the node
+    right = left - total
+    return (left > 0) & (right > 0)
+
+
+# ================================================================= clearance
+def _capsule_rows(A: np.ndarray, B: np.ndarray, R: float, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(wall, row, xlo, xhi): the chord of each wall's capsule of radius R on each row."""
+    zlo = np.minimum(A[:, 1], B[:, 1]) - R
+    zhi = np.maximum(A[:, 1], B[:, 1]) + R
+    r0 = np.searchsorted(z, zlo, side="left")
+    r1 = np.searchsorted(z, zhi, side="right")
+    cnt = np.maximum(r1 - r0, 0)
+    w = np.repeat(np.arange(len(A)), cnt)
+    row = np.repeat(r0, cnt) + (np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    a, b, zz = A[w], B[w], z[row]
+    lo = np.full(len(w), np.inf)
+    hi = np.full(len(w), -np.inf)
+    for p in (a, b):  # end discs
+        dz = zz - p[:, 1]
+        h2 = R * R - dz * dz
+        ok = h2 >= 0
+        h = np.sqrt(np.where(ok, h2, 0.0))
+        lo = np.where(ok, np.minimum(lo, p[:, 0] - h), lo)
+        hi = np.where(ok, np.maximum(hi, p[:, 0] + h), hi)
+    # the band between: 0 <= s <= 1 along the wall and |u| <= R across it, both linear in x
+    d = b - a
+    L2 = d[:, 0] ** 2 + d[:, 1] ** 2
+    L = np.sqrt(L2)
+    good = L > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c1 = (zz - a[:, 1]) * d[:, 1] / L2  # s at x = a_x
+        c2 = (zz - a[:, 1]) * d[:, 0] / L   # u at x = a_x
+        # s = c1 + (x - ax) dx / L2 ; u = c2 - (x - ax) dz / L
+        s_lo = a[:, 0] + (0 - c1) * L2 / d[:, 0]
+        s_hi = a[:, 0] + (1 - c1) * L2 / d[:, 0]
+        u_lo = a[:, 0] + (R - c2) * L / -d[:, 1]
+        u_hi = a[:, 0] + (-R - c2) * L / -d[:, 1]
+    s_a, s_b = np.minimum(s_lo, s_hi), np.maximum(s_lo, s_hi)
+    s_flat = d[:, 0] == 0
+    s_all = (c1 >= 0) & (c1 <= 1)
+    s_a = np.where(s_flat, np.where(s_all, -np.inf, np.inf), s_a)
+    s_b = np.where(s_flat, np.where(s_all, np.inf, -np.inf), s_b)
+    u_a, u_b = np.minimum(u_lo, u_hi), np.maximum(u_lo, u_hi)
+    u_flat = d[:, 1] == 0
+    u_all = np.abs(c2) <= R
+    u_a = np.where(u_flat, np.where(u_all, -np.inf, np.inf), u_a)
+    u_b = np.where(u_flat, np.where(u_all, np.inf, -np.inf), u_b)
+    band_lo = np.maximum(s_a, u_a)
+    band_hi = np.minimum(s_b, u_b)
+    band = good & (band_lo <= band_hi)
+    lo = np.where(band, np.minimum(lo, band_lo), lo)
+    hi = np.where(band, np.maximum(hi, band_hi), hi)
+    keep = lo <= hi
+    return w[keep], row[keep], lo[keep], hi[keep]
+
+
+def too_close(
+    segments: np.ndarray, origin: np.ndarray, cell: float, shape: tuple[int, int], clearance: float,
+    rows: slice = slice(None), tol: float = 0.0,
+) -> np.ndarray:
+    """Nodes of ``rows`` whose distance to some wall is < clearance (or <= tol).
+
+    Exact: candidate nodes are those under each wall's capsule chord widened by one
+    node, and each candidate is decided by the distance kernel itself.
+    """
+    nz, nx = shape
+    z = node_coords(origin[1], cell, nz)[rows]
+    x_nodes = node_coords(origin[0], cell, nx)
+    out = np.zeros((len(z), nx), dtype=bool)
+    seg = np.asarray(segments, dtype=np.float64).reshape(-1, 2, 2)
+    R = max(float(clearance), tol)
+    if len(seg) == 0 or len(z) == 0:
+        return out
+    # a hair wider than R so that rounding in the chord never drops a row; the x
+    # range is widened by a whole node each side for the same reason
+    w, row, xlo, xhi = _capsule_rows(seg[:, 0], seg[:, 1], R * (1 + 1e-9) + 1e-7 * cell, z)
+    j0 = np.clip(np.searchsorted(x_nodes, xlo, side="left") - 1, 0, nx)
+    j1 = np.clip(np.searchsorted(x_nodes, xhi, side="right") + 1, 0, nx)
+    cnt = np.maximum(j1 - j0, 0)
+    total = int(cnt.sum())
+    ww = np.repeat(w, cnt)
+    rr = np.repeat(row, cnt)
+    jj = np.repeat(j0, cnt) + (np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    p = np.stack([x_nodes[jj], z[rr]], axis=1)
+    d2 = point_segment_dist2(p, seg[ww, 0], seg[ww, 1])
+    hit = (d2 < clearance * clearance) | (d2 <= tol * tol)
+    out[rr[hit], jj[hit]] = True
+    return out
+
+
+# ================================================================ classifiers
+def classify(
+    walls: WallList, origin: np.ndarray, cell: float, shape: tuple[int, int], clearance: float,
+    progress: Callable[[int], None] | None = None, band_nodes: int = 1_000_000,
+) -> np.ndarray:
+    """Valid-node mask (the fast default): row-scan free space minus the wall capsules.
+
+    Rows are processed in bands of about ``band_nodes`` nodes; ``progress(rows_done)``
+    is called after each band.
+    """
+    nz, nx = shape
+    tol = on_wall_tolerance(walls.bounds)
+    valid = np.empty(shape, dtype=bool)
+    step = max(1, band_nodes // max(nx, 1))
+    for r0 in range(0, nz, step):
+        rows = slice(r0, min(nz, r0 + step))
+        valid[rows] = free_space(walls, origin, cell, shape, rows) & ~too_close(
+            walls.segments, origin, cell, shape, clearance, rows, tol
+        )
+        if progress is not None:
+            progress(rows.stop - rows.start)
+    return valid
+
+
+def reference_node(walls: WallList, A: np.ndarray, B: np.ndarray, origin: np.ndarray, p: np.ndarray) -> bool:
+    """The 2002 test of one point: is it in free space?
+
+    The line L through the arena origin O and the point P is cut by every wall it
+    crosses (its end points classified by side of L, half-open, so a vertex on L is
+    counted once); the crossings, sorted along L, form the list whose two ends are
+    where L leaves the auxiliary rectangle.  Two pointers walk in from both ends,
+    starting "outside", adding +1 for each wall crossed along its normal and -1
+    against it, until they meet at P.  P is free when both counts are positive.
+    """
+    u = p - origin
+    side_a = (u[0] * (A[:, 1] - origin[1]) - u[1] * (A[:, 0] - origin[0])) > 0
+    side_b = (u[0] * (B[:, 1] - origin[1]) - u[1] * (B[:, 0] - origin[0])) > 0
+    k = np.flatnonzero(side_a != side_b)
+    if len(k) == 0:
+        return False
+    a, d = A[k], B[k] - A[k]
+    # L(t) = O + t u meets a + s d: t = cross(a - O, d) / cross(u, d); P is at t = 1
+    t = ((a[:, 0] - origin[0]) * d[:, 1] - (a[:, 1] - origin[1]) * d[:, 0]) / (u[0] * d[:, 1] - u[1] * d[:, 0])
+    # walking +u: a wall from the left of L to its right has its left side (free) ahead
+    sign = np.where(side_a[k], 1, -1)
+    order = np.argsort(t, kind="stable")
+    crossings = list(zip(t[order].tolist(), sign[order].tolist()))  # the "doubly linked list"
+    head, tail = 0, len(crossings) - 1
+    from_head = from_tail = 0
+    while head <= tail and crossings[head][0] < 1.0:
+        from_head += crossings[head][1]
+        head += 1
+    while tail >= head and crossings[tail][0] > 1.0:
+        from_tail -= crossings[tail][1]
+        tail -= 1
+    # head > tail: the pointers met at P; otherwise a crossing sits exactly on P
+    return head > tail and from_head > 0 and from_tail > 0
+
+
+def classify_reference(
+    walls: WallList, origin: np.ndarray, cell: float, shape: tuple[int, int], clearance: float,
+    nodes: np.ndarray | None = None,
+) -> np.ndarray:
+    """Valid-node mask by the 2002 method, node by node (slow; the reference).
+
+    ``nodes`` (m, 2) restricts the work to some nodes and returns an (m,) mask;
+    otherwise the whole ``shape`` mask is returned.
+    """
+    nz, nx = shape
+    if nodes is None:
+        ii, jj = np.divmod(np.arange(nz * nx), nx)
+    else:
+        ii, jj = np.asarray(nodes).reshape(-1, 2).T
+    xs = node_coords(origin[0], cell, nx)
+    zs = node_coords(origin[1], cell, nz)
+    A, B = _oriented(walls)
+    seg = walls.segments
+    tol = on_wall_tolerance(walls.bounds)
+    O = np.asarray(walls.bounds[0], dtype=np.float64)
+    out = np.zeros(len(ii), dtype=bool)
+    for k, (i, j) in enumerate(zip(ii.tolist(), jj.tolist())):
+        p = np.array([xs[j], zs[i]])
+        d2 = point_segment_dist2(p, seg[:, 0], seg[:, 1])
+        if len(d2) and (d2.min() < clearance * clearance or d2.min() <= tol * tol):
+            continue
+        out[k] = reference_node(walls, A, B, O, p)
+    return out.reshape(shape) if nodes is None else out
+
+
+# ====================================================================== runs
+def _runs_along_last_axis(valid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """1-based index of each valid node in its run along the last axis, and run length."""
+    m, n = valid.shape
+    v = np.zeros((m, n + 1), dtype=bool)
+    v[:, 1:] = valid  # a False column keeps runs from spilling across lines
+    flat = v.ravel()
+    pos = np.arange(flat.size)
+    start = flat.copy()
+    start[1:] &= ~flat[:-1]
+    first = np.maximum.accumulate(np.where(start, pos, 0))
+    index = np.where(flat, pos - first + 1, 0)
+    run = np.cumsum(start)
+    lengths = np.bincount(run[flat], minlength=int(run[-1]) + 1)
+    total = np.where(flat, lengths[run], 0)
+    return index.reshape(m, n + 1)[:, 1:].astype(np.int32), total.reshape(m, n + 1)[:, 1:].astype(np.int32)
+
+
+def runs(valid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(row_index, row_total, col_index, col_total) of a valid mask (the paper's numbering).
+
+    Row runs go along +x (j increasing), column runs along +z (i increasing).
+    """
+    ri, rt = _runs_along_last_axis(valid)
+    ci, ct = _runs_along_last_axis(valid.T)
+    return ri, rt, np.ascontiguousarray(ci.T), np.ascontiguousarray(ct.T)
+
+
+# =================================================================== regions
+def nearest_valid_node(valid: np.ndarray, node: Node, max_steps: int) -> Node | None:
+    """The valid node nearest to ``node`` (Euclidean in nodes) within ``max_steps``."""
+    i, j = node
+    nz, nx = valid.shape
+    i0, i1 = max(0, i - max_steps), min(nz, i + max_steps + 1)
+    j0, j1 = max(0, j - max_steps), min(nx, j + max_steps + 1)
+    win = valid[i0:i1, j0:j1]
+    if not win.any():
+        return None
+    a, b = np.nonzero(win)
+    d = (a + i0 - i) ** 2 + (b + j0 - j) ** 2
+    k = int(np.argmin(d))
+    return (int(a[k] + i0), int(b[k] + j0))
+
+
+def reachable_from(valid: np.ndarray, seeds: list[Node]) -> np.ndarray:
+    """Valid nodes 4-connected to any seed (8-connected moves without corner cutting
+    connect exactly the same nodes)."""
+    from scipy import ndimage
+
+    if not seeds:
+        return valid.copy()
+    labels, _ = ndimage.label(valid)
+    keep = np.unique([labels[s] for s in seeds])
+    keep = keep[keep > 0]
+    return np.isin(labels, keep)
+
+
+# ===================================================================== build
+def build_navgrid(
+    walls: WallList, cell: float, clearance: float, spawns: np.ndarray | None = None,
+    bounds: np.ndarray | None = None, reference: bool = False,
+    progress: Callable[[int], None] | None = None,
+) -> NavGrid:
+    """Classify, number the runs and mark the regions reachable from the spawn points.
+
+    walls : the arena's walls (auxiliary rectangle = default bounds)
+    cell, clearance : metres
+    spawns : (k, 2+) spawn points ``[x, z, ...]``; each seeds the region of its
+             nearest valid node (within the clearance plus two cells).  None or empty:
+             every valid node counts as reachable.
+    reference : use the 2002 classifier instead of the fast one (slow).
+    progress : called with the number of rows just classified.
+    """
+    if not (math.isfinite(clearance) and clearance >= 0):
+        raise ArenaError(f"clearance must be >= 0 metres, got {clearance}")
+    b = walls.bounds if bounds is None else np.asarray(bounds, dtype=np.float64).reshape(2, 2)
+    shape = grid_shape(b, cell)
+    origin = b[0].copy()
+    if reference:
+        valid = classify_reference(walls, origin, cell, shape, clearance)
+        if progress is not None:
+            progress(shape[0])
+    else:
+        valid = classify(walls, origin, cell, shape, clearance, progress=progress)
+    ri, rt, ci, ct = runs(valid)
+    grid = NavGrid(origin, float(cell), shape, valid, ri, rt, ci, ct, valid, float(clearance))
+    seeds: list[Node] = []
+    if spawns is not None and len(spawns):
+        reach = int(math.ceil(clearance / cell)) + 2
+        for s in np.asarray(spawns, dtype=np.float64).reshape(len(spawns), -1):
+            n = nearest_valid_node(valid, grid.node_of(s[0], s[1]), reach)
+            if n is not None:
+                seeds.append(n)
+        grid.reachable = reachable_from(valid, seeds) if seeds else np.zeros_like(valid)
+    else:
+        grid.reachable = valid.copy()
+    grid.spawn_nodes = seeds
+    return grid
+
+
+def grid_from_mask(valid: np.ndarray, origin: tuple[float, float] = (0.0, 0.0), cell: float = 1.0) -> NavGrid:
+    """A NavGrid from a hand-made valid mask (rows = z, columns = x); all reachable."""
+    v = np.asarray(valid, dtype=bool)
+    ri, rt, ci, ct = runs(v)
+    return NavGrid(np.asarray(origin, dtype=np.float64), float(cell), v.shape, v, ri, rt, ci, ct, v.copy())
+
+
+# ===================================================================== table
+def format_table(grid: NavGrid, region: np.ndarray | None = None) -> str:
+    """The 2002-style table, one node a line: position, validity and the four numbers.
+
+    ``region`` ``[[x0, z0], [x1, z1]]`` keeps only the nodes inside it.
+    """
+    i, j = np.nonzero(np.ones(grid.shape, dtype=bool))
+    x = grid.node_x[j]
+    z = grid.node_z[i]
+    if region is not None:
+        r = np.asarray(region, dtype=np.float64).reshape(2, 2)
+        keep = (x >= r[0, 0]) & (x <= r[1, 0]) & (z >= r[0, 1]) & (z <= r[1, 1])
+        i, j, x, z = i[keep], j[keep], x[keep], z[keep]
+    head = [
+        "# tanktool navigation grid: one node a line (the 2002 'malla' table)",
+        f"# origin {grid.origin[0]:g} {grid.origin[1]:g}  cell {grid.cell:g}  shape nz={grid.nz} nx={grid.nx}",
+        "# renglon/columna = 1-based index of the node in its row/column run of valid nodes,",
+        "# total = that run's length (0 for invalid nodes); rows run along +x, columns along +z",
+        "# i j x z valid reachable renglon columna total_renglones total_columnas",
+    ]
+    cols = [
+        i, j, x, z, grid.valid[i, j].astype(int), grid.reachable[i, j].astype(int),
+        grid.row_index[i, j], grid.col_index[i, j], grid.row_total[i, j], grid.col_total[i, j],
+    ]
+    body = [
+        f"{a} {b} {c:.4f} {d:.4f} {e} {f} {g} {h} {k} {m}"
+        for a, b, c, d, e, f, g, h, k, m in zip(*(c.tolist() for c in cols))
+    ]
+    return "\n".join(head + body) + "\n"

@@ -1,0 +1,184 @@
+"""Path planning on the navigation grid: A* (8-connected, no corner cutting) and
+line-of-sight smoothing against the grid or the wall quadtree."""
+
+from __future__ import annotations
+
+import heapq
+import math
+
+import numpy as np
+
+from .navgrid import NavGrid, Node
+from .quadtree import WallQuadtree
+
+_SQRT2 = math.sqrt(2.0)
+
+
+def astar(grid: NavGrid, start: Node, goal: Node, passable: np.ndarray | None = None) -> list[Node]:
+    """Shortest 8-connected path of valid nodes from ``start`` to ``goal`` (both included).
+
+    A diagonal step needs both orthogonal neighbours it passes valid (no corner
+    cutting).  Step costs 1 and sqrt(2); the octile distance is the heuristic, so the
+    path is optimal.  Returns ``[]`` when either end is not passable or no path exists.
+    ``passable`` defaults to ``grid.valid``.
+    """
+    ok = grid.valid if passable is None else passable
+    nz, nx = ok.shape
+    (si, sj), (gi, gj) = start, goal
+    for i, j in (start, goal):
+        if not (0 <= i < nz and 0 <= j < nx):
+            raise ValueError(f"node {(i, j)} is outside the {nz} x {nx} grid")
+    if not (ok[si, sj] and ok[gi, gj]):
+        return []
+    flat = ok.ravel().tolist()  # list indexing is much faster than numpy scalars here
+    s, g = si * nx + sj, gi * nx + gj
+    k = _SQRT2 - 2.0
+
+    def h(n: int) -> float:
+        di = abs(n // nx - gi)
+        dj = abs(n % nx - gj)
+        return di + dj + k * min(di, dj)
+
+    best = {s: 0.0}
+    came: dict[int, int] = {}
+    heap = [(h(s), 0.0, s)]
+    closed = set()
+    while heap:
+        f, gc, n = heapq.heappop(heap)
+        if n == g:
+            out = [n]
+            while n in came:
+                n = came[n]
+                out.append(n)
+            return [divmod(m, nx) for m in reversed(out)]
+        if n in closed:
+            continue
+        closed.add(n)
+        i, j = divmod(n, nx)
+        e = j + 1 < nx and flat[n + 1]
+        w = j > 0 and flat[n - 1]
+        no = i + 1 < nz and flat[n + nx]
+        so = i > 0 and flat[n - nx]
+        steps = []
+        if e:
+            steps.append((n + 1, 1.0))
+        if w:
+            steps.append((n - 1, 1.0))
+        if no:
+            steps.append((n + nx, 1.0))
+            if e and flat[n + nx + 1]:
+                steps.append((n + nx + 1, _SQRT2))
+            if w and flat[n + nx - 1]:
+                steps.append((n + nx - 1, _SQRT2))
+        if so:
+            steps.append((n - nx, 1.0))
+            if e and flat[n - nx + 1]:
+                steps.append((n - nx + 1, _SQRT2))
+            if w and flat[n - nx - 1]:
+                steps.append((n - nx - 1, _SQRT2))
+        for m, c in steps:
+            if m in closed:
+                continue
+            ng = gc + c
+            if ng < best.get(m, math.inf):
+                best[m] = ng
+                came[m] = n
+                heapq.heappush(heap, (ng + h(m), ng, m))
+    return []
+
+
+def path_length(grid: NavGrid, path: list[Node]) -> float:
+    """Length in metres of a node path (straight lines between node centres)."""
+    if len(path) < 2:
+        return 0.0
+    p = grid.centres(np.array(path))
+    return float(np.hypot(*np.diff(p, axis=0).T).sum())
+
+
+def grid_line_of_sight(grid: NavGrid, a: Node, b: Node, passable: np.ndarray | None = None) -> bool:
+    """True when every cell the segment between the two node centres touches is passable.
+
+    Cells are found exactly from the segment's crossings of cell boundaries; passing
+    exactly through a cell corner also needs both cells beside the corner (no corner
+    cutting, as in :func:`astar`).
+    """
+    ok = grid.valid if passable is None else passable
+    (ai, aj), (bi, bj) = a, b
+    # in cell units with node centres at integer coordinates, cells span [k - .5, k + .5]
+    di, dj = bi - ai, bj - aj
+    ts = [0.0, 1.0]
+    for d, s in ((dj, aj), (di, ai)):
+        if d:
+            lo, hi = sorted((s, s + d))
+            k = np.arange(math.floor(lo - 0.5) + 1, math.ceil(hi + 0.5))  # boundaries k - .5
+            ts.extend(((k - 0.5 - s) / d).tolist())
+    t = np.unique(np.clip(ts, 0.0, 1.0))
+    mid = 0.5 * (t[1:] + t[:-1]) if len(t) > 1 else t
+    ci = np.floor(ai + mid * di + 0.5).astype(np.int64)
+    cj = np.floor(aj + mid * dj + 0.5).astype(np.int64)
+    # corners: a t where both an x and a z boundary are crossed at once
+    if di and dj:
+        tx = (np.arange(math.floor(min(aj, bj) - 0.5) + 1, math.ceil(max(aj, bj) + 0.5)) - 0.5 - aj) / dj
+        tz = (np.arange(math.floor(min(ai, bi) - 0.5) + 1, math.ceil(max(ai, bi) + 0.5)) - 0.5 - ai) / di
+        both = np.intersect1d(np.round(tx, 12), np.round(tz, 12))
+        both = both[(both > 0) & (both < 1)]
+        if len(both):
+            eps = 1e-9
+            for e1, e2 in ((eps, -eps), (-eps, eps)):
+                # just before in z and after in x, and the other way round
+                zi = np.floor(ai + (both + e1) * di + 0.5).astype(np.int64)
+                xj = np.floor(aj + (both + e2) * dj + 0.5).astype(np.int64)
+                ci = np.concatenate([ci, zi])
+                cj = np.concatenate([cj, xj])
+    nz, nx = ok.shape
+    if (ci < 0).any() or (ci >= nz).any() or (cj < 0).any() or (cj >= nx).any():
+        return False
+    return bool(ok[ci, cj].all())
+
+
+def smooth_path(
+    obstacles: NavGrid | WallQuadtree, path, *, grid: NavGrid | None = None, clearance: float = 0.0,
+):
+    """Drop the waypoints a straight line can skip (greedy, farthest visible first).
+
+    obstacles : a NavGrid (line of sight = every touched cell passable) or a
+                WallQuadtree (line of sight = no wall within ``clearance`` of the line).
+    path : a list of nodes (as :func:`astar` returns), or an (m, 2) array of world
+           points when ``obstacles`` is a quadtree.  Nodes with a quadtree need ``grid``
+           to place them.
+    Returns the kept waypoints in the same form, first and last always kept.
+    """
+    nodes_given = not (isinstance(path, np.ndarray) and path.dtype.kind == "f")
+    if len(path) <= 2:
+        return list(path) if nodes_given else np.asarray(path)
+    if isinstance(obstacles, NavGrid):
+        if not nodes_given:
+            raise TypeError("smoothing against a NavGrid takes a list of nodes")
+        nodes = [tuple(map(int, n)) for n in path]
+        keep = [0]
+        while keep[-1] < len(nodes) - 1:
+            a = keep[-1]
+            nxt = a + 1
+            for k in range(len(nodes) - 1, a + 1, -1):
+                if grid_line_of_sight(obstacles, nodes[a], nodes[k]):
+                    nxt = k
+                    break
+            keep.append(nxt)
+        return [nodes[k] for k in keep]
+    if nodes_given:
+        if grid is None:
+            raise TypeError("smoothing nodes against a quadtree needs grid= to place them")
+        pts = grid.centres(np.array(path))
+    else:
+        pts = np.asarray(path, dtype=np.float64).reshape(-1, 2)
+    keep = [0]
+    while keep[-1] < len(pts) - 1:
+        a = keep[-1]
+        later = np.arange(a + 1, len(pts))
+        off, _ = obstacles.query_capsules(np.repeat(pts[a][None], len(later), axis=0), pts[later], clearance)
+        clear = np.flatnonzero(np.diff(off) == 0)
+        # the next waypoint always stays: it was reachable from a in the input path
+        keep.append(int(later[clear[-1]]) if len(clear) else a + 1)
+    if nodes_given:
+        return [tuple(map(int, path[k])) for k in keep]
+    return pts[keep]
