@@ -48,7 +48,7 @@ def format_hull(points: np.ndarray, header: str = "") -> str:
     ymid = 0.5 * (pts[:, 1].min() + pts[:, 1].max())
     out = np.round(pts, 4)
     y = pts[:, 1] * 1e4
-    out[:, 1] = np.where(pts[:, 1] >= ymid, np.ceil(y - 1e-6), np.floor(y + 1e-6)) / 1e4
+    out[:, 1] = np.where(pts[:, 1] >= ymid, np.ceil(y), np.floor(y)) / 1e4
     lines = [f"# {line}" for line in header.splitlines()] if header else []
     lines.append("# x y z   (vehicle frame: +x forward, +y up, +z right; metres)")
     lines += [f"{x:.4f} {y:.4f} {z:.4f}" for x, y, z in out]

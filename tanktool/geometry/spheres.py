@@ -60,6 +60,14 @@ class SphereTree:
         counts = np.bincount(self.parent[1:], minlength=k) if k > 1 else np.zeros(k, np.int64)
         splits = np.cumsum(counts)[:-1]
         self._children = list(np.split(order, splits)) if k > 1 else [np.zeros(0, np.int64)]
+        self._leaf = np.array([len(c) == 0 for c in self._children])
+        # row i: the spheres that replace i one level down (its children, or i itself
+        # for a leaf), padded with -1, so a whole frontier expands in one numpy step
+        width = max(1, max(len(c) for c in self._children))
+        self._expand = np.full((k, width), -1, dtype=np.int64)
+        for i, c in enumerate(self._children):
+            row = c if len(c) else np.array([i])
+            self._expand[i, : len(row)] = row
 
     def __len__(self) -> int:
         return len(self.radii)
@@ -74,7 +82,7 @@ class SphereTree:
 
     def is_leaf(self) -> np.ndarray:
         """(k,) bool: True for spheres without children."""
-        return np.array([len(c) == 0 for c in self._children])
+        return self._leaf.copy()
 
     def leaves(self) -> np.ndarray:
         """Indices of the leaf spheres, in file order."""
@@ -121,7 +129,7 @@ def tree_overlap(tA: SphereTree, poseA: Pose, tB: SphereTree, poseB: Pose) -> li
     cb = to_world(tB, *poseB)
     ia = np.zeros(1, np.int64)
     ib = np.zeros(1, np.int64)
-    leafA, leafB = tA.is_leaf(), tB.is_leaf()
+    leafA, leafB = tA._leaf, tB._leaf
     found: list[tuple[int, int]] = []
     while len(ia):
         d2 = np.sum((ca[ia] - cb[ib]) ** 2, axis=1)
@@ -129,15 +137,12 @@ def tree_overlap(tA: SphereTree, poseA: Pose, tB: SphereTree, poseB: Pose) -> li
         ia, ib = ia[hit], ib[hit]
         done = leafA[ia] & leafB[ib]
         found.extend(zip(ia[done].tolist(), ib[done].tolist()))
-        next_a: list[np.ndarray] = []
-        next_b: list[np.ndarray] = []
-        for a, b in zip(ia[~done].tolist(), ib[~done].tolist()):
-            kids_a = tA.children(a) if not leafA[a] else np.array([a])
-            kids_b = tB.children(b) if not leafB[b] else np.array([b])
-            next_a.append(np.repeat(kids_a, len(kids_b)))
-            next_b.append(np.tile(kids_b, len(kids_a)))
-        ia = np.concatenate(next_a) if next_a else np.zeros(0, np.int64)
-        ib = np.concatenate(next_b) if next_b else np.zeros(0, np.int64)
+        ia, ib = ia[~done], ib[~done]
+        # a leaf stays itself while the other side goes a level down
+        ea, eb = tA._expand[ia], tB._expand[ib]
+        valid = (ea >= 0)[:, :, None] & (eb >= 0)[:, None, :]
+        ia = np.broadcast_to(ea[:, :, None], valid.shape)[valid]
+        ib = np.broadcast_to(eb[:, None, :], valid.shape)[valid]
     return sorted(found)
 
 
