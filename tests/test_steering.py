@@ -124,35 +124,36 @@ def test_boxed_in_and_dead_ends():
     assert choose_next(lone, (1, 1), "-x") is None
 
 
+# drawn as in our pictures: z up, so the top line is the highest row i
 PAPER_FIGURE = """
-    ##############
-    #######.######
-    #######G######
-    #.........####
-    #######.######
-    ##############
+    ###############
+    ######.########
+    ######G########
+    ####..........#
+    ######.########
+    ###############
 """
 
 
 def test_grid_shaped_like_the_paper_figure():
     """The paper's example: the grey node heading down, three children in front, HIJO 1
     (ahead-right) leading along a long row, HIJO 2 (straight) a short column, HIJO 3
-    (ahead-left) into a wall.  Our picture is the top view from above (x right, z down),
-    so "down" is +z and its right is -x."""
-    g = grid_from_mask(mask(PAPER_FIGURE))
-    node, heading = (2, 7), "+z"
+    (ahead-left) a short way to a wall.  Our pictures have z up, so "down" is -z and
+    its right is +x."""
+    g = grid_from_mask(mask(PAPER_FIGURE)[::-1])
+    node, heading = (3, 6), "-z"
     kids = {c.name: c for c in children(g, node, heading)}
     hijo1, hijo2, hijo3 = kids["right"], kids["ahead"], kids["left"]
-    assert (hijo1.node, hijo2.node, hijo3.node) == ((3, 6), (3, 7), (3, 8))
+    assert (hijo1.node, hijo2.node, hijo3.node) == ((2, 7), (2, 6), (2, 5))
     table = {
         name: (int(g.row_index[c.node]), int(g.col_index[c.node]), int(g.row_total[c.node]), int(g.col_total[c.node]))
         for name, c in (("HIJO 1", hijo1), ("HIJO 2", hijo2), ("HIJO 3", hijo3))
     }
-    # renglon, columna, total renglones, total columnas (rows of 9 nodes, column of 4)
-    assert table == {"HIJO 1": (6, 1, 9, 1), "HIJO 2": (7, 3, 9, 4), "HIJO 3": (8, 1, 9, 1)}
-    assert (hijo1.ahead, hijo2.ahead, hijo3.ahead) == (5, 1, 1)
+    # renglon, columna, total renglones, total columnas: a row of 10 as in the paper
+    assert table == {"HIJO 1": (4, 1, 10, 1), "HIJO 2": (3, 2, 10, 4), "HIJO 3": (2, 1, 10, 1)}
+    assert (hijo1.ahead, hijo2.ahead, hijo3.ahead) == (6, 1, 1)
     assert choose_next(g, node, heading) == hijo1.node
-    assert heading_of_move(node, hijo1.node, heading) == "-x"  # the agent turns right
+    assert heading_of_move(node, hijo1.node, heading) == "+x"  # the agent turns right
 
 
 def test_paper_table_numbers_single_out_hijo_1():

@@ -1,0 +1,255 @@
+"""``tanktool build-navgrid ARENA``: the wall quadtree and the AI navigation grid.
+
+ARENA is an arena bundle folder (outputs go into it and their sha256 into its
+``arena.toml``) or a bare ``walls.txt`` (outputs go next to it).  Everything is
+computed and rendered in memory first; only then are the files written, each through
+a temporary file and a rename, ``arena.toml`` last.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import click
+
+from ..errors import ArenaError
+from .main import echo, is_quiet
+from .options import progress
+
+#: where bundled vehicles live (the largest footprint sets the default clearance)
+VEHICLES_DIR = Path(__file__).resolve().parents[2] / "vehicles"
+DEFAULTS = {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
+#: show a progress bar from this many nodes up
+PROGRESS_NODES = 1_000_000
+
+
+@dataclass
+class Target:
+    """What build-navgrid works on: walls, where outputs go, and the bundle's manifest."""
+
+    walls: Any
+    out_dir: Path
+    name: str
+    bounds: Any = None
+    spawns: Any = None
+    manifest: Path | None = None
+    toml: dict[str, Any] = field(default_factory=dict)
+    prefix: str = ""  # output names are prefix + navgrid.npz, ...
+
+    def output(self, name: str) -> Path:
+        return self.out_dir / f"{self.prefix}{name}"
+
+
+def open_target(path: Path) -> Target:
+    """An arena bundle folder (or its arena.toml), or a bare walls file."""
+    import numpy as np
+
+    from ..formats.bundle import read_toml
+    from ..formats.walls_txt import read_walls
+
+    if path.is_file() and path.name == "arena.toml":
+        path = path.parent
+    if not path.exists():
+        raise ArenaError(f"{path}: no such arena folder or walls file")
+    if path.is_file():
+        walls = read_walls(path)
+        if len(walls) == 0:
+            raise ArenaError(f"{path}: no walls")
+        # outputs next to it; named after it unless it is the usual walls.txt
+        prefix = "" if path.name == "walls.txt" else f"{path.stem}."
+        return Target(walls, path.parent, path.stem, walls.bounds, prefix=prefix)
+    manifest = path / "arena.toml"
+    if not manifest.exists():
+        raise ArenaError(f"{path}: not an arena bundle (no arena.toml)")
+    doc = read_toml(manifest)
+    wfile = path / str(doc.get("walls", {}).get("file", "walls.txt"))
+    walls = read_walls(wfile)
+    if len(walls) == 0:
+        raise ArenaError(f"{wfile}: no walls")
+    bounds = walls.bounds
+    if "bounds" in doc:
+        try:
+            bounds = np.array(doc["bounds"], dtype=np.float64).reshape(2, 2)
+        except (TypeError, ValueError):
+            raise ArenaError(f"{manifest}: bounds must be [[xmin, zmin], [xmax, zmax]], got {doc['bounds']!r}") from None
+        if not (np.isfinite(bounds).all() and (bounds[1] > bounds[0]).all()):
+            raise ArenaError(f"{manifest}: bounds {bounds.tolist()} have no area")
+    spawns = None
+    if doc.get("spawns"):
+        try:
+            spawns = np.array(doc["spawns"], dtype=np.float64).reshape(len(doc["spawns"]), 3)
+        except (TypeError, ValueError):
+            raise ArenaError(f"{manifest}: spawns must be a list of [x, z, heading], got {doc['spawns']!r}") from None
+    return Target(walls, path, str(doc.get("name", path.name)), bounds, spawns, manifest, doc)
+
+
+def default_clearance(target: Target) -> tuple[float, str]:
+    """The footprint radius of the largest bundled vehicle, else arena.toml's value."""
+    from ..formats.bundle import read_toml
+
+    best: tuple[float, str] | None = None
+    for vt in sorted(VEHICLES_DIR.glob("*/vehicle.toml")):
+        try:
+            r = read_toml(vt).get("footprint_radius")
+            if not isinstance(r, (int, float)) or isinstance(r, bool):
+                from ..formats.vehicle_bundle import load_vehicle
+
+                r = load_vehicle(vt.parent).footprint_radius
+        except Exception as e:  # a broken vehicle must not stop the arena tools
+            click.echo(f"warning: {vt}: skipped for the default clearance ({e})", err=True)
+            continue
+        if math.isfinite(r) and r > 0 and (best is None or r > best[0]):
+            best = (float(r), f"footprint radius of vehicle '{vt.parent.name}'")
+    if best is not None:
+        return best
+    r = target.toml.get("navgrid", {}).get("clearance")
+    if isinstance(r, (int, float)) and not isinstance(r, bool) and math.isfinite(r) and r >= 0:
+        return float(r), "arena.toml [navgrid] clearance"
+    return DEFAULTS["clearance"], "built-in default"
+
+
+def parse_region(text: str | None, bounds) -> Any:
+    """``x0,z0,x1,z1`` -> [[x0, z0], [x1, z1]], checked against the grid's bounds."""
+    import numpy as np
+
+    if text is None:
+        return None
+    parts = text.replace(" ", "").split(",")
+    try:
+        v = [float(p) for p in parts]
+    except ValueError:
+        raise ArenaError(f"--region: expected four numbers x0,z0,x1,z1, got {text!r}") from None
+    if len(v) != 4 or not all(math.isfinite(a) for a in v):
+        raise ArenaError(f"--region: expected four numbers x0,z0,x1,z1, got {text!r}")
+    x0, z0, x1, z1 = v
+    if not (x1 > x0 and z1 > z0):
+        raise ArenaError(f"--region: need x0 < x1 and z0 < z1, got {text}")
+    if x1 < bounds[0][0] or x0 > bounds[1][0] or z1 < bounds[0][1] or z0 > bounds[1][1]:
+        raise ArenaError(f"--region {text} lies outside the arena bounds {np.asarray(bounds).tolist()}")
+    return np.array([[x0, z0], [x1, z1]])
+
+
+def _number_option(name: str, value: float | None, lo: float, lo_open: bool) -> None:
+    if value is None:
+        return
+    bad = not math.isfinite(value) or (value <= lo if lo_open else value < lo)
+    if bad:
+        raise ArenaError(f"--{name} must be {'>' if lo_open else '>='} {lo:g}, got {value:g}")
+
+
+@click.command("build-navgrid")
+@click.argument("arena", type=click.Path(path_type=Path))
+@click.option("--cell", type=float, default=None, help="Node spacing in metres (default: arena.toml [navgrid] cell, else 0.5).")
+@click.option("--clearance", type=float, default=None,
+              help="Minimum distance from a valid node to every wall, metres (default: the largest bundled vehicle's footprint radius).")
+@click.option("--quadtree-depth", type=int, default=None, help="Levels below the root (default 3: 64 leaves).")
+@click.option("--plot", "plot_path", type=click.Path(path_type=Path), default=None,
+              help="Picture to write, .png or .svg (default: navgrid.png in the bundle, or NAME.navgrid.png beside a walls file).")
+@click.option("--annotate", type=click.Choice(["rows", "cols", "both", "none"]), default="both", show_default=True,
+              help="Run numbers printed on the nodes when they are readable.")
+@click.option("--region", default=None, metavar="X0,Z0,X1,Z1", help="Zoom the picture (and --table) to this rectangle.")
+@click.option("--table", "table_path", type=click.Path(path_type=Path), default=None,
+              help="Also write the 2002-style text table, one node a line.")
+def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quadtree_depth: int | None,
+                  plot_path: Path | None, annotate: str, region: str | None, table_path: Path | None) -> None:
+    """Build ARENA's wall quadtree and AI navigation grid, save them, and plot them.
+
+    ARENA is an arena bundle folder or a bare walls.txt file.
+    """
+    import time
+
+    from ..formats.bundle import atomic_write_bytes, atomic_write_text, dumps_toml, sha256_file
+    from ..nav.navgrid import build_navgrid as build, format_table, free_space, grid_shape, open_ends
+    from ..nav.quadtree import WallQuadtree
+    from ..plots.navgrid import render_navgrid
+
+    _number_option("cell", cell, 0.0, True)
+    _number_option("clearance", clearance, 0.0, False)
+    if quadtree_depth is not None and not 0 <= quadtree_depth <= 10:
+        raise ArenaError(f"--quadtree-depth must be 0..10, got {quadtree_depth}")
+    target = open_target(arena)
+    nav_t = target.toml.get("navgrid", {})
+    if cell is None:
+        cell = nav_t.get("cell", DEFAULTS["cell"])
+        _number_option("cell (arena.toml [navgrid])", cell, 0.0, True)
+    if quadtree_depth is None:
+        quadtree_depth = int(nav_t.get("quadtree_depth", DEFAULTS["quadtree_depth"]))
+        if not 0 <= quadtree_depth <= 10:
+            raise ArenaError(f"{target.manifest}: [navgrid] quadtree_depth must be 0..10, got {quadtree_depth}")
+    source = "--clearance"
+    if clearance is None:
+        clearance, source = default_clearance(target)
+    bounds = target.bounds
+    shape = grid_shape(bounds, cell)  # refuses absurd grids before any work
+    reg = parse_region(region, bounds)
+    plot_path = plot_path or target.output("navgrid.png")
+    fmt = plot_path.suffix.lower().lstrip(".")
+    if fmt not in ("png", "svg"):
+        raise ArenaError(f"--plot {plot_path}: the picture must be .png or .svg")
+    for p in [plot_path, table_path]:
+        if p is not None and not p.parent.is_dir():
+            raise ArenaError(f"{p}: folder {p.parent} does not exist")
+
+    loose = open_ends(target.walls)
+    if len(loose) and not is_quiet():
+        x, z = loose[0]
+        click.echo(
+            f"warning: {target.walls.path}: {len(loose)} wall end(s) do not close up (first at {x:g}, {z:g}); "
+            "free space near them depends on the direction it is scanned", err=True,
+        )
+
+    t0 = time.perf_counter()
+    nodes = shape[0] * shape[1]
+    if nodes >= PROGRESS_NODES:
+        with progress(length=shape[0], label=f"classifying {nodes:,} nodes") as bar:
+            grid = build(target.walls, cell, clearance, spawns=target.spawns, bounds=bounds, progress=bar.update)
+    else:
+        grid = build(target.walls, cell, clearance, spawns=target.spawns, bounds=bounds)
+    tree = WallQuadtree.build(target.walls.segments, bounds, depth=quadtree_depth)
+    t_build = time.perf_counter() - t0
+
+    # everything rendered in memory first: a failure here writes nothing
+    free = free_space(target.walls, grid.origin, cell, shape)
+    picture = render_navgrid(
+        grid, target.walls, fmt=fmt, quadtree=tree, free=free, spawns=target.spawns,
+        annotate=annotate, region=reg, title=target.name,
+    )
+    table = format_table(grid, reg) if table_path is not None else None
+    tree_path = target.output("quadtree.npz")
+    grid_path = target.output("navgrid.npz")
+
+    atomic_write_bytes(grid_path, grid.to_bytes())
+    tree.save(tree_path)
+    atomic_write_bytes(plot_path, picture)
+    if table is not None:
+        atomic_write_text(table_path, table)
+    if target.manifest is not None:
+        doc = dict(target.toml)
+        doc["navgrid"] = {**doc.get("navgrid", {}), "cell": float(cell), "clearance": float(clearance),
+                          "quadtree_depth": int(quadtree_depth)}
+        derived = dict(doc.get("derived", {}))
+        derived["navgrid.npz"] = sha256_file(grid_path)
+        derived["quadtree.npz"] = sha256_file(tree_path)
+        if plot_path.resolve() == (target.out_dir / "navgrid.png").resolve():
+            derived["navgrid.png"] = sha256_file(plot_path)
+        doc["derived"] = derived
+        atomic_write_text(target.manifest, dumps_toml(doc))
+
+    n_valid = int(grid.valid.sum())
+    n_reach = int((grid.valid & grid.reachable).sum())
+    echo(
+        f"{target.name}: {shape[0]} x {shape[1]} nodes at {cell:g} m, clearance {clearance:g} m ({source}): "
+        f"{n_valid:,} valid, {n_reach:,} reachable, {n_valid - n_reach:,} unreachable "
+        f"({t_build * 1000:.0f} ms)"
+    )
+    if target.spawns is not None and len(grid.spawn_nodes) < len(target.spawns):
+        click.echo(f"warning: {len(target.spawns) - len(grid.spawn_nodes)} spawn point(s) have no valid node nearby", err=True)
+    wrote = [str(grid_path), f"{tree_path} ({len(tree.leaves)} leaves, depth {tree.max_depth})", str(plot_path)]
+    if table_path is not None:
+        wrote.append(str(table_path))
+    if target.manifest is not None:
+        wrote.append(f"{target.manifest} (hashes)")
+    echo("wrote " + ", ".join(wrote))

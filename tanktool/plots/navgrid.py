@@ -1,0 +1,177 @@
+"""Top view of a navigation grid: nodes by state, walls with their normals, the
+quadtree's leaves, spawn points, and the run numbers on the nodes when they fit.
+
+z points up the picture (as in the other tanktool pictures), x to the right.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+from typing import Any
+
+import numpy as np
+
+#: node states, drawn in this order of colours
+STATE_COLOURS = {
+    "solid / outside": "#4a4a4a",
+    "too close to a wall": "#d9cfc1",
+    "valid": "#8fd18b",
+    "valid, unreachable": "#f0a14a",
+}
+WALL_COLOUR = "#1b1b1b"
+QUADTREE_COLOUR = "#2f6db5"
+SPAWN_COLOUR = "#d62728"
+#: annotate nodes only when a node is at least this many points wide
+MIN_LABEL_PT = {"rows": 13.0, "cols": 13.0, "both": 17.0}
+
+
+def node_states(grid: Any, free: np.ndarray | None = None) -> np.ndarray:
+    """(nz, nx) int codes 0..3 in the order of :data:`STATE_COLOURS`."""
+    s = np.zeros(grid.shape, dtype=np.int8)
+    if free is not None:
+        s[free] = 1
+    else:  # without the free mask, invalid nodes are all one colour
+        s[:] = 1
+    s[grid.valid] = 3
+    s[grid.reachable & grid.valid] = 2
+    return s
+
+
+def render_navgrid(
+    grid: Any,
+    walls: Any,
+    *,
+    fmt: str = "png",
+    quadtree: Any = None,
+    free: np.ndarray | None = None,
+    spawns: np.ndarray | None = None,
+    annotate: str = "both",
+    region: np.ndarray | None = None,
+    title: str | None = None,
+    dpi: int = 120,
+) -> bytes:
+    """The picture as PNG or SVG bytes (``fmt``).
+
+    grid : NavGrid; walls : WallList; quadtree : WallQuadtree (its leaves are drawn);
+    free : free-space mask, to tell "too close to a wall" from "solid / outside";
+    spawns : (k, 3) ``[x, z, heading]``; region : ``[[x0, z0], [x1, z1]]`` to zoom in;
+    annotate : "rows" (renglón/total), "cols" (columna/total), "both" or "none".
+    """
+    import matplotlib
+
+    if os.environ.get("DISPLAY") is None:
+        matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import ListedColormap
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    b = grid.bounds
+    view = b.copy() if region is None else np.asarray(region, dtype=np.float64).reshape(2, 2)
+    # nodes in view decide how big the figure must be for labels to fit
+    j0 = max(0, int(math.floor((view[0, 0] - grid.origin[0]) / grid.cell)))
+    j1 = min(grid.nx, int(math.ceil((view[1, 0] - grid.origin[0]) / grid.cell)))
+    i0 = max(0, int(math.floor((view[0, 1] - grid.origin[1]) / grid.cell)))
+    i1 = min(grid.nz, int(math.ceil((view[1, 1] - grid.origin[1]) / grid.cell)))
+    across = max(1, j1 - j0)
+    tall = max(1, i1 - i0)
+    aspect = (view[1, 1] - view[0, 1]) / max(view[1, 0] - view[0, 0], 1e-9)
+    want_pt = MIN_LABEL_PT.get(annotate, 0.0) * 1.25
+    width_in = 10.0
+    if annotate != "none" and across <= 80 and tall <= 80:
+        width_in = min(max(width_in, across * want_pt / 72.0), 22.0)
+    height_in = min(max(width_in * aspect, 3.0), 22.0)
+    width_in = min(width_in, 22.0) + 2.6  # room for the legend
+    fig = plt.figure(figsize=(width_in, height_in + 0.8))
+    ax = fig.add_axes((0.06, 0.06, (width_in - 2.6) / width_in * 0.92, 0.86))
+
+    states = node_states(grid, free)
+    cmap = ListedColormap(list(STATE_COLOURS.values()))
+    ax.imshow(
+        states, origin="lower", cmap=cmap, vmin=-0.5, vmax=3.5, interpolation="nearest",
+        extent=(b[0, 0], b[1, 0], b[0, 1], b[1, 1]), zorder=0,
+    )
+    cell_pt = (width_in - 2.6) * 0.92 * 72.0 / across
+    if cell_pt >= 6:  # node centres and cell edges, when they do not turn into a smear
+        xs, zs = np.meshgrid(grid.node_x[j0:j1], grid.node_z[i0:i1])
+        open_ = states[i0:i1, j0:j1] > 0  # no dots on solid ground: less clutter
+        ax.scatter(xs[open_], zs[open_], s=max(1.0, (cell_pt * 0.12) ** 2), c="#00000055", lw=0, zorder=1)
+        gx = grid.origin[0] + np.arange(j0, j1 + 1) * grid.cell
+        gz = grid.origin[1] + np.arange(i0, i1 + 1) * grid.cell
+        ax.vlines(gx, gz[0], gz[-1], colors="#ffffff", lw=0.4, alpha=0.7, zorder=1)
+        ax.hlines(gz, gx[0], gx[-1], colors="#ffffff", lw=0.4, alpha=0.7, zorder=1)
+
+    if quadtree is not None:
+        lb = quadtree.box[quadtree.leaves]
+        lines = []
+        for (x0, z0), (x1, z1) in lb.tolist():
+            lines += [[(x0, z0), (x1, z0)], [(x1, z0), (x1, z1)], [(x1, z1), (x0, z1)], [(x0, z1), (x0, z0)]]
+        ax.add_collection(LineCollection(lines, colors=QUADTREE_COLOUR, lw=0.8, alpha=0.55, zorder=2))
+
+    seg = walls.segments
+    ax.add_collection(LineCollection(seg, colors=WALL_COLOUR, lw=1.8, capstyle="round", zorder=3))
+    if walls.aux is not None:
+        ax.add_collection(LineCollection(walls.aux, colors=WALL_COLOUR, lw=0.8, linestyles="dashed", zorder=3))
+    # normals as short ticks into free space, when there are few enough to read
+    view_span = float(np.max(view[1] - view[0]))
+    if 0 < len(seg) <= 400:
+        mid = seg.mean(axis=1)
+        tick = walls.normals * (0.02 * view_span)
+        ax.add_collection(LineCollection(np.stack([mid, mid + tick], axis=1), colors=WALL_COLOUR, lw=1.0, zorder=3))
+
+    if spawns is not None and len(spawns):
+        sp = np.asarray(spawns, dtype=np.float64).reshape(len(spawns), -1)
+        ax.scatter(sp[:, 0], sp[:, 1], marker="*", s=180, c=SPAWN_COLOUR, edgecolors="white", linewidths=0.8, zorder=5)
+        if sp.shape[1] >= 3:
+            L = 0.04 * view_span
+            ax.quiver(sp[:, 0], sp[:, 1], np.cos(sp[:, 2]) * L, np.sin(sp[:, 2]) * L, angles="xy",
+                      scale_units="xy", scale=1, color=SPAWN_COLOUR, width=0.004, zorder=5)
+
+    labelled = 0
+    if annotate != "none" and cell_pt >= MIN_LABEL_PT.get(annotate, 99):
+        font = min(9.0, cell_pt / (4.2 if annotate == "both" else 3.6))
+        ii, jj = np.nonzero(grid.valid[i0:i1, j0:j1])
+        ii, jj = ii + i0, jj + j0
+        for i, j in zip(ii.tolist(), jj.tolist()):
+            x, z = grid.centre(i, j)
+            r = f"{grid.row_index[i, j]}/{grid.row_total[i, j]}"
+            c = f"{grid.col_index[i, j]}/{grid.col_total[i, j]}"
+            text = {"rows": r, "cols": c, "both": f"{r}\n{c}"}[annotate]
+            ax.text(x, z, text, ha="center", va="center", fontsize=font, color="#10301a", linespacing=0.95, zorder=4)
+            labelled += 1
+
+    pad = 0.02 * view_span if region is None else 0.0
+    ax.set_xlim(view[0, 0] - pad, view[1, 0] + pad)
+    ax.set_ylim(view[0, 1] - pad, view[1, 1] + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    n_valid = int(grid.valid.sum())
+    n_reach = int((grid.valid & grid.reachable).sum())
+    head = title or "navigation grid"
+    ax.set_title(
+        f"{head}: {grid.nz} x {grid.nx} nodes, cell {grid.cell:g} m, clearance {grid.clearance:g} m\n"
+        f"{n_valid:,} valid ({n_reach:,} reachable, {n_valid - n_reach:,} unreachable) of {grid.valid.size:,}",
+        fontsize=10,
+    )
+    handles = [Patch(fc=c, ec="#888888", label=k) for k, c in STATE_COLOURS.items()]
+    handles.append(Line2D([], [], color=WALL_COLOUR, lw=1.8, label="wall (tick: free side)"))
+    if walls.aux is not None:
+        handles.append(Line2D([], [], color=WALL_COLOUR, lw=0.8, ls="--", label="auxiliary rectangle"))
+    if quadtree is not None:
+        handles.append(Line2D([], [], color=QUADTREE_COLOUR, lw=0.8, alpha=0.7,
+                              label=f"quadtree leaves ({len(quadtree.leaves)}, depth {quadtree.max_depth})"))
+    if spawns is not None and len(spawns):
+        handles.append(Line2D([], [], marker="*", color=SPAWN_COLOUR, lw=0, ms=12, label="spawn point"))
+    if labelled:
+        handles.append(Patch(fc="none", ec="none", label={
+            "rows": "labels: renglón/total", "cols": "labels: columna/total",
+            "both": "labels: renglón/total\n            columna/total"}[annotate]))
+    fig.legend(handles=handles, loc="upper right", fontsize=8, frameon=False, bbox_to_anchor=(0.995, 0.93))
+    buf = io.BytesIO()
+    fig.savefig(buf, format=fmt, dpi=dpi)
+    plt.close(fig)
+    return buf.getvalue()
