@@ -1,0 +1,92 @@
+"""``tanktool play``: a match.
+
+``--headless`` runs scripted bots without window or sound as fast as the machine allows
+and can write a JSON report.  Without it, the windowed game would start; it is not built
+yet, so the command says so and does the best thing that exists: a short headless match
+on the default arena, a scoreboard, and a top-view picture of the final state.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+
+from ..errors import ArenaError, TanktoolError
+from .main import echo
+from .options import progress
+
+
+def _arena_ref(arena: str | None) -> str:
+    from ..sim.match import default_arena
+
+    ref = arena or default_arena()
+    if ref is None:
+        raise ArenaError("no arena given and none bundled under arenas/ (use --arena PATH)")
+    return ref
+
+
+@click.command("play")
+@click.option("--headless", is_flag=True, help="No window or sound: run scripted bots as fast as possible.")
+@click.option("--arena", "arena", default=None, metavar="A",
+              help="Arena bundle: a folder, or the name of a bundled one (box, maze, paper2002).")
+@click.option("--vehicle", "vehicle", default=None, metavar="V",
+              help="Vehicle bundle: a folder, or the name of a bundled one (light, heavy).")
+@click.option("--bots", type=click.IntRange(1, 64), default=None, help="Number of tanks (default 8 headless, 4 otherwise).")
+@click.option("--seconds", type=click.FloatRange(0, 86400, min_open=True), default=None,
+              help="Simulated seconds (default 60 headless, 20 otherwise).")
+@click.option("--seed", type=int, default=0, show_default=True, help="Random seed: same seed, same match.")
+@click.option("--integrator", type=click.Choice(["semi-implicit", "euler"]), default="semi-implicit",
+              show_default=True, help="Semi-implicit Euler, or the 2002 paper's explicit Euler.")
+@click.option("--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Write the match report (JSON) here.")
+@click.option("--picture", "picture", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Save a top view of the final state (PNG).  Default without --headless: match.png.")
+def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | None, seconds: float | None,
+         seed: int, integrator: str, report_path: Path | None, picture: Path | None) -> None:
+    """Play a match: bots on an arena.
+
+    \b
+    Examples:
+      tanktool play --headless --arena box --bots 8 --seconds 60 --seed 1 --report match.json
+      tanktool play --headless --arena arenas/maze --vehicle heavy --seconds 600
+    """
+    from ..sim.match import default_vehicle, load_match_arena, load_tank_spec, run_match, scoreboard
+
+    if not headless:
+        echo("The game window is not built yet; running a short headless match instead "
+             "(tanktool play --headless for options).")
+        bots = 4 if bots is None else bots
+        seconds = 20.0 if seconds is None else seconds
+        picture = picture or Path("match.png")
+    bots = 8 if bots is None else bots
+    seconds = 60.0 if seconds is None else seconds
+    for out in (report_path, picture):
+        if out is not None and not out.parent.exists():
+            raise TanktoolError(f"{out}: folder {out.parent} does not exist")
+
+    info = load_match_arena(_arena_ref(arena))
+    vref = vehicle or default_vehicle()
+    spec = load_tank_spec(vref)
+    if vref is None:
+        echo("no vehicle bundled yet: using the built-in box tank")
+    steps = int(round(seconds * 120))
+    with progress(length=steps, label=f"{info.name}: {bots} bots, {seconds:g} s") as bar:
+        result = run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
+                           integrator=integrator, on_progress=bar.update)
+    report = result.report
+    echo(scoreboard(report))
+    timing = report["timing"]
+    echo(f"{report['steps']} steps in {timing['wall_clock_s']:.2f} s: "
+         f"{timing['steps_per_second']:.0f} steps/s, {timing['realtime_factor']:.1f}x real time")
+    if report_path is not None:
+        from ..formats.bundle import atomic_write_text
+
+        atomic_write_text(report_path, json.dumps(report, indent=1) + "\n")
+        echo(f"report: {report_path}")
+    if picture is not None:
+        from ..plots.match import save_match_picture
+
+        save_match_picture(result, picture)
+        echo(f"picture: {picture}")

@@ -1,0 +1,191 @@
+"""Headless matches: load an arena and a vehicle, put scripted bots in a world, run it
+for a number of simulated seconds as fast as the machine allows, and report.
+
+The report is one JSON-ready dict: ``arena``, ``seed``, ``seconds`` (simulated),
+``tanks`` (name, kills, deaths, shots, hits, wall_bumps, distance, position [x, z] at
+the end, ...), ``events`` (the timeline) and, under ``timing`` only, everything that
+depends on the machine's speed.  The same seed gives the same report apart from
+``timing``.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from ..errors import ArenaError, TanktoolError, VehicleError
+from .body import TankSpec
+from .driver import make_drivers
+from .world import DT, World
+
+REPO = Path(__file__).resolve().parent.parent.parent
+DEFAULT_ARENAS = ("box", "paper2002", "maze")
+DEFAULT_VEHICLES = ("light", "heavy")
+#: where the bot positions are sampled for the picture's trails [s]
+TRAIL_PERIOD = 0.25
+
+
+@dataclass
+class ArenaInfo:
+    name: str
+    walls: Any                    # WallList
+    spawns: np.ndarray            # (k, 3) [x, z, heading]
+    path: Path | None
+
+
+@dataclass
+class MatchResult:
+    report: dict[str, Any]
+    world: World
+    arena: ArenaInfo
+    trails: list[list[tuple[float, float]]] = field(default_factory=list)
+
+
+def _bundle_dir(ref: str | Path, kind: str, defaults: tuple[str, ...]) -> Path:
+    """A bundle folder from a path or a bundled name (``box`` -> <repo>/arenas/box)."""
+    p = Path(ref)
+    if p.exists():
+        return p
+    for base in (REPO / kind, Path.cwd() / kind):
+        if (base / str(ref)).is_dir():
+            return base / str(ref)
+    have = sorted(d.name for d in (REPO / kind).iterdir() if d.is_dir()) if (REPO / kind).is_dir() else []
+    err = ArenaError if kind == "arenas" else VehicleError
+    raise err(f"{ref}: no such {kind[:-1]} (a folder path, or one of: {', '.join(have) or 'none bundled yet'})")
+
+
+def default_arena() -> str | None:
+    """The first bundled arena that exists, or None."""
+    for name in DEFAULT_ARENAS:
+        if (REPO / "arenas" / name / "walls.txt").is_file():
+            return name
+    return None
+
+
+def default_vehicle() -> str | None:
+    for name in DEFAULT_VEHICLES:
+        if (REPO / "vehicles" / name / "vehicle.toml").is_file():
+            return name
+    return None
+
+
+def load_match_arena(ref: str | Path) -> ArenaInfo:
+    """Walls and spawn points of an arena bundle (name or folder)."""
+    path = _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
+    if importlib.util.find_spec("tanktool.arena") is not None:
+        from ..arena import load_arena  # the arena engineer's loader, when present
+
+        bundle = load_arena(path)
+        spawns = np.asarray(bundle.spawns, dtype=np.float64).reshape(-1, 3)
+        return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path))
+    from ..formats.bundle import read_toml
+    from ..formats.walls_txt import read_walls
+
+    walls = read_walls(path / "walls.txt")
+    manifest = path / "arena.toml"
+    doc = read_toml(manifest)
+    raw = doc.get("spawns", doc.get("arena", {}).get("spawns"))
+    try:
+        spawns = np.asarray(raw, dtype=np.float64).reshape(-1, 3)
+    except (TypeError, ValueError):
+        raise ArenaError(f"{manifest}: 'spawns' must be a list of [x, z, heading] triples") from None
+    if not np.isfinite(spawns).all():
+        raise ArenaError(f"{manifest}: spawns must be finite numbers")
+    return ArenaInfo(str(doc.get("name", path.name)), walls, spawns, path)
+
+
+def load_tank_spec(ref: str | Path | None) -> TankSpec:
+    """A vehicle bundle (name or folder) as a TankSpec; None gives the built-in box
+    tank (used only while no vehicle is bundled)."""
+    if ref is None:
+        return TankSpec.box("box")
+    from ..formats.vehicle_bundle import load_vehicle
+
+    return TankSpec.from_vehicle(load_vehicle(_bundle_dir(ref, "vehicles", DEFAULT_VEHICLES)))
+
+
+def _r(v: float, nd: int = 3) -> float:
+    v = round(float(v), nd)
+    return 0.0 if v == 0.0 else v       # no "-0.0" in reports
+
+
+def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 60.0, seed: int = 0,
+              dt: float = DT, integrator: str = "semi-implicit",
+              on_progress: Callable[[int], None] | None = None, progress_every: int = 120) -> MatchResult:
+    """Run ``bots`` scripted tanks for ``seconds`` of simulated time."""
+    if bots < 1:
+        raise TanktoolError(f"--bots must be at least 1, got {bots}")
+    if not (seconds > 0 and math.isfinite(seconds)):
+        raise TanktoolError(f"--seconds must be a positive number, got {seconds}")
+    names = [f"bot{i + 1}" for i in range(bots)]
+    world = World(arena.walls, [spec] * bots, arena.spawns, seed=seed, dt=dt, integrator=integrator, names=names)
+    drivers = make_drivers(world)
+    steps = int(round(seconds / dt))
+    events = []
+    trail_every = max(int(round(TRAIL_PERIOD / dt)), 1)
+    trails: list[list[tuple[float, float]]] = [[t.position] for t in world.tanks]
+    tanks = world.tanks
+    start = time.perf_counter()
+    for k in range(steps):
+        commands = [d(world, t) for d, t in zip(drivers, tanks)]
+        events.extend(world.step(None, commands))
+        if (k + 1) % trail_every == 0:
+            for tr, t in zip(trails, tanks):
+                tr.append(t.position if t.alive else (math.nan, math.nan))
+        if on_progress is not None and (k + 1) % progress_every == 0:
+            on_progress(progress_every)
+    wall = time.perf_counter() - start
+    if on_progress is not None and steps % progress_every:
+        on_progress(steps % progress_every)
+    report = make_report(world, arena.name, spec.name, seed, events)
+    report["timing"] = {
+        "wall_clock_s": round(wall, 4),
+        "steps_per_second": round(steps / wall, 1) if wall > 0 else None,
+        "realtime_factor": round(steps * dt / wall, 2) if wall > 0 else None,
+    }
+    return MatchResult(report, world, arena, trails)
+
+
+def make_report(world: World, arena: str, vehicle: str, seed: int, events: list) -> dict[str, Any]:
+    """The match report (without ``timing``)."""
+    names = world.names
+    tanks = []
+    for t in world.tanks:
+        x, z = t.position
+        tanks.append({
+            "name": t.name, "vehicle": t.spec.name, "kills": t.kills, "deaths": t.deaths,
+            "shots": t.shots, "hits": t.hits, "wall_bumps": t.wall_bumps,
+            "distance": _r(t.distance, 2), "position": [_r(x), _r(z)], "heading": _r(t.heading, 4),
+            "hit_points": _r(t.hp, 2), "alive": t.alive,
+        })
+    ranking = sorted(tanks, key=lambda d: (-d["kills"], d["deaths"], names.index(d["name"])))
+    return {
+        "arena": arena,
+        "vehicle": vehicle,
+        "seed": seed,
+        "seconds": _r(world.t, 6),
+        "steps": world.steps,
+        "dt": world.dt,
+        "integrator": world.integrator,
+        "winner": ranking[0]["name"] if ranking and ranking[0]["kills"] > 0 else None,
+        "tanks": tanks,
+        "events": [e.to_dict(names) for e in events],
+    }
+
+
+def scoreboard(report: dict[str, Any]) -> str:
+    """A fixed-width table of the tanks, best first."""
+    rows = sorted(report["tanks"], key=lambda d: (-d["kills"], d["deaths"]))
+    head = f"{'tank':<8} {'kills':>5} {'deaths':>6} {'shots':>5} {'hits':>4} {'bumps':>5} {'distance':>9}  position"
+    lines = [head, "-" * len(head)]
+    for d in rows:
+        x, z = d["position"]
+        lines.append(f"{d['name']:<8} {d['kills']:>5} {d['deaths']:>6} {d['shots']:>5} {d['hits']:>4} "
+                     f"{d['wall_bumps']:>5} {d['distance']:>8.1f}m  ({x:.1f}, {z:.1f})")
+    return "\n".join(lines)

@@ -1,0 +1,71 @@
+"""``tanktool play``: headless matches, reports, the stand-in for the window, errors."""
+
+from __future__ import annotations
+
+import json
+
+from click.testing import CliRunner
+from sim_fixtures import box_arena, maze_arena, write_arena_bundle
+
+from tanktool.cli.main import cli
+
+
+def _arena(tmp_path, maze=False):
+    walls, spawns = maze_arena() if maze else box_arena()
+    return write_arena_bundle(tmp_path / ("maze" if maze else "testbox"), walls, spawns,
+                              name="maze" if maze else "testbox")
+
+
+def test_headless_report(tmp_path):
+    arena = _arena(tmp_path)
+    out = tmp_path / "r.json"
+    args = ["play", "--headless", "--arena", str(arena), "--bots", "6", "--seconds", "5",
+            "--seed", "3", "--report", str(out)]
+    r = CliRunner().invoke(cli, args)
+    assert r.exit_code == 0, r.output
+    assert "kills" in r.output and "steps/s" in r.output
+    rep = json.loads(out.read_text())
+    assert rep["arena"] == "testbox" and rep["seed"] == 3 and rep["seconds"] == 5.0
+    assert len(rep["tanks"]) == 6
+    for t in rep["tanks"]:
+        assert {"name", "kills", "deaths", "shots", "hits", "wall_bumps", "distance", "position"} <= set(t)
+        assert len(t["position"]) == 2
+    assert set(rep["timing"]) == {"wall_clock_s", "steps_per_second", "realtime_factor"}
+    # same seed: same report apart from timing
+    out2 = tmp_path / "r2.json"
+    r = CliRunner().invoke(cli, args[:-1] + [str(out2)])
+    assert r.exit_code == 0
+    rep2 = json.loads(out2.read_text())
+    rep.pop("timing"), rep2.pop("timing")
+    assert rep == rep2
+
+
+def test_play_without_headless_runs_a_match_and_draws_it(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    arena = _arena(tmp_path, maze=True)
+    r = CliRunner().invoke(cli, ["play", "--arena", str(arena), "--seconds", "3"])
+    assert r.exit_code == 0, r.output
+    assert "window is not built yet" in r.output
+    assert "picture: match.png" in r.output
+    png = (tmp_path / "match.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+    assert sum(1 for line in r.output.splitlines() if line.startswith("bot")) == 4
+
+
+def test_bad_input_is_one_line_and_exit_2(tmp_path):
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(tmp_path / "nowhere")])
+    assert r.exit_code == 2
+    assert "error:" in r.output and "nowhere" in r.output and "Traceback" not in r.output
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    (bad / "walls.txt").write_text("0 0 10\n")
+    (bad / "arena.toml").write_text('name = "bad"\nspawns = [[1, 1, 0]]\n')
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(bad)])
+    assert r.exit_code == 2 and "walls.txt:1" in r.output
+    arena = _arena(tmp_path)
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(arena), "--bots", "20"])
+    assert r.exit_code == 2 and "spawn points" in r.output
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(arena), "--report",
+                                 str(tmp_path / "no" / "such" / "r.json")])
+    assert r.exit_code == 2 and "does not exist" in r.output
+    assert not (tmp_path / "no").exists()

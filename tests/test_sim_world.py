@@ -1,0 +1,207 @@
+"""The world step: stages, forces, integrators, determinism, and the soak."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from sim_fixtures import box_arena, bundled_arenas, free_spec, maze_arena
+
+from tanktool.errors import ArenaError, TanktoolError, VehicleError
+from tanktool.formats.walls_txt import read_walls
+from tanktool.sim.body import TankSpec
+from tanktool.sim.commands import Command, parse_command
+from tanktool.sim.driver import make_drivers
+from tanktool.sim.match import ArenaInfo, run_match
+from tanktool.sim.world import World
+
+
+def _open_world(spec: TankSpec, heading: float = 0.0, integrator: str = "semi-implicit") -> World:
+    walls, _ = box_arena()
+    w = World(walls, [spec], [(20.0, 10.0, heading)], seed=0, integrator=integrator)
+    w.tanks[0].place(20.0, 10.0, heading)
+    return w
+
+
+def test_commands_clamp_and_parse():
+    c = Command(advance=3.0, rotate=-7.0, strafe=float("nan"), fire=1)
+    assert c.to_tuple() == (1.0, -1.0, 0.0, True)
+    assert Command.from_keys(forward=True, left=True, strafe_right=True).to_tuple() == (1.0, -1.0, 1.0, False)
+    assert parse_command("0.5 -1 0 1") == Command(0.5, -1.0, 0.0, True)
+    with pytest.raises(TanktoolError):
+        parse_command("1 2")
+    with pytest.raises(TanktoolError):
+        parse_command("1 0 0 2")
+
+
+def test_stages_are_named_and_in_order():
+    names = ["initialise_objects", "direction", "forces", "integrate", "vertices",
+             "detect_collisions", "resolve_collisions"]
+    for n in names:
+        assert callable(getattr(World, n))
+    import inspect
+
+    src = inspect.getsource(World.step)
+    pos = [src.index(f"self.{n}(") for n in names]
+    assert pos == sorted(pos)
+
+
+def test_full_throttle_levels_off_at_top_speed():
+    spec = TankSpec.box("t", top_speed=10.0, friction=0.3)
+    w = _open_world(spec, heading=0.0)
+    t = w.tanks[0]
+    for _ in range(int(12 / w.dt)):
+        w.step(None, [Command(advance=1.0)])
+        assert t.speed() <= spec.top_speed * (1 + 1e-9)
+    # drag and fading engine balance a little under top speed: E(1 - v/vmax) = m μ v
+    expect = spec.engine_force / (spec.engine_force / spec.top_speed + spec.mass * spec.friction)
+    assert t.vx == pytest.approx(expect, rel=1e-3)
+    assert abs(t.vz) < 1e-9 and t.heading == 0.0
+    # coasting: rolling drag brings it to rest
+    for _ in range(int(30 / w.dt)):
+        w.step(None, [Command()])
+    assert t.speed() < 0.01 * expect
+
+
+def test_turn_strafe_and_grip_directions():
+    spec = TankSpec.box("t")
+    w = _open_world(spec, heading=0.3)
+    t = w.tanks[0]
+    for _ in range(60):
+        w.step(None, [Command(rotate=1.0)])
+    assert t.heading > 0.3 and t.omega > 0          # rotate > 0 turns towards the right side
+    w = _open_world(spec, heading=0.3)
+    t = w.tanks[0]
+    x0, z0 = t.x, t.z
+    for _ in range(120):
+        w.step(None, [Command(strafe=1.0)])
+    dx, dz = t.x - x0, t.z - z0
+    right = (-math.sin(0.3), math.cos(0.3))
+    assert dx * right[0] + dz * right[1] > 0.5
+    assert abs(dx * math.cos(0.3) + dz * math.sin(0.3)) < 1e-6
+    # lateral grip: a sideways slide dies far faster than a forward roll
+    w = _open_world(spec, heading=0.0)
+    t = w.tanks[0]
+    t.vz = 5.0                                       # sideways for heading 0
+    for _ in range(120):
+        w.step(None, [Command()])
+    side_left = abs(t.vz)
+    w = _open_world(spec, heading=0.0)
+    t = w.tanks[0]
+    t.vx = 5.0
+    for _ in range(120):
+        w.step(None, [Command()])
+    assert side_left < 0.01 and t.vx > 2.0
+
+
+@pytest.mark.parametrize("integrator", ["semi-implicit", "euler"])
+def test_one_step_of_each_integrator(integrator):
+    spec = free_spec(engine_force=50000.0, top_speed=1000.0)
+    w = _open_world(spec, heading=0.0, integrator=integrator)
+    t = w.tanks[0]
+    t.vx = 2.0
+    x0, dt = t.x, w.dt
+    w.step(None, [Command(advance=1.0)])
+    a = spec.engine_force * (1 - 2.0 / spec.top_speed) / spec.mass
+    assert t.vx == pytest.approx(2.0 + a * dt, rel=1e-12)
+    if integrator == "euler":
+        assert t.x - x0 == pytest.approx(2.0 * dt, rel=1e-12)        # old velocity
+    else:
+        assert t.x - x0 == pytest.approx((2.0 + a * dt) * dt, rel=1e-12)  # new velocity
+    with pytest.raises(ValueError):
+        World(box_arena()[0], [spec], [(1, 1, 0)], integrator="rk4")
+
+
+def _run(seed: int, steps: int = 1200, integrator: str = "semi-implicit"):
+    walls, spawns = box_arena()
+    w = World(walls, [TankSpec.box("t")] * 8, spawns, seed=seed, integrator=integrator)
+    drivers = make_drivers(w)
+    events = []
+    for _ in range(steps):
+        events += w.step(None, [d(w, t) for d, t in zip(drivers, w.tanks)])
+    return w.state(), [e.to_dict() for e in events]
+
+
+def test_determinism_same_seed_same_everything():
+    s1, e1 = _run(11)
+    s2, e2 = _run(11)
+    assert s1 == s2 and e1 == e2
+    assert any(e["kind"] == "shot" for e in e1)
+    s3, e3 = _run(12)
+    assert s3 != s1
+    s4, _ = _run(11, integrator="euler")
+    assert s4 != s1
+
+
+def test_report_is_reproducible_apart_from_timing():
+    walls, spawns = maze_arena()
+    arena = ArenaInfo("maze", walls, spawns, None)
+    r1 = run_match(arena, TankSpec.box("t"), bots=6, seconds=8, seed=5).report
+    r2 = run_match(arena, TankSpec.box("t"), bots=6, seconds=8, seed=5).report
+    assert "timing" in r1 and r1["timing"]["steps_per_second"] > 0
+    r1.pop("timing"), r2.pop("timing")
+    assert r1 == r2
+    assert r1["seconds"] == pytest.approx(8.0) and r1["steps"] == 960
+    keys = {"name", "kills", "deaths", "shots", "hits", "wall_bumps", "distance", "position"}
+    assert all(keys <= set(t) for t in r1["tanks"])
+    kills = sum(t["kills"] for t in r1["tanks"])
+    assert kills == sum(1 for e in r1["events"] if e["kind"] == "kill") == sum(t["deaths"] for t in r1["tanks"])
+    assert sum(t["shots"] for t in r1["tanks"]) == sum(1 for e in r1["events"] if e["kind"] == "shot")
+    assert sum(t["wall_bumps"] for t in r1["tanks"]) == sum(1 for e in r1["events"] if e["kind"] == "wall_bump")
+
+
+def test_bad_setup_errors():
+    walls, spawns = box_arena()
+    with pytest.raises(ArenaError, match="spawn points"):
+        World(walls, [TankSpec.box("t")] * 11, spawns)
+    with pytest.raises(VehicleError, match="restitution"):
+        TankSpec.box("t", restitution=1.5)
+    with pytest.raises(VehicleError, match="mass"):
+        TankSpec.box("t", mass=-1.0)
+
+
+def _soak(walls, spawns, seconds: float, seed: int = 1):
+    specs = [TankSpec.box("light", length=5.0, width=3.0, mass=15000.0),
+             TankSpec.box("heavy", length=7.0, width=3.6, mass=40000.0, engine_force=200000.0)]
+    w = World(walls, [specs[i % 2] for i in range(8)], spawns, seed=seed)
+    drivers = make_drivers(w)
+    (x0, z0), (x1, z1) = w.bounds.tolist()
+    kinds = set()
+    for k in range(int(seconds / w.dt)):
+        for e in w.step(None, [d(w, t) for d, t in zip(drivers, w.tanks)]):
+            kinds.add(e.kind)
+        if k % 12 == 0:
+            for t in w.tanks:
+                assert all(math.isfinite(v) for v in (t.x, t.z, t.heading, t.vx, t.vz, t.omega))
+                if t.alive:
+                    for px, pz in t.hull_world():
+                        assert x0 - 0.02 <= px <= x1 + 0.02 and z0 - 0.02 <= pz <= z1 + 0.02
+            for s in w.shells:
+                assert math.isfinite(s.x + s.y + s.z) and x0 - 1 <= s.x <= x1 + 1 and z0 - 1 <= s.z <= z1 + 1
+    return kinds
+
+
+def _soak_arenas():
+    out = [("box-fixture", *box_arena()), ("maze-fixture", *maze_arena())]
+    for p in bundled_arenas():
+        toml = p / "arena.toml"
+        from tanktool.formats.bundle import read_toml
+
+        sp = np.asarray(read_toml(toml).get("spawns", []), float).reshape(-1, 3)
+        if len(sp) >= 8:
+            out.append((p.name, read_walls(p / "walls.txt"), sp))
+    return out
+
+
+@pytest.mark.parametrize("name,walls,spawns", _soak_arenas(), ids=[a[0] for a in _soak_arenas()])
+def test_soak_30s(name, walls, spawns):
+    kinds = _soak(walls, spawns, 30.0)
+    assert "shot" in kinds
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,walls,spawns", _soak_arenas(), ids=[a[0] for a in _soak_arenas()])
+def test_soak_10min(name, walls, spawns):
+    kinds = _soak(walls, spawns, 600.0, seed=2)
+    assert {"shot", "hit", "kill", "respawn"} <= kinds
