@@ -51,11 +51,13 @@ def test_full_throttle_levels_off_at_top_speed():
     spec = TankSpec.box("t", top_speed=10.0, friction=0.3)
     w = _open_world(spec, heading=0.0)
     t = w.tanks[0]
-    for _ in range(int(12 / w.dt)):
+    for _ in range(int(8 / w.dt)):      # 8 s: steady long before the east wall
         w.step(None, [Command(advance=1.0)])
         assert t.speed() <= spec.top_speed * (1 + 1e-9)
-    # drag and fading engine balance a little under top speed: E(1 - v/vmax) = m μ v
-    expect = spec.engine_force / (spec.engine_force / spec.top_speed + spec.mass * spec.friction)
+    # drag and the engine balance where E·min(1, 20(1 - v/top)) = m μ v
+    E, mu_m, top = spec.engine_force, spec.mass * spec.friction, spec.top_speed
+    expect = E / mu_m if E / mu_m <= 0.95 * top else 20 * E / (mu_m + 20 * E / top)
+    assert expect > 0.9 * top
     assert t.vx == pytest.approx(expect, rel=1e-3)
     assert abs(t.vz) < 1e-9 and t.heading == 0.0
     # coasting: rolling drag brings it to rest
@@ -103,7 +105,7 @@ def test_one_step_of_each_integrator(integrator):
     t.vx = 2.0
     x0, dt = t.x, w.dt
     w.step(None, [Command(advance=1.0)])
-    a = spec.engine_force * (1 - 2.0 / spec.top_speed) / spec.mass
+    a = spec.engine_force / spec.mass
     assert t.vx == pytest.approx(2.0 + a * dt, rel=1e-12)
     if integrator == "euler":
         assert t.x - x0 == pytest.approx(2.0 * dt, rel=1e-12)        # old velocity
@@ -205,3 +207,32 @@ def test_soak_30s(name, walls, spawns):
 def test_soak_10min(name, walls, spawns):
     kinds = _soak(walls, spawns, 600.0, seed=2)
     assert {"shot", "hit", "kill", "respawn"} <= kinds
+
+
+def test_spec_from_vehicle_bundle():
+    from tanktool.formats.vehicle_bundle import VehicleBundle
+    from tanktool.geometry.spheres import SphereTree
+
+    hull = np.array([[x, y, z] for y in (0.0, 2.0) for x, z in ((3, 1.5), (-3, 1.5), (-3, -1.5), (3, -1.5))])
+    tree = SphereTree(centers=[[0, 1, 0], [-1.5, 1, 0], [1.5, 1, 0]], radii=[3.5, 2.2, 2.2],
+                      parent=[-1, 0, 0], level=[1, 2, 2])
+    vb = VehicleBundle(name="lt", path=None, toml={"drive": {}}, hull=hull, spheres=tree, mass=18000.0,
+                       inertia=60000.0, centre_of_mass=np.array([0.5, 0.8, 0.0]), footprint_radius=3.4,
+                       engine_force=90000.0, turn_torque=80000.0, strafe_force=45000.0, friction=0.4,
+                       restitution=0.25, top_speed=12.5, fire_interval=1.5, shell_speed=400.0, hit_points=120.0)
+    spec = TankSpec.from_vehicle(vb)
+    assert (spec.name, spec.mass, spec.top_speed, spec.hit_points, spec.shell_speed) == ("lt", 18000.0, 12.5, 120.0, 400.0)
+    # geometry is kept about the centre of mass
+    assert max(x for x, _ in spec.hull_local) == pytest.approx(2.5)
+    assert spec.spheres[0] == pytest.approx((-0.5, 1.0, 0.0, 3.5))
+    assert spec.sphere_children[0] == [1, 2]
+    # and the tank's position is still the vehicle-frame origin
+    from tanktool.sim.body import Tank
+
+    t = Tank(0, spec, 0.0, 0.0, 0.0)
+    t.place(10.0, 20.0, math.pi / 2)
+    assert t.position == pytest.approx((10.0, 20.0))
+    assert (t.x, t.z) == pytest.approx((10.0, 20.5))
+    vb.top_speed = 0.0
+    with pytest.raises(VehicleError, match="top_speed"):
+        TankSpec.from_vehicle(vb)

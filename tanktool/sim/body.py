@@ -88,12 +88,13 @@ class TankSpec:
         hull = [tuple(float(c) for c in p) for p in self.hull]
         if not 3 <= len(hull) <= 64 or any(len(p) != 3 for p in hull):
             raise VehicleError(f"vehicle {self.name!r}: hull must be 3..64 points (x, y, z), got {len(hull)}")
-        for key in ("mass", "inertia", "top_speed", "turn_rate", "shell_speed", "hit_points", "fire_interval"):
+        for key in ("mass", "inertia", "top_speed", "turn_rate", "hit_points"):
             v = float(getattr(self, key))
             if not (math.isfinite(v) and v > 0):
                 raise VehicleError(f"vehicle {self.name!r}: {key} must be a positive number, got {v}")
             setattr(self, key, v)
-        for key in ("engine_force", "turn_torque", "strafe_force", "friction", "grip", "shell_damage"):
+        for key in ("engine_force", "turn_torque", "strafe_force", "friction", "grip", "shell_damage",
+                    "shell_speed", "fire_interval"):
             v = float(getattr(self, key))
             if not (math.isfinite(v) and v >= 0):
                 raise VehicleError(f"vehicle {self.name!r}: {key} must be >= 0, got {v}")
@@ -174,6 +175,14 @@ class TankSpec:
             if v is not None:
                 kw[key] = v
         com = getattr(vb, "centre_of_mass", None)
+        try:
+            return cls._from_parts(vb, tree, kw, com, name)
+        except VehicleError as e:
+            where = getattr(vb, "path", None)
+            raise VehicleError(f"{where}/vehicle.toml: {e}" if where else str(e)) from None
+
+    @classmethod
+    def _from_parts(cls, vb: Any, tree: Any, kw: dict[str, Any], com: Any, name: str | None) -> "TankSpec":
         return cls(
             name=name or str(vb.name),
             hull=[tuple(p) for p in _tolist(vb.hull)],

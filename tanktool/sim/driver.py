@@ -33,10 +33,11 @@ class ScriptedDriver:
     think_hz : decisions per simulated second
     sight : how far it looks for targets [m]
     aim_tolerance : fire when the target is within this angle of the gun [rad]
+    aim_spread : standard deviation of the aiming error, drawn anew after each shot [rad]
     """
 
     def __init__(self, rng: random.Random, think_hz: float = 10.0, sight: float = 120.0,
-                 aim_tolerance: float = math.radians(4.0)) -> None:
+                 aim_tolerance: float = math.radians(4.0), aim_spread: float = math.radians(3.0)) -> None:
         self.rng = rng
         self.period = 1.0 / think_hz
         self.sight = sight
@@ -48,6 +49,9 @@ class ScriptedDriver:
         self.stuck_since: float | None = None
         self.reverse_until = -math.inf
         self.turn_bias = 1.0 if rng.random() < 0.5 else -1.0
+        # aim error: a person (or bot) does not lay the gun perfectly; redrawn per shot
+        self.aim_error = rng.gauss(0.0, aim_spread)
+        self.aim_spread = aim_spread
 
     def __call__(self, world: "World", tank: "Tank") -> Command:
         if not tank.alive:
@@ -68,12 +72,14 @@ class ScriptedDriver:
         target = self._target(world, tank)
         if target is not None:
             dx, dz = target.x - tank.x, target.z - tank.z
-            err = _wrap(math.atan2(dz, dx) - tank.heading)
+            err = _wrap(math.atan2(dz, dx) + self.aim_error - tank.heading)
             dist = math.hypot(dx, dz)
             advance = 0.6 if dist > 30.0 else -0.3 if dist < 12.0 else 0.0
             strafe = self.turn_bias * 0.5 if abs(err) < 0.3 else 0.0
-            return Command(advance=advance, rotate=max(-1.0, min(1.0, 3.0 * err)), strafe=strafe,
-                           fire=abs(err) < self.aim_tolerance)
+            fire = abs(err) < self.aim_tolerance and tank.reload <= 0.0
+            if fire:
+                self.aim_error = self.rng.gauss(0.0, self.aim_spread)
+            return Command(advance=advance, rotate=max(-1.0, min(1.0, 3.0 * err)), strafe=strafe, fire=fire)
         # roaming
         if self.waypoint is None or t > self.waypoint_deadline or \
                 math.hypot(self.waypoint[0] - tank.x, self.waypoint[1] - tank.z) < 6.0:

@@ -40,6 +40,8 @@ EVENT_KINDS = ("shot", "hit", "kill", "wall_bump", "respawn")
 #: a wall contact after this long without one counts as a new bump [s]
 BUMP_GAP = 0.25
 TWO_PI = 2.0 * math.pi
+#: the engine's pull fades from full to nothing over the last 1/FADE of the top speed
+FADE = 20.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -195,9 +197,11 @@ class World:
         Forward:  F_f = E·a·fade − m·μ·v_f          (μ: rolling drag rate [1/s])
         Sideways: F_r = S·s·fade − m·μ·v_r − m·g·slide
         Turning:  τ   = T·r − (T/ω_max)·ω
-        ``fade`` = 1 − (speed in the commanded direction)/(top speed) clamped to [0, 1]:
-        the engine gives nothing past top speed (half of it sideways), yet a collision
-        may still push a tank faster.  ``slide`` is the part of the sideways velocity
+        ``fade`` = 20·(1 − (speed in the commanded direction)/(top speed)) clamped to
+        [0, 1]: full pull up to 95 % of top speed, nothing at it (half of it sideways), so
+        top speed is a cap the engine respects, yet a collision may still push a tank
+        faster.  Vehicle bundles set E = m·μ·top_speed, where drag alone would level
+        off at top speed.  ``slide`` is the part of the sideways velocity
         outside what the strafe command asks for (all of it when not strafing), and the
         grip rate g (much larger than μ) kills it, so tracks do not slide like ice.
         Drag rates are capped at 1/dt so an explicit step can never reverse a velocity.
@@ -215,7 +219,7 @@ class World:
             strafe_top = 0.5 * sp.top_speed
             ff = -m * min(sp.friction, inv_dt) * vf
             if a != 0.0:
-                fade = 1.0 - (vf if a > 0.0 else -vf) / sp.top_speed
+                fade = FADE * (1.0 - (vf if a > 0.0 else -vf) / sp.top_speed)
                 ff += sp.engine_force * a * (0.0 if fade < 0.0 else 1.0 if fade > 1.0 else fade)
             # lateral: rolling drag inside the commanded strafe range, grip beyond it
             fr = -m * min(sp.friction, inv_dt) * vr
@@ -223,7 +227,7 @@ class World:
             slide = vr - (lo if vr < lo else hi if vr > hi else vr)
             fr -= m * min(sp.grip, inv_dt) * slide
             if s != 0.0:
-                fade = 1.0 - (vr if s > 0.0 else -vr) / strafe_top
+                fade = FADE * (1.0 - (vr if s > 0.0 else -vr) / strafe_top)
                 fr += sp.strafe_force * s * (0.0 if fade < 0.0 else 1.0 if fade > 1.0 else fade)
             t.fx = ff * c - fr * sn
             t.fz = ff * sn + fr * c
