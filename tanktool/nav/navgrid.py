@@ -258,7 +258,7 @@ def row_crossings(A: np.ndarray, B: np.ndarray, z: np.ndarray) -> tuple[np.ndarr
     r1 = np.searchsorted(z, hi, side="left")
     cnt = np.maximum(r1 - r0, 0)
     w = np.repeat(np.arange(len(A)), cnt)
-    row = np.repeat(r0, cnt) + (np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    row = np.repeat(r0, cnt) + _ramp(cnt)
     a, b, zz = A[w], B[w], z[row]
     x = a[:, 0] + (zz - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
     # free space on the left of a->b: going up (b above) the left is -x, so walking +x
@@ -288,18 +288,27 @@ def free_space(walls: WallList, origin: np.ndarray, cell: float, shape: tuple[in
 
 
 # ================================================================= clearance
-def _capsule_rows(A: np.ndarray, B: np.ndarray, R: float, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(wall, row, xlo, xhi): the chord of each wall's capsule of radius R on each row."""
+def _ramp(cnt: np.ndarray) -> np.ndarray:
+    """0, 1, .., cnt[0]-1, 0, 1, .., cnt[1]-1, ...: positions inside repeated blocks."""
+    total = int(cnt.sum())
+    return np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+
+
+def _capsule_pairs(A: np.ndarray, B: np.ndarray, R: float, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(wall, row) for every row whose line may meet the wall's capsule of radius R."""
     zlo = np.minimum(A[:, 1], B[:, 1]) - R
     zhi = np.maximum(A[:, 1], B[:, 1]) + R
     r0 = np.searchsorted(z, zlo, side="left")
     r1 = np.searchsorted(z, zhi, side="right")
     cnt = np.maximum(r1 - r0, 0)
-    w = np.repeat(np.arange(len(A)), cnt)
-    row = np.repeat(r0, cnt) + (np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt))
-    a, b, zz = A[w], B[w], z[row]
-    lo = np.full(len(w), np.inf)
-    hi = np.full(len(w), -np.inf)
+    return np.repeat(np.arange(len(A)), cnt), np.repeat(r0, cnt) + _ramp(cnt)
+
+
+def _capsule_chords(a: np.ndarray, b: np.ndarray, zz: np.ndarray, R: float) -> tuple[np.ndarray, np.ndarray]:
+    """x-interval [lo, hi] where the line z = zz meets the capsule of radius R around
+    segment a-b (all arrays per pair); lo > hi when it misses."""
+    lo = np.full(len(zz), np.inf)
+    hi = np.full(len(zz), -np.inf)
     for p in (a, b):  # end discs
         dz = zz - p[:, 1]
         h2 = R * R - dz * dz
@@ -307,36 +316,34 @@ def _capsule_rows(A: np.ndarray, B: np.ndarray, R: float, z: np.ndarray) -> tupl
         h = np.sqrt(np.where(ok, h2, 0.0))
         lo = np.where(ok, np.minimum(lo, p[:, 0] - h), lo)
         hi = np.where(ok, np.maximum(hi, p[:, 0] + h), hi)
-    # the band between: 0 <= s <= 1 along the wall and |u| <= R across it, both linear in x
+    # the band between: 0 <= s <= 1 along the wall and |u| <= R across it, both linear in x:
+    # s = c1 + (x - ax) dx / L2,  u = c2 - (x - ax) dz / L
     d = b - a
     L2 = d[:, 0] ** 2 + d[:, 1] ** 2
     L = np.sqrt(L2)
-    good = L > 0
     with np.errstate(divide="ignore", invalid="ignore"):
-        c1 = (zz - a[:, 1]) * d[:, 1] / L2  # s at x = a_x
-        c2 = (zz - a[:, 1]) * d[:, 0] / L   # u at x = a_x
-        # s = c1 + (x - ax) dx / L2 ; u = c2 - (x - ax) dz / L
+        c1 = (zz - a[:, 1]) * d[:, 1] / L2
+        c2 = (zz - a[:, 1]) * d[:, 0] / L
         s_lo = a[:, 0] + (0 - c1) * L2 / d[:, 0]
         s_hi = a[:, 0] + (1 - c1) * L2 / d[:, 0]
         u_lo = a[:, 0] + (R - c2) * L / -d[:, 1]
         u_hi = a[:, 0] + (-R - c2) * L / -d[:, 1]
     s_a, s_b = np.minimum(s_lo, s_hi), np.maximum(s_lo, s_hi)
-    s_flat = d[:, 0] == 0
     s_all = (c1 >= 0) & (c1 <= 1)
+    s_flat = d[:, 0] == 0
     s_a = np.where(s_flat, np.where(s_all, -np.inf, np.inf), s_a)
     s_b = np.where(s_flat, np.where(s_all, np.inf, -np.inf), s_b)
     u_a, u_b = np.minimum(u_lo, u_hi), np.maximum(u_lo, u_hi)
-    u_flat = d[:, 1] == 0
     u_all = np.abs(c2) <= R
+    u_flat = d[:, 1] == 0
     u_a = np.where(u_flat, np.where(u_all, -np.inf, np.inf), u_a)
     u_b = np.where(u_flat, np.where(u_all, np.inf, -np.inf), u_b)
     band_lo = np.maximum(s_a, u_a)
     band_hi = np.minimum(s_b, u_b)
-    band = good & (band_lo <= band_hi)
+    band = (L > 0) & (band_lo <= band_hi)
     lo = np.where(band, np.minimum(lo, band_lo), lo)
     hi = np.where(band, np.maximum(hi, band_hi), hi)
-    keep = lo <= hi
-    return w[keep], row[keep], lo[keep], hi[keep]
+    return lo, hi
 
 
 def too_close(
@@ -345,8 +352,10 @@ def too_close(
 ) -> np.ndarray:
     """Nodes of ``rows`` whose distance to some wall is < clearance (or <= tol).
 
-    Exact: candidate nodes are those under each wall's capsule chord widened by one
-    node, and each candidate is decided by the distance kernel itself.
+    Exact with respect to the distance kernel: on each row, the nodes well inside a
+    wall's capsule (its chord for a radius shrunk by 1e-7, far beyond rounding) are
+    marked at once; the few nodes near the chord's ends (the chord for a radius grown
+    a hair, widened by one node each side) are decided by the kernel itself.
     """
     nz, nx = shape
     z = node_coords(origin[1], cell, nz)[rows]
@@ -356,20 +365,39 @@ def too_close(
     R = max(float(clearance), tol)
     if len(seg) == 0 or len(z) == 0:
         return out
-    # a hair wider than R so that rounding in the chord never drops a row; the x
-    # range is widened by a whole node each side for the same reason
-    w, row, xlo, xhi = _capsule_rows(seg[:, 0], seg[:, 1], R * (1 + 1e-9) + 1e-7 * cell, z)
-    j0 = np.clip(np.searchsorted(x_nodes, xlo, side="left") - 1, 0, nx)
-    j1 = np.clip(np.searchsorted(x_nodes, xhi, side="right") + 1, 0, nx)
-    cnt = np.maximum(j1 - j0, 0)
-    total = int(cnt.sum())
-    ww = np.repeat(w, cnt)
-    rr = np.repeat(row, cnt)
-    jj = np.repeat(j0, cnt) + (np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt))
-    p = np.stack([x_nodes[jj], z[rr]], axis=1)
-    d2 = point_segment_dist2(p, seg[ww, 0], seg[ww, 1])
-    hit = (d2 < clearance * clearance) | (d2 <= tol * tol)
-    out[rr[hit], jj[hit]] = True
+    w, row = _capsule_pairs(seg[:, 0], seg[:, 1], R * (1 + 1e-9) + 1e-7 * cell, z)
+    a, b, zz = seg[w, 0], seg[w, 1], z[row]
+    olo, ohi = _capsule_chords(a, b, zz, R * (1 + 1e-9) + 1e-7 * cell)
+    ilo, ihi = _capsule_chords(a, b, zz, R * (1 - 1e-7))
+    j0 = np.clip(np.searchsorted(x_nodes, olo, side="left") - 1, 0, nx)
+    j1 = np.clip(np.searchsorted(x_nodes, ohi, side="right") + 1, 0, nx)
+    j1 = np.maximum(j1, j0)
+    # interior [k0, k1): nodes inside the shrunk chord, clipped into [j0, j1]
+    k0 = np.clip(np.searchsorted(x_nodes, ilo, side="left"), j0, j1)
+    k1 = np.clip(np.searchsorted(x_nodes, ihi, side="right"), j0, j1)
+    inner = k1 > k0
+    k0 = np.where(inner, k0, j1)
+    k1 = np.where(inner, k1, j1)
+    # mark interiors with a running sum of +1/-1 per row
+    if inner.any():
+        m = nx + 1
+        acc = np.bincount(row[inner] * m + k0[inner], minlength=len(z) * m)
+        acc -= np.bincount(row[inner] * m + k1[inner], minlength=len(z) * m)
+        out |= np.cumsum(acc.reshape(len(z), m), axis=1)[:, :nx] > 0
+    # kernel on the two edge pieces [j0, k0) and [k1, j1)
+    for lo_, hi_ in ((j0, k0), (k1, j1)):
+        cnt = np.maximum(hi_ - lo_, 0)
+        sel = cnt > 0
+        if not sel.any():
+            continue
+        cnt_s = cnt[sel]
+        ww = np.repeat(w[sel], cnt_s)
+        rr = np.repeat(row[sel], cnt_s)
+        jj = np.repeat(lo_[sel], cnt_s) + _ramp(cnt_s)
+        p = np.stack([x_nodes[jj], z[rr]], axis=1)
+        d2 = point_segment_dist2(p, seg[ww, 0], seg[ww, 1])
+        hit = (d2 < clearance * clearance) | (d2 <= tol * tol)
+        out[rr[hit], jj[hit]] = True
     return out
 
 
@@ -466,18 +494,18 @@ def classify_reference(
 def _runs_along_last_axis(valid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """1-based index of each valid node in its run along the last axis, and run length."""
     m, n = valid.shape
-    v = np.zeros((m, n + 1), dtype=bool)
-    v[:, 1:] = valid  # a False column keeps runs from spilling across lines
-    flat = v.ravel()
-    pos = np.arange(flat.size)
-    start = flat.copy()
-    start[1:] &= ~flat[:-1]
-    first = np.maximum.accumulate(np.where(start, pos, 0))
-    index = np.where(flat, pos - first + 1, 0)
-    run = np.cumsum(start)
-    lengths = np.bincount(run[flat], minlength=int(run[-1]) + 1)
-    total = np.where(flat, lengths[run], 0)
-    return index.reshape(m, n + 1)[:, 1:].astype(np.int32), total.reshape(m, n + 1)[:, 1:].astype(np.int32)
+    v = np.zeros((m, n + 2), dtype=np.int8)
+    v[:, 1:-1] = valid  # False borders keep runs from spilling across lines
+    d = np.diff(v.ravel())
+    starts = np.flatnonzero(d == 1)  # index (in the padded flat array) of a run's first node, minus 1
+    ends = np.flatnonzero(d == -1)
+    lengths = ends - starts
+    where = np.flatnonzero(v.ravel())
+    index = np.zeros(v.size, dtype=np.int32)
+    total = np.zeros(v.size, dtype=np.int32)
+    index[where] = _ramp(lengths) + 1
+    total[where] = np.repeat(lengths, lengths)
+    return index.reshape(m, n + 2)[:, 1:-1], total.reshape(m, n + 2)[:, 1:-1]
 
 
 def runs(valid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -24,7 +24,7 @@ WALL_COLOUR = "#1b1b1b"
 QUADTREE_COLOUR = "#2f6db5"
 SPAWN_COLOUR = "#d62728"
 #: annotate nodes only when a node is at least this many points wide
-MIN_LABEL_PT = {"rows": 13.0, "cols": 13.0, "both": 17.0}
+MIN_LABEL_PT = {"rows": 13.0, "cols": 13.0, "both": 18.0}
 
 
 def node_states(grid: Any, free: np.ndarray | None = None) -> np.ndarray:
@@ -79,7 +79,7 @@ def render_navgrid(
     across = max(1, j1 - j0)
     tall = max(1, i1 - i0)
     aspect = (view[1, 1] - view[0, 1]) / max(view[1, 0] - view[0, 0], 1e-9)
-    want_pt = MIN_LABEL_PT.get(annotate, 0.0) * 1.25
+    want_pt = MIN_LABEL_PT.get(annotate, 0.0) * 1.45
     width_in = 10.0
     if annotate != "none" and across <= 80 and tall <= 80:
         width_in = min(max(width_in, across * want_pt / 72.0), 22.0)
@@ -132,7 +132,8 @@ def render_navgrid(
 
     labelled = 0
     if annotate != "none" and cell_pt >= MIN_LABEL_PT.get(annotate, 99):
-        font = min(9.0, cell_pt / (4.2 if annotate == "both" else 3.6))
+        # "12/34" is five characters of about 0.6 em: fill most of the cell's width
+        font = min(9.0, cell_pt / (3.4 if annotate == "both" else 3.2))
         ii, jj = np.nonzero(grid.valid[i0:i1, j0:j1])
         ii, jj = ii + i0, jj + j0
         for i, j in zip(ii.tolist(), jj.tolist()):
