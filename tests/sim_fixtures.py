@@ -57,6 +57,13 @@ def free_spec(**kw) -> TankSpec:
     return TankSpec.box("free", **params)
 
 
+def bundled_vehicle_specs() -> list[TankSpec]:
+    """TankSpecs of the bundled vehicles (vehicles/*/vehicle.toml)."""
+    from tanktool.sim.match import load_tank_spec
+
+    return [load_tank_spec(p.parent) for p in sorted((ROOT / "vehicles").glob("*/vehicle.toml"))]
+
+
 def bundled_arenas() -> list[Path]:
     return sorted(p.parent for p in (ROOT / "arenas").glob("*/walls.txt"))
 

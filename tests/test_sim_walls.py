@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 import pytest
-from sim_fixtures import box_arena, bundled_arenas, maze_arena
+from sim_fixtures import box_arena, bundled_arenas, bundled_vehicle_specs, maze_arena
 
 from tanktool.formats.walls_txt import read_walls
 from tanktool.sim.body import TankSpec
@@ -100,8 +100,8 @@ def _ends_inside(C: np.ndarray, HD: np.ndarray, spec: TankSpec, seg: np.ndarray)
     return float(max(inside.max(), 0.0))
 
 
-def _push_runs(walls, steps: int, which=None):
-    spec = TankSpec.box("pusher", restitution=0.2)
+def _push_runs(walls, steps: int, which=None, spec: TankSpec | None = None):
+    spec = spec or TankSpec.box("pusher", restitution=0.2)
     seg = walls.all_segments()
     bounds = walls.bounds
     brute = BruteWallIndex(seg)
@@ -182,3 +182,13 @@ def test_push_10000_steps(name, walls):
 def test_push_10000_steps_every_wall(name, walls):
     tested, skipped = _push_runs(walls, steps=10_000)
     assert tested >= 0.9 * (tested + skipped) and tested > 0
+
+
+@pytest.mark.parametrize("spec", bundled_vehicle_specs(), ids=lambda s: s.name)
+def test_bundled_vehicles_push_into_every_wall(spec):
+    """The bundled vehicles' own hull points (8..16, not a box) in the box fixture and
+    the first bundled arena."""
+    arenas = [box_arena()[0]] + [read_walls(p / "walls.txt") for p in bundled_arenas()[:1]]
+    for walls in arenas:
+        tested, skipped = _push_runs(walls, steps=600, spec=spec)
+        assert tested > 0

@@ -8,7 +8,6 @@ on the default arena, a scoreboard, and a top-view picture of the final state.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
@@ -52,7 +51,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --headless --arena box --bots 8 --seconds 60 --seed 1 --report match.json
       tanktool play --headless --arena arenas/maze --vehicle heavy --seconds 600
     """
-    from ..sim.match import default_vehicle, load_match_arena, load_tank_spec, run_match, scoreboard
+    from ..sim.match import default_vehicle, format_report, load_match_arena, load_tank_spec, run_match, scoreboard
 
     if not headless:
         echo("The game window is not built yet; running a short headless match instead "
@@ -83,7 +82,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
     if report_path is not None:
         from ..formats.bundle import atomic_write_text
 
-        atomic_write_text(report_path, json.dumps(report, indent=1) + "\n")
+        atomic_write_text(report_path, format_report(report))
         echo(f"report: {report_path}")
     if picture is not None:
         from ..plots.match import save_match_picture

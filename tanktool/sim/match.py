@@ -162,7 +162,7 @@ def make_report(world: World, arena: str, vehicle: str, seed: int, events: list)
             "name": t.name, "vehicle": t.spec.name, "kills": t.kills, "deaths": t.deaths,
             "shots": t.shots, "hits": t.hits, "wall_bumps": t.wall_bumps,
             "distance": _r(t.distance, 2), "position": [_r(x), _r(z)], "heading": _r(t.heading, 4),
-            "hit_points": _r(t.hp, 2), "alive": t.alive,
+            "hit_points": _r(max(t.hp, 0.0), 2), "alive": t.alive,
         })
     ranking = sorted(tanks, key=lambda d: (-d["kills"], d["deaths"], names.index(d["name"])))
     return {
@@ -177,6 +177,20 @@ def make_report(world: World, arena: str, vehicle: str, seed: int, events: list)
         "tanks": tanks,
         "events": [e.to_dict(names) for e in events],
     }
+
+
+def format_report(report: dict[str, Any]) -> str:
+    """The report as JSON text with one tank or event a line (diff- and grep-friendly)."""
+    import json
+
+    parts = []
+    for key, value in report.items():
+        if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            inner = ",\n  ".join(json.dumps(v) for v in value)
+            parts.append(f" {json.dumps(key)}: [\n  {inner}\n ]")
+        else:
+            parts.append(f" {json.dumps(key)}: {json.dumps(value)}")
+    return "{\n" + ",\n".join(parts) + "\n}\n"
 
 
 def scoreboard(report: dict[str, Any]) -> str:
