@@ -1,0 +1,249 @@
+"""``tanktool import-vehicle MODEL``: a vehicle model in, a vehicle bundle out.
+
+The work is in :func:`build_vehicle_bundle` (also used by tools/build_vehicles.py);
+the click command only checks options, calls it and prints the summary.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import click
+import numpy as np
+
+from .. import __version__
+from ..errors import VehicleError
+from .main import echo
+from .options import force_option, name_option, scale_option, up_option
+
+HULL_POINTS = (8, 16)
+LEVELS = (1, 5)
+BRANCHING = (2, 8)
+MASS_RANGE = (1.0, 1.0e6)  # kg: a toy to ten times the heaviest tank ever built
+SURFACE_SAMPLES = 4000     # points spread over the surface besides the vertices
+
+
+@dataclass
+class ImportResult:
+    out: Path
+    name: str
+    hull_points: int
+    footprint_area: float
+    convex_area: float
+    sphere_count: int
+    leaf_count: int
+    levels: int
+    root_radius: float
+    mass: float
+    inertia: float
+    method: str
+    seconds: float
+
+    def summary(self) -> str:
+        ratio = self.footprint_area / self.convex_area if self.convex_area else 1.0
+        return "\n".join([
+            f"wrote {self.out}/",
+            f"  hull     {self.hull_points} points, footprint {self.footprint_area:.3f} m^2 = "
+            f"{ratio:.3f} x convex hull ({self.convex_area:.3f} m^2)",
+            f"  spheres  {self.sphere_count} in {self.levels} levels, {self.leaf_count} leaves, "
+            f"root radius {self.root_radius:.3f} m",
+            f"  mass     {self.mass:,.0f} kg ({self.method}), inertia {self.inertia:,.0f} kg m^2 about the vertical axis",
+            f"  took     {self.seconds:.2f} s",
+        ])
+
+
+def check_options(hull_points: int, sphere_levels: int, branching: int, mass: float | None, name: str) -> None:
+    """Reject bad option values with one VehicleError line (exit 2)."""
+    lo, hi = HULL_POINTS
+    if not (lo <= hull_points <= hi) or hull_points % 2:
+        raise VehicleError(f"--hull-points must be an even number from {lo} to {hi} "
+                           f"(a bottom and a top point per footprint corner), got {hull_points}")
+    if not LEVELS[0] <= sphere_levels <= LEVELS[1]:
+        raise VehicleError(f"--sphere-levels must be from {LEVELS[0]} to {LEVELS[1]}, got {sphere_levels}")
+    if not BRANCHING[0] <= branching <= BRANCHING[1]:
+        raise VehicleError(f"--branching must be from {BRANCHING[0]} to {BRANCHING[1]} children per sphere, got {branching}")
+    if mass is not None and not (math.isfinite(mass) and MASS_RANGE[0] <= mass <= MASS_RANGE[1]):
+        raise VehicleError(f"--mass must be from {MASS_RANGE[0]:g} to {MASS_RANGE[1]:g} kg, got {mass:g}")
+    if not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9_.-]*", name):
+        raise VehicleError(f"--name {name!r}: use letters, digits, '_', '-' and '.' only")
+
+
+def vehicle_frame_offset(vertices: np.ndarray) -> np.ndarray:
+    """Translation into the vehicle frame: origin at the centre of the footprint's
+    bounding box, y = 0 at the lowest point."""
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    return np.array([-(lo[0] + hi[0]) / 2, -lo[1], -(lo[2] + hi[2]) / 2])
+
+
+def derive(mesh, hull_points_n: int, levels: int, branching: int, mass: float | None):
+    """Hull, sphere tree and mass properties of a vehicle-frame mesh."""
+    from ..geometry.hull import hull_points
+    from ..geometry.mass import mass_properties
+    from ..geometry.spheres import build_points, build_sphere_tree
+
+    v = np.asarray(mesh.vertices, dtype=np.float64)
+    hull, fp = hull_points(v, hull_points_n)
+    pts = build_points(v, np.asarray(mesh.faces), SURFACE_SAMPLES, seed=0)
+    tree = build_sphere_tree(pts, levels=levels, branching=branching, seed=0)
+    mp = mass_properties(mesh, fp.polygon, mass=mass)
+    return hull, fp, tree, mp
+
+
+def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = None, scale: float = 1.0,
+                         hull_points_n: int = 16, levels: int = 3, branching: int = 4,
+                         mass: float | None = None, force: bool = False,
+                         drive: dict[str, Any] | None = None) -> ImportResult:
+    """Read ``model`` and write the vehicle bundle ``out`` atomically.
+
+    ``drive`` replaces the computed [drive] defaults (``make vehicles`` keeps the
+    hand-edited figures of a bundled vehicle this way).
+    """
+    import trimesh
+
+    from ..formats.bundle import dumps_toml, sha256_file, staged_dir, atomic_write_text, atomic_write_bytes
+    from ..formats.models import default_up, detect_format, load_scene
+    from ..formats.vehicle_bundle import write_hull
+    from ..geometry.mass import drive_defaults
+    from ..geometry.spheres import write_spheres
+    from ..plots.vehicle import plot_vehicle
+
+    t0 = time.perf_counter()
+    model = Path(model)
+    check_options(hull_points_n, levels, branching, mass, name)
+    out = Path(out)
+    if out.exists() and not force:
+        raise VehicleError(f"{out}: already exists (use --force to overwrite)")
+    if out.resolve() == model.resolve().parent:
+        raise VehicleError(f"{out}: the output folder must not be the folder of the model being imported")
+    fmt = detect_format(model)
+    up_used = up or default_up(fmt)
+    scene = load_scene(model, up=up_used, scale=scale)
+    meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
+    extent = np.ptp(mesh.vertices, axis=0)
+    if not (extent[0] > 0 and extent[2] > 0):
+        raise VehicleError(f"{model}: the model is flat seen from above (extent {extent[0]:g} x {extent[2]:g} m in x-z)")
+    if extent.max() > 1e4:
+        raise VehicleError(f"{model}: the model is {extent.max():g} m across: wrong --scale?")
+    offset = vehicle_frame_offset(np.asarray(mesh.vertices))
+    scene.apply_translation(offset)
+    mesh.apply_translation(offset)
+
+    hull, fp, tree, mp = derive(mesh, hull_points_n, levels, branching, mass)
+    if not MASS_RANGE[0] <= mp.mass <= MASS_RANGE[1]:
+        raise VehicleError(f"{model}: its volume ({mp.volume:.3g} m^3, {mp.method}) gives a mass of "
+                           f"{mp.mass:.4g} kg, outside {MASS_RANGE[0]:g}..{MASS_RANGE[1]:g} kg: "
+                           f"wrong --scale? or give --mass")
+    params = drive_defaults(mp.mass, mp.inertia)
+    if drive:
+        params.update({k: drive[k] for k in params if k in drive})
+    header = f"{name}: made by tanktool {__version__} import-vehicle from {model.name}"
+
+    with staged_dir(out, force=force) as tmp:
+        source_name = model.name
+        shutil.copyfile(model, tmp / source_name)
+        atomic_write_bytes(tmp / "model.glb", scene.export(file_type="glb"))
+        write_hull(tmp / "hull.txt", hull, header)
+        write_spheres(tmp / "spheres.txt", tree, header)
+        plot_vehicle(tmp / "preview.png", mesh, hull, tree,
+                     title=f"{name}: {len(hull)} hull points, {len(tree)} spheres, {mp.mass / 1000:.1f} t")
+        radius = float(np.max(np.hypot(hull[:, 0], hull[:, 2])))
+        doc = {
+            "name": name,
+            "tool_version": __version__,
+            "footprint_radius": round(radius, 4),
+            "source": {"file": source_name, "sha256": sha256_file(tmp / source_name), "up": up_used,
+                       "scale": float(scale), "vehicle_frame_offset": [round(float(x), 6) for x in offset]},
+            "model": {"file": "model.glb"},
+            "mass": {"mass": round(mp.mass, 3), "inertia": round(mp.inertia, 3),
+                     "centre_of_mass": [round(float(x), 4) for x in mp.centre_of_mass],
+                     "method": mp.method, "volume": round(mp.volume, 6),
+                     "mass_given": mass is not None},
+            "drive": params,
+            "hull": {"file": "hull.txt", "points": int(len(hull)), "requested": hull_points_n,
+                     "footprint_area": round(fp.area, 6), "convex_area": round(fp.convex_area, 6)},
+            "spheres": {"file": "spheres.txt", "levels": int(tree.levels), "branching": branching,
+                        "count": int(len(tree)), "leaves": int(len(tree.leaves())),
+                        "requested_levels": levels},
+            "derived": {f: sha256_file(tmp / f) for f in ("model.glb", "hull.txt", "spheres.txt", "preview.png")},
+        }
+        atomic_write_text(tmp / "vehicle.toml", DRIVE_COMMENT + dumps_toml(doc))
+    return ImportResult(out, name, len(hull), fp.area, fp.convex_area, len(tree), len(tree.leaves()),
+                        int(tree.levels), float(tree.radii[0]), mp.mass, mp.inertia, mp.method,
+                        time.perf_counter() - t0)
+
+
+DRIVE_COMMENT = """\
+# Vehicle bundle made by `tanktool import-vehicle`.  Frame: +x forward, +y up, +z right,
+# origin at the centre of the footprint's bounding box, y = 0 at the lowest point.
+# [mass]: mass kg; inertia kg m^2 about the vertical axis through centre_of_mass;
+#   method "mesh" (closed model) or "hull-box" (hull prism filled uniformly).
+# [drive] may be edited by hand: engine_force N; turn_torque N m; strafe_force N;
+#   friction 1/s (linear drag rate: the ground slows the tank by friction * velocity,
+#   so engine_force = mass * friction * top_speed balances at top speed);
+#   restitution 0..1; top_speed m/s; fire_interval s; shell_speed m/s; hit_points.
+# [derived] sha256 of each derived file: `tanktool check` reports stale data.
+"""
+
+
+@click.command("import-vehicle")
+@click.argument("model", type=click.Path(path_type=Path))
+@click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
+              help="Bundle folder to write (default: ./<name>).")
+@name_option
+@up_option
+@scale_option
+@click.option("--hull-points", type=int, default=16, show_default=True,
+              help="Hull points, even, 8..16: 8 = minimum rectangle box, more = N/2-gon prism.")
+@click.option("--sphere-levels", type=int, default=3, show_default=True, help="Levels of the sphere tree (1..5).")
+@click.option("--branching", type=int, default=4, show_default=True, help="Children per sphere (2..8).")
+@click.option("--mass", type=float, default=None,
+              help="Mass in kg (default: 2000 kg/m^3 times the model's volume).")
+@force_option
+def import_vehicle(model: Path, out: Path | None, name: str | None, up: str | None, scale: float,
+                   hull_points: int, sphere_levels: int, branching: int, mass: float | None, force: bool) -> None:
+    """Turn a vehicle MODEL (.3ds, .obj, .stl, .glb, ...) into a vehicle bundle.
+
+    Writes vehicle.toml, a copy of MODEL, model.glb, hull.txt, spheres.txt and
+    preview.png into the bundle folder, all or nothing.  The model should face +x.
+    """
+    name = name or model.stem
+    out = out if out is not None else Path(name)
+    result = build_vehicle_bundle(model, out, name, up=up, scale=scale, hull_points_n=hull_points,
+                                  levels=sphere_levels, branching=branching, mass=mass, force=force)
+    echo(result.summary())
+
+
+def load_vehicle_source(bundle: Path):
+    """The bundle's source model in the vehicle frame, read with its stored up/scale."""
+    import trimesh
+
+    from ..formats.bundle import read_toml
+    from ..formats.models import load_scene
+
+    doc = read_toml(Path(bundle) / "vehicle.toml")
+    src = doc["source"]
+    scene = load_scene(Path(bundle) / src["file"], up=src["up"], scale=src["scale"])
+    meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
+    mesh.apply_translation(vehicle_frame_offset(np.asarray(mesh.vertices)))
+    return mesh
+
+
+def rebuild_params(doc: dict[str, Any]) -> dict[str, Any]:
+    """The build_vehicle_bundle keyword arguments a bundle was made with."""
+    src, hull, spheres, mass = doc["source"], doc["hull"], doc["spheres"], doc["mass"]
+    return {
+        "up": src["up"], "scale": float(src["scale"]),
+        "hull_points_n": int(hull.get("requested", hull["points"])),
+        "levels": int(spheres.get("requested_levels", spheres["levels"])),
+        "branching": int(spheres["branching"]),
+        "mass": float(mass["mass"]) if mass.get("mass_given") else None,
+        "drive": dict(doc.get("drive", {})),
+    }

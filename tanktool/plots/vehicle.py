@@ -1,0 +1,117 @@
+"""Vehicle preview: top and side views with the hull points and each sphere level.
+
+One column for the hull (footprint polygon and hull points over the model) and one
+column per sphere-tree level; the top row looks down from +y (x right, z down, so a
+tank facing +x has its right side, +z, at the bottom of the picture), the bottom row
+looks from the vehicle's right side (+z: x right, y up).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+LEVEL_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b"]
+
+
+def _faces_2d(ax, vertices: np.ndarray, faces: np.ndarray, colours: np.ndarray, axes: tuple[int, int],
+              depth: int, towards_viewer: bool) -> None:
+    """Draw the triangles projected on ``axes``, far ones first (painter's order)."""
+    from matplotlib.collections import PolyCollection
+
+    tri = vertices[faces]
+    key = tri[:, :, depth].mean(axis=1)
+    order = np.argsort(key if towards_viewer else -key)
+    polys = tri[order][:, :, list(axes)]
+    # shade by how squarely a face looks at the viewer, a light from the eye
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(n, axis=1)
+    facing = np.abs(n[:, depth]) / np.where(length > 0, length, 1.0)
+    shaded = np.clip(colours * (0.6 + 0.4 * facing)[:, None], 0, 1)[order]
+    ax.add_collection(PolyCollection(polys, facecolors=shaded, edgecolors=shaded,
+                                     linewidths=0.3, zorder=1))
+
+
+def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: str = "") -> None:
+    """Write the preview PNG for a vehicle-frame ``mesh`` with its hull and sphere tree."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Polygon
+
+    from ..formats.bundle import atomic_write_bytes
+
+    v = np.asarray(mesh.vertices, dtype=np.float64)
+    f = np.asarray(mesh.faces, dtype=np.int64)
+    try:
+        colours = np.asarray(mesh.visual.face_colors, dtype=np.float64)[:, :3] / 255.0
+    except Exception:  # no colour information: a neutral grey
+        colours = np.full((len(f), 3), 0.6)
+    colours = 0.35 + 0.65 * colours  # lighten so the outlines on top stay readable
+
+    levels = int(tree.level.max())
+    k = len(hull) // 2
+    ncol = 1 + levels
+    lo = np.minimum(v.min(axis=0), (tree.centers - tree.radii[:, None]).min(axis=0))
+    hi = np.maximum(v.max(axis=0), (tree.centers + tree.radii[:, None]).max(axis=0))
+    pad = 0.05 * float((hi - lo).max())
+    lo, hi = lo - pad, hi + pad
+    width_x, width_z, height_y = hi[0] - lo[0], hi[2] - lo[2], hi[1] - lo[1]
+    panel_w = 3.6
+    fig, axs = plt.subplots(
+        2, ncol, figsize=(panel_w * ncol, panel_w * (width_z + height_y) / width_x + 1.2),
+        gridspec_kw={"height_ratios": [width_z, height_y]}, squeeze=False,
+    )
+    views = [((0, 2), 1, True, "top (from +y)", "z (m, right side down)"),
+             ((0, 1), 2, True, "side (from the right, +z)", "y (m)")]
+    for row, (axes, depth, toward, label, ylabel) in enumerate(views):
+        for col in range(ncol):
+            ax = axs[row, col]
+            _faces_2d(ax, v, f, colours, axes, depth, toward)
+            ax.set_aspect("equal")
+            ax.set_xlim(lo[axes[0]], hi[axes[0]])
+            if row == 0:
+                ax.set_ylim(hi[2], lo[2])  # z grows downwards: looking down from +y
+            else:
+                ax.set_ylim(lo[1], hi[1])
+            ax.tick_params(labelsize=7)
+            ax.grid(True, lw=0.3, alpha=0.5, zorder=0)
+            if col == 0:
+                ax.set_ylabel(ylabel, fontsize=8)
+            if row == 1:
+                ax.set_xlabel("x (m, forward)", fontsize=8)
+            if col == 0:
+                pts2 = hull[:, list(axes)]
+                if row == 0:
+                    ax.add_patch(Polygon(pts2[:k], closed=True, fill=False, ec="black", lw=1.4, zorder=3))
+                else:
+                    ylo, yhi = hull[:, 1].min(), hull[:, 1].max()
+                    xlo, xhi = hull[:, 0].min(), hull[:, 0].max()
+                    ax.add_patch(Polygon([[xlo, ylo], [xhi, ylo], [xhi, yhi], [xlo, yhi]], closed=True,
+                                         fill=False, ec="black", lw=1.4, zorder=3))
+                ax.plot(pts2[:, 0], pts2[:, 1], "o", ms=4, mfc="#ffdd00", mec="black", zorder=4)
+                ax.set_title(f"hull: {len(hull)} points — {label}", fontsize=9)
+            else:
+                lev = col
+                idx = np.flatnonzero(tree.level == lev)
+                colour = LEVEL_COLOURS[(lev - 1) % len(LEVEL_COLOURS)]
+                for i in idx:
+                    c = tree.centers[i]
+                    ax.add_patch(Circle((c[axes[0]], c[axes[1]]), tree.radii[i], fill=True, fc=colour,
+                                        alpha=0.10, ec="none", zorder=2))
+                    ax.add_patch(Circle((c[axes[0]], c[axes[1]]), tree.radii[i], fill=False, ec=colour,
+                                        lw=1.1, zorder=3))
+                    ax.plot(c[axes[0]], c[axes[1]], "+", color=colour, ms=5, zorder=4)
+                ax.set_title(f"level {lev}: {len(idx)} sphere{'s' if len(idx) != 1 else ''} — {label}", fontsize=9)
+    if title:
+        fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    import io
+
+    buf = io.BytesIO()
+    # no timestamps in the PNG so that rebuilding gives the same bytes
+    fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
+    plt.close(fig)
+    atomic_write_bytes(path, buf.getvalue())
