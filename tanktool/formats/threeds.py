@@ -1,0 +1,843 @@
+"""3D Studio (.3ds) reader and writer.
+
+A .3ds file is a tree of chunks: a little-endian ``u16`` id and a ``u32`` length that
+counts the 6-byte header, followed by the chunk's own data and then its children.
+The reader walks that tree with explicit bounds, so a damaged file can only ever
+produce a :class:`~tanktool.errors.FormatError` naming the file and byte offset:
+
+* every chunk must fit inside its parent (and the parent inside the file);
+* every loop over chunks advances by a chunk length of at least 6 bytes, so a
+  parse always terminates;
+* every count read from the file (vertices, faces, UVs, group sizes) is checked
+  against the bytes left in its chunk *before* an array is made, so no array is
+  ever larger than about twice the bytes it was read from (float32 -> float64).
+
+Only the chunks a static import needs are interpreted (objects, triangle meshes,
+materials, master scale, keyframer node names); everything else, including lights
+and cameras, is skipped by its length.
+
+Vertices stay in the file's own axes (3DS is Z-up); :mod:`tanktool.formats.models`
+turns them into the world frame.  Importing this module registers ``"3ds"`` with
+trimesh's loader registry, so ``trimesh.load("x.3ds")`` works afterwards.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, BinaryIO, Iterator, Sequence
+
+import numpy as np
+
+from ..errors import FormatError
+from .bundle import atomic_write_bytes
+
+__all__ = [
+    "DEFAULT_COLOR",
+    "KeyframerNode",
+    "Material",
+    "MeshObject",
+    "Model3DS",
+    "TextureMap",
+    "encode_3ds",
+    "load_scene",
+    "read_3ds",
+    "scene_to_3ds_objects",
+    "write_3ds",
+]
+
+# ---------------------------------------------------------------------------
+# chunk ids (names follow lib3ds)
+
+MAIN = 0x4D4D
+M3D_VERSION = 0x0002
+MDATA = 0x3D3D
+MESH_VERSION = 0x3D3E
+MASTER_SCALE = 0x0100
+NAMED_OBJECT = 0x4000
+N_TRI_OBJECT = 0x4100
+POINT_ARRAY = 0x4110
+FACE_ARRAY = 0x4120
+MSH_MAT_GROUP = 0x4130
+TEX_VERTS = 0x4140
+SMOOTH_GROUP = 0x4150
+MESH_MATRIX = 0x4160
+MAT_ENTRY = 0xAFFF
+MAT_NAME = 0xA000
+MAT_AMBIENT = 0xA010
+MAT_DIFFUSE = 0xA020
+MAT_SPECULAR = 0xA030
+MAT_SHININESS = 0xA040
+MAT_SHIN2PCT = 0xA041
+MAT_TRANSPARENCY = 0xA050
+MAT_TWO_SIDE = 0xA081
+MAT_MAPNAME = 0xA300
+COLOR_F = 0x0010
+COLOR_24 = 0x0011
+LIN_COLOR_24 = 0x0012
+LIN_COLOR_F = 0x0013
+INT_PERCENTAGE = 0x0030
+FLOAT_PERCENTAGE = 0x0031
+KFDATA = 0xB000
+OBJECT_NODE_TAG = 0xB002
+NODE_HDR = 0xB010
+INSTANCE_NAME = 0xB011
+NODE_ID = 0xB030
+
+#: texture-map chunks inside a material, by the name we report them under
+MAP_CHUNKS = {
+    0xA200: "diffuse",
+    0xA33A: "diffuse2",
+    0xA204: "specular",
+    0xA210: "opacity",
+    0xA230: "bump",
+    0xA33C: "shininess",
+    0xA33D: "self_illumination",
+    0xA220: "reflection",
+}
+
+#: colour of faces that have no material (neutral grey, opaque), RGBA uint8
+DEFAULT_COLOR = (128, 128, 128, 255)
+
+#: vertex and face counts are u16 in the format
+MAX_COUNT = 0xFFFF
+
+HEADER = struct.Struct("<HI")
+VERTEX_DTYPE = np.dtype(("<f4", (3,)))
+UV_DTYPE = np.dtype(("<f4", (2,)))
+FACE_DTYPE = np.dtype([("vertices", "<u2", (3,)), ("flags", "<u2")])
+
+#: colour sub-chunks in order of preference: linear forms first (they are what the
+#: artist picked; the plain ones are gamma-corrected copies), float before 24-bit
+_COLOR_PREFERENCE = (LIN_COLOR_F, LIN_COLOR_24, COLOR_F, COLOR_24)
+
+
+# ---------------------------------------------------------------------------
+# plain data
+
+
+@dataclass
+class TextureMap:
+    """A texture map of a material: image file name and strength (0..1)."""
+
+    kind: str
+    file: str | None = None
+    strength: float | None = None
+
+
+@dataclass
+class Material:
+    """One 0xAFFF material entry.  Colours are RGB floats 0..1; percentages are
+    given as fractions (``transparency`` 0 = opaque, 1 = invisible)."""
+
+    name: str
+    ambient: tuple[float, float, float] | None = None
+    diffuse: tuple[float, float, float] | None = None
+    specular: tuple[float, float, float] | None = None
+    shininess: float | None = None
+    shininess_strength: float | None = None
+    transparency: float = 0.0
+    two_sided: bool = False
+    maps: dict[str, TextureMap] = field(default_factory=dict)
+    offset: int = 0
+
+    @property
+    def texture(self) -> str | None:
+        """File name of the diffuse texture map, if any."""
+        m = self.maps.get("diffuse")
+        return m.file if m else None
+
+    def rgba(self) -> tuple[int, int, int, int]:
+        """Diffuse colour with alpha from the transparency, as uint8 RGBA."""
+        if self.diffuse is None:
+            rgb = DEFAULT_COLOR[:3]
+        else:
+            rgb = tuple(int(round(float(np.clip(c, 0.0, 1.0)) * 255)) for c in self.diffuse)
+        alpha = int(round((1.0 - float(np.clip(self.transparency, 0.0, 1.0))) * 255))
+        return (rgb[0], rgb[1], rgb[2], alpha)
+
+
+@dataclass
+class MeshObject:
+    """One triangle mesh (a 0x4100 inside a 0x4000 named object).
+
+    Attributes
+    ----------
+    vertices : (n, 3) float64, in the file's axes (Z up), master scale NOT applied
+    faces : (m, 3) int32 indices into ``vertices``
+    face_flags : (m,) uint16 edge-visibility / wrap flags as stored
+    face_material : (m,) int32 index into ``Model3DS.materials``, -1 for none
+    uv : (k, 2) float64 texture coordinates (k is normally n) or None
+    smoothing : (m,) uint32 smoothing-group bit masks or None
+    matrix : (4, 4) float64 object matrix from 0x4160 (columns: x, y, z axes and
+        origin).  The vertices are already in world space; this is informational.
+    """
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    face_flags: np.ndarray
+    face_material: np.ndarray
+    uv: np.ndarray | None = None
+    smoothing: np.ndarray | None = None
+    matrix: np.ndarray = field(default_factory=lambda: np.eye(4))
+    offset: int = 0
+
+
+@dataclass
+class KeyframerNode:
+    """An object node (0xB002) of the keyframer: which object it instances."""
+
+    name: str
+    instance: str | None = None
+    node_id: int | None = None
+    parent: int | None = None
+
+    @property
+    def instance_name(self) -> str:
+        """``name`` or ``name.instance`` when the node names its instance."""
+        return f"{self.name}.{self.instance}" if self.instance else self.name
+
+
+@dataclass
+class Model3DS:
+    """Everything read from one .3ds file."""
+
+    source: str
+    master_scale: float = 1.0
+    version: int | None = None
+    mesh_version: int | None = None
+    materials: list[Material] = field(default_factory=list)
+    objects: list[MeshObject] = field(default_factory=list)
+    nodes: list[KeyframerNode] = field(default_factory=list)
+
+    @property
+    def instance_names(self) -> list[str]:
+        return [n.instance_name for n in self.nodes]
+
+    def material_index(self, name: str) -> int:
+        for i, m in enumerate(self.materials):
+            if m.name == name:
+                return i
+        return -1
+
+
+# ---------------------------------------------------------------------------
+# reader
+
+
+class _Reader:
+    """Walks the chunk tree of one file held in memory."""
+
+    def __init__(self, data: bytes, source: str) -> None:
+        self.data = data
+        self.source = source
+        # material names of 0x4130 groups, resolved after the whole file is read
+        # because materials may follow the objects that use them
+        self.pending_groups: list[tuple[MeshObject, str, np.ndarray]] = []
+
+    # -- helpers -------------------------------------------------------------
+
+    def error(self, offset: int, message: str) -> FormatError:
+        return FormatError(f"{self.source}: byte {offset}: {message}")
+
+    def children(self, start: int, end: int, parent: int) -> Iterator[tuple[int, int, int, int]]:
+        """Yield ``(id, offset, body_start, chunk_end)`` for each chunk in [start, end).
+
+        Each step advances by the chunk's length, which is checked to be at least
+        the 6-byte header: the loop cannot stall.
+        """
+        pos = start
+        while pos < end:
+            if end - pos < HEADER.size:
+                raise self.error(
+                    pos,
+                    f"{end - pos} stray byte(s) at the end of chunk 0x{parent:04X}, "
+                    f"too few for a 6-byte chunk header",
+                )
+            cid, length = HEADER.unpack_from(self.data, pos)
+            if length < HEADER.size:
+                raise self.error(
+                    pos, f"chunk 0x{cid:04X} has length {length}, less than its 6-byte header"
+                )
+            if length > end - pos:
+                where = (
+                    f"the file ends at byte {len(self.data)}"
+                    if end == len(self.data) and parent == -1
+                    else f"its parent chunk 0x{parent:04X} ends at byte {end}"
+                )
+                raise self.error(
+                    pos,
+                    f"chunk 0x{cid:04X} claims {length} bytes (to byte {pos + length}) "
+                    f"but {where}",
+                )
+            yield cid, pos, pos + HEADER.size, pos + length
+            pos += length
+
+    def need(self, offset: int, end: int, size: int, what: str, cid: int) -> None:
+        """Raise unless ``size`` bytes are left between ``offset`` and ``end``."""
+        if size > end - offset:
+            raise self.error(
+                offset,
+                f"chunk 0x{cid:04X}: {what}: {size} bytes needed but only {end - offset} left",
+            )
+
+    def cstring(self, offset: int, end: int, cid: int) -> tuple[str, int]:
+        """A NUL-terminated name at ``offset``; returns (text, offset after the NUL)."""
+        nul = self.data.find(b"\0", offset, end)
+        if nul < 0:
+            raise self.error(
+                offset, f"chunk 0x{cid:04X}: name not terminated by a NUL byte before byte {end}"
+            )
+        # 3DS names are 8-bit; latin-1 maps every byte, so decoding cannot fail
+        return self.data[offset:nul].decode("latin-1"), nul + 1
+
+    def u16(self, offset: int, end: int, cid: int, what: str) -> int:
+        self.need(offset, end, 2, what, cid)
+        return struct.unpack_from("<H", self.data, offset)[0]
+
+    def array(self, offset: int, end: int, count: int, dtype: np.dtype, what: str, cid: int) -> np.ndarray:
+        """``count`` items of ``dtype`` at ``offset``, after checking they fit."""
+        self.need(offset, end, count * dtype.itemsize, what, cid)
+        return np.frombuffer(self.data, dtype=dtype, count=count, offset=offset)
+
+    def floats(self, offset: int, end: int, n: int, cid: int, what: str) -> np.ndarray:
+        arr = self.array(offset, end, n, np.dtype("<f4"), what, cid).astype(np.float64)
+        if not np.isfinite(arr).all():
+            raise self.error(offset, f"chunk 0x{cid:04X}: {what} not finite (NaN or inf)")
+        return arr
+
+    # -- the tree ------------------------------------------------------------
+
+    def read(self) -> Model3DS:
+        data = self.data
+        if len(data) == 0:
+            raise FormatError(f"{self.source}: byte 0: empty file, expected a 3DS model (magic 0x4D4D)")
+        if len(data) < HEADER.size:
+            raise self.error(0, f"file has {len(data)} bytes, too short for a 3DS header")
+        cid = HEADER.unpack_from(data, 0)[0]
+        if cid != MAIN:
+            raise self.error(0, f"not a 3DS file: expected magic 0x4D4D, found 0x{cid:04X}")
+        model = Model3DS(source=self.source)
+        # only the first top-level chunk is the model; anything after it (some
+        # exporters pad the file) is not part of the tree
+        for cid, off, body, end in self.children(0, len(data), -1):
+            self.main(model, body, end)
+            break
+        for obj, name, idx in self.pending_groups:
+            obj.face_material[idx] = model.material_index(name)
+        return model
+
+    def main(self, model: Model3DS, start: int, end: int) -> None:
+        for cid, off, body, cend in self.children(start, end, MAIN):
+            if cid == M3D_VERSION:
+                self.need(body, cend, 4, "version", cid)
+                model.version = struct.unpack_from("<I", self.data, body)[0]
+            elif cid == MDATA:
+                self.mdata(model, body, cend)
+            elif cid == KFDATA:
+                self.keyframer(model, body, cend)
+
+    def mdata(self, model: Model3DS, start: int, end: int) -> None:
+        for cid, off, body, cend in self.children(start, end, MDATA):
+            if cid == MESH_VERSION:
+                self.need(body, cend, 4, "mesh version", cid)
+                model.mesh_version = struct.unpack_from("<I", self.data, body)[0]
+            elif cid == MASTER_SCALE:
+                scale = float(self.floats(body, cend, 1, cid, "master scale")[0])
+                if not scale > 0:
+                    raise self.error(body, f"master scale must be positive, got {scale}")
+                model.master_scale = scale
+            elif cid == MAT_ENTRY:
+                model.materials.append(self.material(off, body, cend))
+            elif cid == NAMED_OBJECT:
+                self.named_object(model, off, body, cend)
+
+    def named_object(self, model: Model3DS, off: int, start: int, end: int) -> None:
+        name, pos = self.cstring(start, end, NAMED_OBJECT)
+        for cid, coff, body, cend in self.children(pos, end, NAMED_OBJECT):
+            # lights (0x4600) and cameras (0x4700) are skipped by their length
+            if cid == N_TRI_OBJECT:
+                model.objects.append(self.trimesh(name, off, body, cend))
+
+    def trimesh(self, name: str, off: int, start: int, end: int) -> MeshObject:
+        obj = MeshObject(
+            name=name,
+            vertices=np.zeros((0, 3)),
+            faces=np.zeros((0, 3), dtype=np.int32),
+            face_flags=np.zeros(0, dtype=np.uint16),
+            face_material=np.full(0, -1, dtype=np.int32),
+            offset=off,
+        )
+        face_offset = None
+        for cid, coff, body, cend in self.children(start, end, N_TRI_OBJECT):
+            if cid == POINT_ARRAY:
+                n = self.u16(body, cend, cid, "vertex count")
+                obj.vertices = self.floats(body + 2, cend, 3 * n, cid, f"{n} vertices").reshape(n, 3)
+            elif cid == TEX_VERTS:
+                n = self.u16(body, cend, cid, "texture vertex count")
+                obj.uv = self.floats(body + 2, cend, 2 * n, cid, f"{n} texture vertices").reshape(n, 2)
+            elif cid == MESH_MATRIX:
+                m = self.floats(body, cend, 12, cid, "object matrix").reshape(4, 3)
+                matrix = np.eye(4)
+                matrix[:3, :] = m.T  # rows in the file are the x, y, z axes and origin
+                obj.matrix = matrix
+            elif cid == FACE_ARRAY:
+                face_offset = coff
+                self.face_array(obj, body, cend)
+        if len(obj.faces):
+            bad = obj.faces >= len(obj.vertices)
+            if bad.any():
+                i = int(np.flatnonzero(bad.any(axis=1))[0])
+                raise self.error(
+                    face_offset + HEADER.size + 2 + 8 * i,
+                    f"object {name!r}: face {i} uses vertex {int(obj.faces[i].max())} "
+                    f"but the object has {len(obj.vertices)} vertices",
+                )
+        return obj
+
+    def face_array(self, obj: MeshObject, start: int, end: int) -> None:
+        n = self.u16(start, end, FACE_ARRAY, "face count")
+        rec = self.array(start + 2, end, n, FACE_DTYPE, f"{n} faces", FACE_ARRAY)
+        obj.faces = rec["vertices"].astype(np.int32)
+        obj.face_flags = rec["flags"].copy()
+        obj.face_material = np.full(n, -1, dtype=np.int32)
+        for cid, off, body, cend in self.children(start + 2 + n * FACE_DTYPE.itemsize, end, FACE_ARRAY):
+            if cid == MSH_MAT_GROUP:
+                name, pos = self.cstring(body, cend, cid)
+                k = self.u16(pos, cend, cid, "group face count")
+                idx = self.array(pos + 2, cend, k, np.dtype("<u2"), f"{k} face indices", cid)
+                if k and int(idx.max()) >= n:
+                    raise self.error(
+                        pos + 2,
+                        f"material group {name!r} names face {int(idx.max())} "
+                        f"but the object has {n} faces",
+                    )
+                self.pending_groups.append((obj, name, idx.astype(np.int32)))
+            elif cid == SMOOTH_GROUP:
+                if cend - body != 4 * n:
+                    raise self.error(
+                        off,
+                        f"smoothing groups chunk has {cend - body} bytes, "
+                        f"expected 4 per face = {4 * n}",
+                    )
+                obj.smoothing = np.frombuffer(self.data, "<u4", n, body).astype(np.uint32)
+
+    def material(self, off: int, start: int, end: int) -> Material:
+        mat = Material(name="", offset=off)
+        for cid, coff, body, cend in self.children(start, end, MAT_ENTRY):
+            if cid == MAT_NAME:
+                mat.name = self.cstring(body, cend, cid)[0]
+            elif cid == MAT_AMBIENT:
+                mat.ambient = self.color(body, cend, cid)
+            elif cid == MAT_DIFFUSE:
+                mat.diffuse = self.color(body, cend, cid)
+            elif cid == MAT_SPECULAR:
+                mat.specular = self.color(body, cend, cid)
+            elif cid == MAT_SHININESS:
+                mat.shininess = self.percent(body, cend, cid)
+            elif cid == MAT_SHIN2PCT:
+                mat.shininess_strength = self.percent(body, cend, cid)
+            elif cid == MAT_TRANSPARENCY:
+                t = self.percent(body, cend, cid)
+                mat.transparency = 0.0 if t is None else t
+            elif cid == MAT_TWO_SIDE:
+                mat.two_sided = True
+            elif cid in MAP_CHUNKS:
+                kind = MAP_CHUNKS[cid]
+                mat.maps[kind] = self.texture_map(kind, body, cend, cid)
+        return mat
+
+    def color(self, start: int, end: int, parent: int) -> tuple[float, float, float] | None:
+        found: dict[int, tuple[float, float, float]] = {}
+        for cid, off, body, cend in self.children(start, end, parent):
+            if cid in (COLOR_F, LIN_COLOR_F):
+                rgb = self.floats(body, cend, 3, cid, "colour")
+                found[cid] = (float(rgb[0]), float(rgb[1]), float(rgb[2]))
+            elif cid in (COLOR_24, LIN_COLOR_24):
+                self.need(body, cend, 3, "colour", cid)
+                r, g, b = self.data[body : body + 3]
+                found[cid] = (r / 255.0, g / 255.0, b / 255.0)
+        for cid in _COLOR_PREFERENCE:
+            if cid in found:
+                return found[cid]
+        return None
+
+    def percent(self, start: int, end: int, parent: int) -> float | None:
+        """A 0x0030 (int16 0..100) or 0x0031 (float 0..100) percentage, as a fraction."""
+        for cid, off, body, cend in self.children(start, end, parent):
+            if cid == INT_PERCENTAGE:
+                self.need(body, cend, 2, "percentage", cid)
+                return struct.unpack_from("<h", self.data, body)[0] / 100.0
+            if cid == FLOAT_PERCENTAGE:
+                return float(self.floats(body, cend, 1, cid, "percentage")[0]) / 100.0
+        return None
+
+    def texture_map(self, kind: str, start: int, end: int, parent: int) -> TextureMap:
+        tex = TextureMap(kind=kind)
+        for cid, off, body, cend in self.children(start, end, parent):
+            if cid == MAT_MAPNAME:
+                tex.file = self.cstring(body, cend, cid)[0]
+            elif cid in (INT_PERCENTAGE, FLOAT_PERCENTAGE):
+                # the strength is stored directly as a percentage sub-chunk
+                if cid == INT_PERCENTAGE:
+                    self.need(body, cend, 2, "percentage", cid)
+                    tex.strength = struct.unpack_from("<h", self.data, body)[0] / 100.0
+                else:
+                    tex.strength = float(self.floats(body, cend, 1, cid, "percentage")[0]) / 100.0
+        return tex
+
+    def keyframer(self, model: Model3DS, start: int, end: int) -> None:
+        for cid, off, body, cend in self.children(start, end, KFDATA):
+            if cid != OBJECT_NODE_TAG:
+                continue
+            node = KeyframerNode(name="")
+            for sid, soff, sbody, send in self.children(body, cend, cid):
+                if sid == NODE_ID:
+                    node.node_id = self.u16(sbody, send, sid, "node id")
+                elif sid == NODE_HDR:
+                    node.name, pos = self.cstring(sbody, send, sid)
+                    self.need(pos, send, 6, "node flags and parent", sid)
+                    parent = struct.unpack_from("<H", self.data, pos + 4)[0]
+                    node.parent = None if parent == 0xFFFF else parent
+                elif sid == INSTANCE_NAME:
+                    node.instance = self.cstring(sbody, send, sid)[0] or None
+            model.nodes.append(node)
+
+
+def read_3ds(source: str | os.PathLike | bytes | BinaryIO, name: str | None = None) -> Model3DS:
+    """Parse a .3ds file (a path, its bytes, or an open binary file).
+
+    ``name`` is used in error messages (default: the path, or ``<bytes>``).  Raises
+    FormatError for anything that is not a well-formed 3DS chunk tree.
+    """
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        data = bytes(source)
+        label = name or "<bytes>"
+    elif isinstance(source, (str, os.PathLike)):
+        label = name or str(source)
+        try:
+            data = Path(source).read_bytes()
+        except FileNotFoundError:
+            raise FormatError(f"{label}: no such file") from None
+        except IsADirectoryError:
+            raise FormatError(f"{label}: is a folder, expected a .3ds file") from None
+        except OSError as e:
+            raise FormatError(f"{label}: cannot read: {e.strerror}") from None
+    else:
+        data = source.read()
+        label = name or str(getattr(source, "name", "<stream>"))
+    return _Reader(data, label).read()
+
+
+# ---------------------------------------------------------------------------
+# trimesh
+
+
+def _unique_names(names: Sequence[str]) -> list[str]:
+    seen: dict[str, int] = {}
+    out = []
+    for n in names:
+        n = n or "object"
+        if n in seen:
+            seen[n] += 1
+            candidate = f"{n}_{seen[n]}"
+            while candidate in seen:
+                seen[n] += 1
+                candidate = f"{n}_{seen[n]}"
+            n = candidate
+        seen.setdefault(n, 0)
+        out.append(n)
+    return out
+
+
+def _face_colors(model: Model3DS, obj: MeshObject) -> np.ndarray:
+    """(m, 4) uint8 RGBA per face from its material (grey when it has none)."""
+    palette = np.array([m.rgba() for m in model.materials] + [DEFAULT_COLOR], dtype=np.uint8)
+    # -1 (no material) picks the last row, the default colour
+    return palette[obj.face_material]
+
+
+def _geometry_kwargs(model: Model3DS) -> dict[str, dict[str, Any]]:
+    """Trimesh keyword arguments for each mesh object with faces, master scale applied."""
+    objs = [o for o in model.objects if len(o.faces)]
+    out = {}
+    for name, obj in zip(_unique_names([o.name for o in objs]), objs):
+        out[name] = {
+            "vertices": obj.vertices * model.master_scale,
+            "faces": obj.faces.astype(np.int64),
+            "face_colors": _face_colors(model, obj),
+            "process": False,
+            "metadata": {
+                "name": name,
+                "3ds_object": obj.name,
+                "materials": sorted(
+                    {model.materials[i].name for i in np.unique(obj.face_material) if i >= 0}
+                ),
+            },
+        }
+    return out
+
+
+def _scene_metadata(model: Model3DS) -> dict[str, Any]:
+    return {
+        "3ds_master_scale": model.master_scale,
+        "3ds_instances": model.instance_names,
+    }
+
+
+def load_scene(path: str | os.PathLike):
+    """Read ``path`` as a ``trimesh.Scene`` in the file's own axes (Z up).
+
+    One geometry per mesh object with faces, named after the object; per-face
+    colours from the material diffuse colour (alpha from its transparency; faces
+    without a material are neutral grey); master scale applied.
+    """
+    import trimesh
+
+    model = read_3ds(path)
+    geometry = {name: trimesh.Trimesh(**kw) for name, kw in _geometry_kwargs(model).items()}
+    scene = trimesh.Scene()
+    for name, mesh in geometry.items():
+        scene.add_geometry(mesh, geom_name=name, node_name=name)
+    scene.metadata.update(_scene_metadata(model))
+    return scene
+
+
+def load_3ds(file_obj: BinaryIO, file_type: str | None = None, resolver: Any = None, **kwargs: Any) -> dict[str, Any]:
+    """trimesh loader: returns the keyword arguments of a Scene (see ``load_scene``)."""
+    model = read_3ds(file_obj)
+    return {"geometry": _geometry_kwargs(model), "metadata": _scene_metadata(model)}
+
+
+def _register() -> None:
+    from trimesh.exchange import load as trimesh_load
+
+    trimesh_load.mesh_loaders["3ds"] = load_3ds
+
+
+_register()
+
+
+# ---------------------------------------------------------------------------
+# writer
+
+
+def _chunk(cid: int, *parts: bytes) -> bytes:
+    body = b"".join(parts)
+    if len(body) + HEADER.size > 0xFFFFFFFF:
+        raise ValueError(f"chunk 0x{cid:04X} would exceed the 4 GiB limit of the format")
+    return HEADER.pack(cid, len(body) + HEADER.size) + body
+
+
+def _name_bytes(name: str, what: str) -> bytes:
+    if "\0" in name:
+        raise ValueError(f"{what} {name!r} contains a NUL character")
+    return name.encode("latin-1", errors="replace") + b"\0"
+
+
+def _split_mesh(vertices: np.ndarray, faces: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Split a mesh into parts of at most 65535 vertices and 65535 faces (u16 counts).
+
+    Faces keep their order; each part takes the longest run of faces whose distinct
+    vertices still fit (binary search: the count only grows with the run).
+    """
+    if len(vertices) <= MAX_COUNT and len(faces) <= MAX_COUNT:
+        return [(vertices, faces)]
+    parts = []
+    safe = MAX_COUNT // 3  # this many faces always fit: at most 3 new vertices each
+    start, m = 0, len(faces)
+    while start < m:
+        hi = min(m, start + MAX_COUNT)
+        if len(np.unique(faces[start:hi])) <= MAX_COUNT:
+            stop = hi
+        else:
+            lo = min(m, start + safe)  # known to fit
+            while hi - lo > 1:
+                mid = (lo + hi) // 2
+                if len(np.unique(faces[start:mid])) <= MAX_COUNT:
+                    lo = mid
+                else:
+                    hi = mid
+            stop = lo
+        used, inverse = np.unique(faces[start:stop], return_inverse=True)
+        parts.append((vertices[used], inverse.reshape(-1, 3)))
+        start = stop
+    return parts
+
+
+def _color_chunk(cid: int, rgb: tuple[float, float, float]) -> bytes:
+    rgb24 = bytes(int(round(c * 255)) for c in rgb)
+    # 24-bit for old readers, linear float for an exact round trip
+    return _chunk(
+        cid,
+        _chunk(COLOR_24, rgb24),
+        _chunk(LIN_COLOR_F, struct.pack("<3f", *rgb)),
+    )
+
+
+def encode_3ds(
+    objects: Sequence[tuple[str, Any, Any, Sequence[float]]], master_scale: float = 1.0
+) -> bytes:
+    """The bytes of a .3ds file holding ``objects``; see :func:`write_3ds`."""
+    if not (np.isfinite(master_scale) and master_scale > 0):
+        raise ValueError(f"master_scale must be a positive number, got {master_scale!r}")
+    colors: dict[tuple[float, float, float], int] = {}
+    object_chunks = []
+    for k, item in enumerate(objects):
+        try:
+            name, vertices, faces, rgb = item
+        except (TypeError, ValueError):
+            raise ValueError(f"object {k}: expected (name, vertices, faces, rgb)") from None
+        vertices = np.asarray(vertices, dtype=np.float64)
+        faces = np.asarray(faces)
+        if vertices.ndim != 2 or vertices.shape[1] != 3:
+            raise ValueError(f"object {name!r}: vertices must be (n, 3), got {vertices.shape}")
+        if faces.size == 0:
+            faces = faces.reshape(0, 3).astype(np.int64)
+        if faces.ndim != 2 or faces.shape[1] != 3 or not np.issubdtype(faces.dtype, np.integer):
+            raise ValueError(f"object {name!r}: faces must be (m, 3) integers, got {faces.shape} {faces.dtype}")
+        if not np.isfinite(vertices).all():
+            raise ValueError(f"object {name!r}: vertices must be finite")
+        if len(faces) and (faces.min() < 0 or faces.max() >= len(vertices)):
+            raise ValueError(f"object {name!r}: face index out of range 0..{len(vertices) - 1}")
+        rgb_t = tuple(float(c) for c in rgb)
+        if len(rgb_t) != 3 or not all(0.0 <= c <= 1.0 for c in rgb_t):
+            raise ValueError(f"object {name!r}: colour must be 3 floats in 0..1, got {rgb!r}")
+        if np.abs(vertices).max(initial=0.0) > np.finfo(np.float32).max:
+            raise ValueError(f"object {name!r}: vertices exceed the float32 range of the format")
+        mat = colors.setdefault(rgb_t, len(colors))
+        parts = _split_mesh(vertices, faces)
+        for p, (v, f) in enumerate(parts):
+            part_name = name if len(parts) == 1 else f"{name}_{p}"
+            object_chunks.append(_object_chunk(part_name, v, f, f"Material{mat}"))
+    material_chunks = [
+        _chunk(
+            MAT_ENTRY,
+            _chunk(MAT_NAME, _name_bytes(f"Material{i}", "material")),
+            _color_chunk(MAT_AMBIENT, rgb),
+            _color_chunk(MAT_DIFFUSE, rgb),
+        )
+        for rgb, i in colors.items()
+    ]
+    mdata = _chunk(
+        MDATA,
+        _chunk(MESH_VERSION, struct.pack("<I", 3)),
+        *material_chunks,
+        _chunk(MASTER_SCALE, struct.pack("<f", master_scale)),
+        *object_chunks,
+    )
+    return _chunk(MAIN, _chunk(M3D_VERSION, struct.pack("<I", 3)), mdata)
+
+
+def _object_chunk(name: str, vertices: np.ndarray, faces: np.ndarray, material: str) -> bytes:
+    points = np.ascontiguousarray(vertices, dtype="<f4")
+    rec = np.zeros(len(faces), dtype=FACE_DTYPE)
+    rec["vertices"] = faces
+    rec["flags"] = 0x0007  # all three edges visible, as 3ds Max writes them
+    group = _chunk(
+        MSH_MAT_GROUP,
+        _name_bytes(material, "material"),
+        struct.pack("<H", len(faces)),
+        np.arange(len(faces), dtype="<u2").tobytes(),
+    )
+    matrix = np.zeros((4, 3), dtype="<f4")
+    matrix[:3] = np.eye(3)
+    return _chunk(
+        NAMED_OBJECT,
+        _name_bytes(name, "object name"),
+        _chunk(
+            N_TRI_OBJECT,
+            _chunk(POINT_ARRAY, struct.pack("<H", len(points)), points.tobytes()),
+            _chunk(MESH_MATRIX, matrix.tobytes()),
+            _chunk(FACE_ARRAY, struct.pack("<H", len(faces)), rec.tobytes(), group),
+        ),
+    )
+
+
+def write_3ds(
+    path: str | os.PathLike,
+    objects: Sequence[tuple[str, Any, Any, Sequence[float]]],
+    master_scale: float = 1.0,
+) -> None:
+    """Write ``objects`` to a .3ds file, atomically.
+
+    Parameters
+    ----------
+    path : where to write
+    objects : list of ``(name, vertices, faces, rgb)``: vertices (n, 3) float in the
+        FILE's axes (Z up), faces (m, 3) int, rgb three floats 0..1 (the diffuse
+        colour).  One material is written per distinct colour; objects over 65535
+        vertices or faces are split into ``name_0``, ``name_1``, ...
+    master_scale : stored in the 0x0100 chunk (readers multiply vertices by it)
+
+    Raises ValueError for malformed objects (nothing is written then).
+    """
+    atomic_write_bytes(path, encode_3ds(objects, master_scale))
+
+
+#: (x, y, z) Y-up -> (x, -z, y) Z-up, the inverse of models.Z_UP_TO_Y_UP
+_Y_UP_TO_Z_UP = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.float64)
+
+
+def _mesh_face_rgb(mesh: Any) -> np.ndarray:
+    """(m, 3) uint8 colour of each face; grey when the mesh has no colours."""
+    m = len(mesh.faces)
+    visual = mesh.visual
+    kind = getattr(visual, "kind", None)
+    if kind in ("face", "vertex"):
+        return np.asarray(visual.face_colors)[:, :3].astype(np.uint8)
+    if kind == "texture":
+        material = getattr(visual, "material", None)
+        main = getattr(material, "main_color", None)
+        if main is not None:
+            return np.tile(np.asarray(main, dtype=np.uint8)[:3], (m, 1))
+    return np.tile(np.array(DEFAULT_COLOR[:3], dtype=np.uint8), (m, 1))
+
+
+def scene_to_3ds_objects(geometry: Any) -> list[tuple[str, np.ndarray, np.ndarray, tuple[float, float, float]]]:
+    """Turn a Y-up ``trimesh.Trimesh`` or ``trimesh.Scene`` into :func:`write_3ds` objects.
+
+    Scene transforms are applied; axes go back to the 3DS convention
+    (x, y, z) -> (x, -z, y); each mesh is split by face colour into one object per
+    colour (named ``<node>`` or ``<node>_<k>``), keeping only the vertices used.
+    """
+    import trimesh
+
+    items: list[tuple[str, Any, np.ndarray]] = []
+    if isinstance(geometry, trimesh.Trimesh):
+        items.append((str(geometry.metadata.get("name") or "mesh"), geometry, np.eye(4)))
+    elif isinstance(geometry, trimesh.Scene):
+        for node in geometry.graph.nodes_geometry:
+            transform, geom_name = geometry.graph[node]
+            mesh = geometry.geometry.get(geom_name)
+            if isinstance(mesh, trimesh.Trimesh):
+                items.append((str(node), mesh, np.asarray(transform, dtype=np.float64)))
+    else:
+        raise TypeError(f"expected a trimesh.Trimesh or trimesh.Scene, got {type(geometry).__name__}")
+
+    objects = []
+    for name, mesh, transform in items:
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        if len(faces) == 0:
+            continue
+        verts = np.asarray(mesh.vertices, dtype=np.float64) @ transform[:3, :3].T + transform[:3, 3]
+        verts = verts @ _Y_UP_TO_Z_UP.T
+        rgb = _mesh_face_rgb(mesh)
+        palette, which = np.unique(rgb, axis=0, return_inverse=True)
+        which = which.reshape(-1)
+        for k, color in enumerate(palette):
+            sel = faces[which == k]
+            used, inverse = np.unique(sel, return_inverse=True)
+            obj_name = name if len(palette) == 1 else f"{name}_{k}"
+            objects.append(
+                (
+                    obj_name,
+                    verts[used],
+                    inverse.reshape(-1, 3),
+                    (color[0] / 255.0, color[1] / 255.0, color[2] / 255.0),
+                )
+            )
+    return objects
