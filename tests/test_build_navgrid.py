@@ -129,3 +129,26 @@ def test_bad_files(tmp_path, bundle):
     r = run(bundle, "--clearance", 1)
     assert r.exit_code == 2 and "walls.txt:2: expected 5 fields" in r.output
     assert not (bundle / "navgrid.npz").exists()
+
+
+def test_picture_labels_small_grids_and_regions(tmp_path):
+    from tanktool.nav.synthetic import box_arena
+    from tanktool.plots.navgrid import render_navgrid
+
+    w = box_arena(6, 4, margin=1)
+    sp = np.array([[3.0, 2.0, 0.0]])
+    g = build_navgrid(w, 1.0, 0.9, spawns=sp)
+    svg = render_navgrid(g, w, fmt="svg", quadtree=WallQuadtree.build(w.segments, w.bounds), spawns=sp,
+                         annotate="both").decode()
+    # nodes at x = 1.5 .. 4.5 and z = 1.5, 2.5 keep 0.9 m: rows of 4, columns of 2
+    assert g.valid.sum() == 8 and ">3/4<" in svg and ">2/2<" in svg and "spawn point" in svg
+    assert "quadtree leaves (64, depth 3)" in svg
+    rows_only = render_navgrid(g, w, fmt="svg", annotate="rows").decode()
+    assert ">3/4<" in rows_only and ">2/2<" not in rows_only
+    assert ">3/4<" not in render_navgrid(g, w, fmt="svg", annotate="none").decode()
+    # a big grid is not labelled as a whole, but a region of it is
+    big = build_navgrid(random_arena(1), 0.25, 0.5)
+    whole = render_navgrid(big, random_arena(1), fmt="svg", annotate="cols").decode()
+    assert "labels:" not in whole
+    part = render_navgrid(big, random_arena(1), fmt="svg", annotate="cols", region=np.array([[10, 10], [14, 13.0]])).decode()
+    assert "labels: columna/total" in part

@@ -24,7 +24,7 @@ WALL_COLOUR = "#1b1b1b"
 QUADTREE_COLOUR = "#2f6db5"
 SPAWN_COLOUR = "#d62728"
 #: annotate nodes only when a node is at least this many points wide
-MIN_LABEL_PT = {"rows": 13.0, "cols": 13.0, "both": 18.0}
+MIN_LABEL_PT = {"rows": 15.0, "cols": 15.0, "both": 20.0}
 
 
 def node_states(grid: Any, free: np.ndarray | None = None) -> np.ndarray:
@@ -71,6 +71,9 @@ def render_navgrid(
 
     b = grid.bounds
     view = b.copy() if region is None else np.asarray(region, dtype=np.float64).reshape(2, 2)
+    view_span = float(np.max(view[1] - view[0]))
+    pad = 0.02 * view_span if region is None else 0.5 * grid.cell
+    view = view + np.array([[-pad], [pad]])
     # nodes in view decide how big the figure must be for labels to fit
     j0 = max(0, int(math.floor((view[0, 0] - grid.origin[0]) / grid.cell)))
     j1 = min(grid.nx, int(math.ceil((view[1, 0] - grid.origin[0]) / grid.cell)))
@@ -95,10 +98,14 @@ def render_navgrid(
         extent=(b[0, 0], b[1, 0], b[0, 1], b[1, 1]), zorder=0,
     )
     cell_pt = (width_in - 2.6) * 0.92 * 72.0 / across
+    labelling = annotate != "none" and cell_pt >= MIN_LABEL_PT.get(annotate, 99)
     if cell_pt >= 6:  # node centres and cell edges, when they do not turn into a smear
         xs, zs = np.meshgrid(grid.node_x[j0:j1], grid.node_z[i0:i1])
-        open_ = states[i0:i1, j0:j1] > 0  # no dots on solid ground: less clutter
-        ax.scatter(xs[open_], zs[open_], s=max(1.0, (cell_pt * 0.12) ** 2), c="#00000055", lw=0, zorder=1)
+        # no dots on solid ground (clutter) nor under labels (the label marks the node)
+        dot = states[i0:i1, j0:j1] > 0
+        if labelling:
+            dot &= ~grid.valid[i0:i1, j0:j1]
+        ax.scatter(xs[dot], zs[dot], s=min(max(1.0, (cell_pt * 0.12) ** 2), 9.0), c="#00000055", lw=0, zorder=1)
         gx = grid.origin[0] + np.arange(j0, j1 + 1) * grid.cell
         gz = grid.origin[1] + np.arange(i0, i1 + 1) * grid.cell
         ax.vlines(gx, gz[0], gz[-1], colors="#ffffff", lw=0.4, alpha=0.7, zorder=1)
@@ -116,7 +123,6 @@ def render_navgrid(
     if walls.aux is not None:
         ax.add_collection(LineCollection(walls.aux, colors=WALL_COLOUR, lw=0.8, linestyles="dashed", zorder=3))
     # normals as short ticks into free space, when there are few enough to read
-    view_span = float(np.max(view[1] - view[0]))
     if 0 < len(seg) <= 400:
         mid = seg.mean(axis=1)
         tick = walls.normals * (0.02 * view_span)
@@ -124,16 +130,16 @@ def render_navgrid(
 
     if spawns is not None and len(spawns):
         sp = np.asarray(spawns, dtype=np.float64).reshape(len(spawns), -1)
-        ax.scatter(sp[:, 0], sp[:, 1], marker="*", s=180, c=SPAWN_COLOUR, edgecolors="white", linewidths=0.8, zorder=5)
+        ax.scatter(sp[:, 0], sp[:, 1], marker="*", s=200, c=SPAWN_COLOUR, edgecolors="white", linewidths=0.8, zorder=6)
         if sp.shape[1] >= 3:
             L = 0.04 * view_span
             ax.quiver(sp[:, 0], sp[:, 1], np.cos(sp[:, 2]) * L, np.sin(sp[:, 2]) * L, angles="xy",
                       scale_units="xy", scale=1, color=SPAWN_COLOUR, width=0.004, zorder=5)
 
     labelled = 0
-    if annotate != "none" and cell_pt >= MIN_LABEL_PT.get(annotate, 99):
+    if labelling:
         # "12/34" is five characters of about 0.6 em: fill most of the cell's width
-        font = min(9.0, cell_pt / (3.4 if annotate == "both" else 3.2))
+        font = min(11.0, cell_pt / 4.0)
         ii, jj = np.nonzero(grid.valid[i0:i1, j0:j1])
         ii, jj = ii + i0, jj + j0
         for i, j in zip(ii.tolist(), jj.tolist()):
@@ -144,9 +150,8 @@ def render_navgrid(
             ax.text(x, z, text, ha="center", va="center", fontsize=font, color="#10301a", linespacing=0.95, zorder=4)
             labelled += 1
 
-    pad = 0.02 * view_span if region is None else 0.0
-    ax.set_xlim(view[0, 0] - pad, view[1, 0] + pad)
-    ax.set_ylim(view[0, 1] - pad, view[1, 1] + pad)
+    ax.set_xlim(view[0, 0], view[1, 0])
+    ax.set_ylim(view[0, 1], view[1, 1])
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("z [m]")
@@ -173,6 +178,8 @@ def render_navgrid(
             "both": "labels: renglón/total\n            columna/total"}[annotate]))
     fig.legend(handles=handles, loc="upper right", fontsize=8, frameon=False, bbox_to_anchor=(0.995, 0.93))
     buf = io.BytesIO()
-    fig.savefig(buf, format=fmt, dpi=dpi)
+    # SVG keeps its text as text, so run numbers can be searched and selected
+    with plt.rc_context({"svg.fonttype": "none"}):
+        fig.savefig(buf, format=fmt, dpi=dpi)
     plt.close(fig)
     return buf.getvalue()
