@@ -159,7 +159,7 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
             "tool_version": __version__,
             "footprint_radius": round(radius, 4),
             "source": {"file": source_name, "sha256": sha256_file(tmp / source_name), "up": up_used,
-                       "scale": float(scale), "vehicle_frame_offset": [round(float(x), 6) for x in offset]},
+                       "scale": float(scale), "vehicle_frame_offset": [round(float(x), 6) + 0.0 for x in offset]},
             "model": {"file": "model.glb"},
             "mass": {"mass": round(mp.mass, 3), "inertia": round(mp.inertia, 3),
                      "centre_of_mass": [round(float(x), 4) for x in mp.centre_of_mass],
