@@ -47,7 +47,6 @@ from ..geometry.segments import point_segment_dist2
 
 #: refuse grids larger than this (nodes); 25 M nodes is ~300 MB of arrays
 MAX_NODES = 25_000_000
-_FORMAT = "tanktool-navgrid-1"
 _FIELDS = ("valid", "row_index", "row_total", "col_index", "col_total", "reachable")
 
 Node = tuple[int, int]
@@ -146,7 +145,7 @@ class NavGrid:
     def to_bytes(self) -> bytes:
         buf = io.BytesIO()
         np.savez_compressed(
-            buf, format=np.array(_FORMAT), origin=np.asarray(self.origin, dtype=np.float64),
+            buf, origin=np.asarray(self.origin, dtype=np.float64),
             cell=np.array(float(self.cell)), shape=np.array(self.shape, dtype=np.int64),
             valid=self.valid, row_index=self.row_index, row_total=self.row_total,
             col_index=self.col_index, col_total=self.col_total, reachable=self.reachable,
