@@ -152,3 +152,12 @@ def test_picture_labels_small_grids_and_regions(tmp_path):
     assert "labels:" not in whole
     part = render_navgrid(big, random_arena(1), fmt="svg", annotate="cols", region=np.array([[10, 10], [14, 13.0]])).decode()
     assert "labels: columna/total" in part
+
+
+def test_progress_bar_on_large_grids(bundle, monkeypatch):
+    monkeypatch.setattr(cmd, "PROGRESS_NODES", 100)
+    r = run(bundle, "--clearance", 1, "--annotate", "none")
+    assert r.exit_code == 0, r.output
+    assert "classifying 1,792 nodes" in r.output
+    r = CliRunner().invoke(cli, ["-q", "build-navgrid", str(bundle), "--clearance", "1", "--annotate", "none"])
+    assert r.exit_code == 0 and r.output == ""

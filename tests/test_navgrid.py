@@ -286,3 +286,42 @@ def test_walls_without_aux_use_their_extent():
     assert np.array_equal(g.origin, [0, 0]) and g.shape == (16, 16)
     assert g.valid.sum() == 14 * 14
     assert aux_rectangle(0, 0, 1, 1).shape == (4, 2, 2)
+
+
+@pytest.mark.parametrize("cell", [2.0, 1.0, 0.5])
+def test_rows_through_vertices_and_along_walls(cell):
+    # origin -1 and cell 2: node rows and columns pass exactly through the maze's
+    # vertices and along its walls, and many lines to the origin pass through vertices
+    w = block_maze(6, n=4)
+    origin, shape, X, Z = _nodes(w, cell)
+    for clearance in (0.0, 1.0):
+        fast = classify(w, origin, cell, shape, clearance)
+        assert np.array_equal(fast, classify_reference(w, origin, cell, shape, clearance))
+    inside_free = free_space(w, origin, cell, shape)
+    d2 = _min_dist2(w, X, Z)
+    # nodes exactly on a wall are never valid, even with no clearance
+    assert not classify(w, origin, cell, shape, 0.0)[d2 == 0].any()
+    assert inside_free.sum() > 0
+
+
+def _fuzz(seed):
+    rng = np.random.default_rng(seed)
+    w = random_arena(seed, size=float(rng.uniform(20, 60)), cells=int(rng.integers(2, 6)))
+    cell = float(rng.uniform(0.6, 1.4))
+    shift = rng.uniform(-3, 3, size=2)
+    bounds = w.bounds + shift  # grids need not start at the auxiliary corner
+    clearance = float(rng.uniform(0, 2))
+    a = build_navgrid(w, cell, clearance, bounds=bounds)
+    b = build_navgrid(w, cell, clearance, bounds=bounds, reference=True)
+    assert np.array_equal(a.valid, b.valid), seed
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_fuzz_fast_equals_reference_short(seed):
+    _fuzz(100 + seed)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", range(40))
+def test_fuzz_fast_equals_reference(seed):
+    _fuzz(seed)
