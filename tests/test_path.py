@@ -130,3 +130,24 @@ def test_smoothing_against_the_quadtree_respects_clearance():
     assert np.allclose(g.centres(np.array(as_nodes)), sm)
     with pytest.raises(TypeError, match="grid="):
         smooth_path(q, p)
+
+
+def test_grid_line_of_sight_equals_dense_sampling():
+    rng = np.random.default_rng(4)
+    valid = rng.random((14, 17)) < 0.8
+    g = grid_from_mask(valid)
+    t = np.linspace(0, 1, 4001)
+    for _ in range(300):
+        a = tuple(int(v) for v in rng.integers(0, (14, 17)))
+        b = tuple(int(v) for v in rng.integers(0, (14, 17)))
+        # every boundary crossing too, so that exact corner passes are sampled
+        tt = np.concatenate([t] + [(np.arange(abs(d)) + 0.5) / abs(d) for d in (b[0] - a[0], b[1] - a[1]) if d])
+        cells = set()
+        for ez in (-1e-7, 1e-7):
+            for ex in (-1e-7, 1e-7):
+                zi = np.floor(a[0] + tt * (b[0] - a[0]) + ez + 0.5).astype(int)
+                xj = np.floor(a[1] + tt * (b[1] - a[1]) + ex + 0.5).astype(int)
+                inside = (zi >= 0) & (zi < 14) & (xj >= 0) & (xj < 17)
+                cells |= set(zip(zi[inside].tolist(), xj[inside].tolist()))
+        expect = all(valid[c] for c in cells)
+        assert grid_line_of_sight(g, a, b) == expect, (a, b)

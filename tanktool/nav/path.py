@@ -98,48 +98,46 @@ def path_length(grid: NavGrid, path: list[Node]) -> float:
 def grid_line_of_sight(grid: NavGrid, a: Node, b: Node, passable: np.ndarray | None = None) -> bool:
     """True when every cell the segment between the two node centres touches is passable.
 
-    Cells are found exactly from the segment's crossings of cell boundaries; passing
-    exactly through a cell corner also needs both cells beside the corner (no corner
-    cutting, as in :func:`astar`).
+    An integer walk over the cells (exact: no floating point); where the segment
+    passes exactly through a cell corner, both cells beside the corner must be
+    passable too (no corner cutting, as in :func:`astar`).
     """
     ok = grid.valid if passable is None else passable
-    (ai, aj), (bi, bj) = a, b
-    # in cell units with node centres at integer coordinates, cells span [k - .5, k + .5]
-    di, dj = bi - ai, bj - aj
-    ts = [0.0, 1.0]
-    for d, s in ((dj, aj), (di, ai)):
-        if d:
-            lo, hi = sorted((s, s + d))
-            k = np.arange(math.floor(lo - 0.5) + 1, math.ceil(hi + 0.5))  # boundaries k - .5
-            ts.extend(((k - 0.5 - s) / d).tolist())
-    t = np.unique(np.clip(ts, 0.0, 1.0))
-    mid = 0.5 * (t[1:] + t[:-1]) if len(t) > 1 else t
-    ci = np.floor(ai + mid * di + 0.5).astype(np.int64)
-    cj = np.floor(aj + mid * dj + 0.5).astype(np.int64)
-    # corners: a t where both an x and a z boundary are crossed at once
-    if di and dj:
-        tx = (np.arange(math.floor(min(aj, bj) - 0.5) + 1, math.ceil(max(aj, bj) + 0.5)) - 0.5 - aj) / dj
-        tz = (np.arange(math.floor(min(ai, bi) - 0.5) + 1, math.ceil(max(ai, bi) + 0.5)) - 0.5 - ai) / di
-        both = np.intersect1d(np.round(tx, 12), np.round(tz, 12))
-        both = both[(both > 0) & (both < 1)]
-        if len(both):
-            eps = 1e-9
-            for e1, e2 in ((eps, -eps), (-eps, eps)):
-                # just before in z and after in x, and the other way round
-                zi = np.floor(ai + (both + e1) * di + 0.5).astype(np.int64)
-                xj = np.floor(aj + (both + e2) * dj + 0.5).astype(np.int64)
-                ci = np.concatenate([ci, zi])
-                cj = np.concatenate([cj, xj])
     nz, nx = ok.shape
-    if (ci < 0).any() or (ci >= nz).any() or (cj < 0).any() or (cj >= nx).any():
+    (z, x), (bi, bj) = a, b
+    if not (0 <= z < nz and 0 <= x < nx and 0 <= bi < nz and 0 <= bj < nx):
         return False
-    return bool(ok[ci, cj].all())
+    dz, dx = bi - z, bj - x
+    sz, sx = (dz > 0) - (dz < 0), (dx > 0) - (dx < 0)
+    mz, mx = abs(dz), abs(dx)
+    if not ok[z, x]:
+        return False
+    iz = ix = 0
+    while ix < mx or iz < mz:
+        # the next boundary crossed: x's at t = (ix + 1/2) / mx, z's at (iz + 1/2) / mz
+        d = (1 + 2 * ix) * mz - (1 + 2 * iz) * mx
+        if d == 0:
+            if not (ok[z, x + sx] and ok[z + sz, x]):
+                return False
+            x += sx
+            z += sz
+            ix += 1
+            iz += 1
+        elif d < 0:
+            x += sx
+            ix += 1
+        else:
+            z += sz
+            iz += 1
+        if not ok[z, x]:
+            return False
+    return True
 
 
 def smooth_path(
     obstacles: NavGrid | WallQuadtree, path, *, grid: NavGrid | None = None, clearance: float = 0.0,
 ):
-    """Drop the waypoints a straight line can skip (greedy, farthest visible first).
+    """Drop the waypoints a straight line can skip (greedy string pulling).
 
     obstacles : a NavGrid (line of sight = every touched cell passable) or a
                 WallQuadtree (line of sight = no wall within ``clearance`` of the line).
@@ -155,15 +153,15 @@ def smooth_path(
         if not nodes_given:
             raise TypeError("smoothing against a NavGrid takes a list of nodes")
         nodes = [tuple(map(int, n)) for n in path]
+        ok = obstacles.valid
         keep = [0]
         while keep[-1] < len(nodes) - 1:
             a = keep[-1]
-            nxt = a + 1
-            for k in range(len(nodes) - 1, a + 1, -1):
-                if grid_line_of_sight(obstacles, nodes[a], nodes[k]):
-                    nxt = k
-                    break
-            keep.append(nxt)
+            # walk forward while the straight line still holds (string pulling)
+            k = a + 1
+            while k + 1 < len(nodes) and grid_line_of_sight(obstacles, nodes[a], nodes[k + 1], ok):
+                k += 1
+            keep.append(k)
         return [nodes[k] for k in keep]
     if nodes_given:
         if grid is None:
