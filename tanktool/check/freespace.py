@@ -1,0 +1,223 @@
+"""Free space of a wall list, built from the walls alone (shapely + numpy).
+
+The walls cut the plane into faces: :func:`analyse` nodes the wall segments (so a T
+junction splits the wall it touches) and polygonizes them.  Every bounded face is a
+polygon whose whole boundary is walls; everything outside all faces is the unbounded
+face, index ``-1``.  Each wall then looks at the faces on its two sides: a point a
+hair along its normal lies in its *front* face, a point a hair behind it in its
+*back* face.  A face is free space when the walls around it mostly (by length) turn
+their normals towards it; callers holding spawn points may overrule that vote.
+
+Nothing here relies on the normals being right, which is the point: the rules use
+these faces to find the walls whose normals are wrong.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import shapely
+from shapely import STRtree
+
+from ..formats.walls_txt import WallList
+
+UNBOUNDED = -1
+NO_FACE = -2  # the "face" of a zero-length wall, which has no sides
+
+
+@dataclass
+class FreeSpace:
+    """Faces of the wall arrangement and how each wall sits between them.
+
+    front, back : (n,) int, face index on the normal side / behind each wall
+                  (``UNBOUNDED`` outside every face, ``NO_FACE`` for zero-length walls)
+    free : (m,) bool per bounded face, by the normals' vote (callers may change it)
+    dangling : (k, 2) wall end points joined to no other wall; ``dangling_wall`` (k,)
+               the wall each belongs to
+    """
+
+    walls: WallList
+    faces: list                      # shapely Polygons, bounded faces
+    front: np.ndarray
+    back: np.ndarray
+    free: np.ndarray
+    dangling: np.ndarray
+    dangling_wall: np.ndarray
+    grid: float                      # snapping grid, metres
+    lines: object                    # (n,) shapely LineStrings of the walls (None for zero-length)
+    noded: object                    # the walls as one noded geometry
+    _face_tree: STRtree | None = field(default=None, repr=False)
+    _wall_tree: STRtree | None = field(default=None, repr=False)
+    _wall_ids: np.ndarray | None = field(default=None, repr=False)
+    _buffers: dict = field(default_factory=dict, repr=False)
+
+    # ------------------------------------------------------------------ lookups
+    def face_of(self, points: np.ndarray) -> np.ndarray:
+        """(n,) face index holding each (x, z) point; ``UNBOUNDED`` outside every face."""
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        out = np.full(len(pts), UNBOUNDED, dtype=np.int64)
+        if not self.faces or not len(pts):
+            return out
+        if self._face_tree is None:
+            self._face_tree = STRtree(self.faces)
+        pi, fi = self._face_tree.query(shapely.points(pts), predicate="within")
+        out[pi] = fi
+        return out
+
+    def nearest_wall(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Distance from each point to the nearest wall, and that wall's index."""
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+        dist = np.full(len(pts), np.inf)
+        idx = np.full(len(pts), -1, dtype=np.int64)
+        if self._wall_tree is None or not len(pts):
+            return dist, idx
+        (pi, ti), d = self._wall_tree.query_nearest(shapely.points(pts), return_distance=True, all_matches=False)
+        dist[pi] = d
+        idx[pi] = self._wall_ids[ti]
+        return dist, idx
+
+    def passage(self, point: np.ndarray, reach: float) -> tuple[float, np.ndarray]:
+        """Width and centre of the passage around ``point``: from the nearest wall to the
+        nearest wall on the opposite side (within ``reach``); twice the distance to the
+        nearest wall when no wall faces it."""
+        m = np.asarray(point, dtype=np.float64).reshape(2)
+        if self._wall_tree is None:
+            return math.inf, m
+        pt = shapely.points(m)
+        cand = self._wall_tree.query(pt, predicate="dwithin", distance=float(reach))
+        if not len(cand):
+            return math.inf, m
+        near = shapely.get_coordinates(shapely.shortest_line(pt, self._wall_tree.geometries[cand]))[1::2]
+        off = near - m
+        d = np.hypot(off[:, 0], off[:, 1])
+        k = int(np.argmin(d))
+        opposite = (off @ off[k]) < 0
+        if not opposite.any():
+            return 2.0 * float(d[k]), m
+        j = int(np.flatnonzero(opposite)[np.argmin(d[opposite])])
+        return float(np.hypot(*(near[j] - near[k]))), 0.5 * (near[j] + near[k])
+
+    def region(self, face_ids) -> object:
+        """The union of the given bounded faces (one shapely geometry)."""
+        faces = [self.faces[i] for i in sorted(set(int(f) for f in face_ids)) if i >= 0]
+        if not faces:
+            return shapely.Polygon()
+        return shapely.union_all(faces)
+
+    def clear_region(self, face_ids, radius: float) -> object:
+        """Where the centre of a disc of ``radius`` can stand in those faces without
+        touching any wall (walls inside a face, like a lone fence, count too)."""
+        region = self.region(face_ids)
+        if radius <= 0 or region.is_empty or self.noded is None:
+            return region
+        key = round(float(radius), 9)
+        if key not in self._buffers:
+            self._buffers[key] = shapely.buffer(self.noded, float(radius), quad_segs=8)
+        return shapely.difference(region, self._buffers[key])
+
+    def flipped(self) -> np.ndarray:
+        """(n,) bool: walls whose normal points into solid while their back faces free space."""
+        free = np.append(self.free, False)  # index -1 (unbounded) is never free
+        ok = self.front >= UNBOUNDED
+        f = np.where(ok, self.front, UNBOUNDED)
+        b = np.where(ok, self.back, UNBOUNDED)
+        return ok & (f != b) & ~free[f] & free[b]
+
+
+def snap_grid(segments: np.ndarray) -> float:
+    """A snapping grid far below any feature an arena has, and far above rounding noise."""
+    m = float(np.max(np.abs(segments))) if segments.size else 1.0
+    return 1e-7 * max(1.0, m)
+
+
+def analyse(walls: WallList) -> FreeSpace:
+    """Faces, wall sides, the normals' vote and the dangling wall ends of ``walls``."""
+    seg = np.asarray(walls.segments, dtype=np.float64).reshape(-1, 2, 2)
+    n = len(seg)
+    g = snap_grid(seg)
+    snapped = np.round(seg / g) * g
+    length = np.hypot(*(snapped[:, 1] - snapped[:, 0]).T)
+    live = np.flatnonzero(length > 0)
+    front = np.full(n, NO_FACE, dtype=np.int64)
+    back = np.full(n, NO_FACE, dtype=np.int64)
+    lines = np.full(n, None, dtype=object)
+    if len(live) == 0:
+        return FreeSpace(walls, [], front, back, np.zeros(0, bool), np.zeros((0, 2)), np.zeros(0, np.int64),
+                         g, lines, None)
+    lines[live] = shapely.linestrings(snapped[live])
+    # snap-rounding noder: robust against nearly collinear and nearly touching walls
+    noded = shapely.union_all(lines[live], grid_size=g)
+    parts = shapely.get_parts(noded)
+    faces = list(shapely.get_parts(shapely.polygonize(parts))) if len(parts) else []
+    faces = [f for f in faces if f.area > 0]
+
+    fs = FreeSpace(walls, faces, front, back, np.zeros(len(faces), bool), np.zeros((0, 2)),
+                   np.zeros(0, np.int64), g, lines, noded)
+    fs._wall_tree = STRtree(lines[live])
+    fs._wall_ids = live
+
+    # a point a hair in front of and behind each wall, a little off its middle so
+    # that it does not land on a T junction placed exactly at the middle
+    p, q = snapped[live, 0], snapped[live, 1]
+    d = q - p
+    L = length[live]
+    normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / L[:, None] * walls.direction[live, None]
+    eps = np.minimum(100.0 * g, 0.05 * L)
+    mid = p + (0.5 + 1.0 / 128.0) * d
+    sides = fs.face_of(np.concatenate([mid + eps[:, None] * normal, mid - eps[:, None] * normal]))
+    front[live] = sides[: len(live)]
+    back[live] = sides[len(live):]
+
+    vote = np.zeros(len(faces) + 1)
+    np.add.at(vote, front[live], L)   # index -1 lands in the extra last slot
+    np.add.at(vote, back[live], -L)
+    fs.free = vote[: len(faces)] > 0
+
+    fs.dangling, fs.dangling_wall = _dangling_ends(snapped, live, lines, g)
+    return fs
+
+
+def _dangling_ends(snapped: np.ndarray, live: np.ndarray, lines, g: float) -> tuple[np.ndarray, np.ndarray]:
+    """Wall ends touching no other wall (neither its ends nor its length)."""
+    ends = np.concatenate([snapped[live, 0], snapped[live, 1]])
+    owner = np.concatenate([live, live])
+    tree = STRtree(lines[live])
+    pi, ti = tree.query(shapely.points(ends), predicate="dwithin", distance=2.0 * g)
+    other = live[ti] != owner[pi]
+    joined = np.zeros(len(ends), dtype=bool)
+    joined[pi[other]] = True
+    return ends[~joined], owner[~joined]
+
+
+def gaps(fs: FreeSpace) -> list[tuple[int, int, np.ndarray, np.ndarray]]:
+    """Pairs of dangling wall ends that most likely belong together, closest first.
+
+    Returns ``(wall_a, wall_b, end_a, end_b)``; each end is used once and the two ends
+    of one wall are never paired (that would be the wall itself).
+    """
+    k = len(fs.dangling)
+    if k < 2:
+        return []
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(fs.dangling)
+    kk = min(k, 6)
+    dist, idx = tree.query(fs.dangling, k=kk)
+    cand = []
+    for i in range(k):
+        for d, j in zip(np.atleast_1d(dist[i])[1:], np.atleast_1d(idx[i])[1:]):
+            if j < k and i < j and fs.dangling_wall[i] != fs.dangling_wall[j]:
+                cand.append((float(d), i, int(j)))
+            elif j < k and j < i and fs.dangling_wall[i] != fs.dangling_wall[j]:
+                cand.append((float(d), int(j), i))
+    cand = sorted(set(cand))
+    used = np.zeros(k, dtype=bool)
+    out = []
+    for _, i, j in cand:
+        if used[i] or used[j]:
+            continue
+        used[i] = used[j] = True
+        out.append((int(fs.dangling_wall[i]), int(fs.dangling_wall[j]), fs.dangling[i], fs.dangling[j]))
+    return out

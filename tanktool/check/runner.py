@@ -1,0 +1,185 @@
+"""Find what to check under the given paths, run the rules, collect one report.
+
+A path may be an arena bundle, a vehicle bundle (the folder or its manifest), a bare
+walls file, or a folder holding any of them at any depth.  Rules that relate arenas
+and vehicles (clearance, passages, V401) see the bundles being checked plus the
+bundled ones beside them: for ``X/arenas/<name>`` the vehicles in ``X/vehicles/``,
+and the other way round.
+"""
+
+from __future__ import annotations
+
+import os
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .arena_rules import ArenaInfo, VehicleSize, check_arena, check_walls_file
+from .diagnostics import ERROR, WARNING, Diagnostic, diag
+from .vehicle_rules import check_vehicle, vehicle_fit
+
+ARENA_MANIFEST = "arena.toml"
+VEHICLE_MANIFEST = "vehicle.toml"
+
+
+@dataclass
+class Report:
+    files: list[str] = field(default_factory=list)
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    unreadable: list[str] = field(default_factory=list)   # one message per path that cannot be read
+
+    @property
+    def errors(self) -> int:
+        return sum(d.severity == ERROR for d in self.diagnostics)
+
+    @property
+    def warnings(self) -> int:
+        return sum(d.severity == WARNING for d in self.diagnostics)
+
+    def exit_code(self, strict: bool = False) -> int:
+        if self.unreadable:
+            return 2
+        if self.errors or (strict and self.warnings):
+            return 1
+        return 0
+
+    def summary(self) -> str:
+        def n(k: int, word: str) -> str:
+            return f"{k} {word}{'' if k == 1 else 's'}"
+        return f"{n(self.errors, 'error')}, {n(self.warnings, 'warning')} in {n(len(self.files), 'file')}"
+
+    def to_dict(self) -> dict:
+        return {"files": self.files,
+                "diagnostics": [d.to_dict() for d in self.diagnostics],
+                "summary": {"errors": self.errors, "warnings": self.warnings}}
+
+
+@dataclass
+class Targets:
+    arenas: list[Path] = field(default_factory=list)
+    vehicles: list[Path] = field(default_factory=list)
+    walls: list[Path] = field(default_factory=list)
+    unreadable: list[str] = field(default_factory=list)
+
+    def add(self, kind: str, p: Path) -> None:
+        lst = getattr(self, kind)
+        if p not in lst:
+            lst.append(p)
+
+
+def _is_walls_file(p: Path) -> bool:
+    return p.name == "walls.txt" or p.name.endswith(".walls.txt") or p.name.endswith("_walls.txt")
+
+
+def discover(paths: list[Path]) -> Targets:
+    t = Targets()
+    for p in paths:
+        if not p.exists():
+            t.unreadable.append(f"{p}: no such file or folder")
+        elif p.is_file():
+            if not os.access(p, os.R_OK):
+                t.unreadable.append(f"{p}: cannot be read (permission denied)")
+            elif p.name == ARENA_MANIFEST:
+                t.add("arenas", p.parent)
+            elif p.name == VEHICLE_MANIFEST:
+                t.add("vehicles", p.parent)
+            else:
+                t.add("walls", p)  # any other file is taken as a wall list
+        elif not os.access(p, os.R_OK | os.X_OK):
+            t.unreadable.append(f"{p}: folder cannot be read (permission denied)")
+        else:
+            _walk(p, t)
+    return t
+
+
+def _walk(root: Path, t: Targets) -> None:
+    """Bundles and walls files under ``root``; a bundle's own folder is not searched further."""
+    def onerror(e: OSError) -> None:
+        t.unreadable.append(f"{e.filename}: folder cannot be read ({e.strerror})")
+
+    for here, dirs, files in os.walk(root, onerror=onerror):
+        dirs[:] = sorted(d for d in dirs if not d.startswith("."))  # staged or hidden bundles
+        d = Path(here)
+        if ARENA_MANIFEST in files:
+            t.add("arenas", d)
+            dirs[:] = []
+        elif VEHICLE_MANIFEST in files:
+            t.add("vehicles", d)
+            dirs[:] = []
+        else:
+            for f in sorted(files):
+                if _is_walls_file(d / f):
+                    t.add("walls", d / f)
+
+
+def _siblings(bundle: Path, kind: str, manifest: str) -> list[Path]:
+    """Bundled ``kind`` ('arenas'/'vehicles') next to the collection holding ``bundle``."""
+    folder = bundle.resolve().parent.parent / kind
+    if not folder.is_dir():
+        return []
+    try:
+        return sorted(p.parent for p in folder.glob(f"*/{manifest}"))
+    except OSError:
+        return []
+
+
+def _guard(report: Report, path: Path, fn, *args):
+    """Run one bundle's rules; a crash becomes X001 (so check itself never crashes)."""
+    try:
+        return fn(*args)
+    except OSError as e:
+        report.unreadable.append(f"{e.filename or path}: cannot be read ({e.strerror or e})")
+    except Exception as e:  # a bug in a rule: report it and go on with the other files
+        where = traceback.extract_tb(e.__traceback__)[-1]
+        report.diagnostics.append(diag("X001", str(path), 0,
+                                       f"{type(e).__name__}: {e} (in {Path(where.filename).name}:{where.lineno})"))
+    return None
+
+
+def run_check(paths: list[str | os.PathLike]) -> Report:
+    targets = discover([Path(p) for p in paths])
+    report = Report(unreadable=list(targets.unreadable))
+
+    # vehicles first: their sizes feed the arena rules
+    sizes: dict[Path, VehicleSize] = {}
+    for v in targets.vehicles:
+        report.files.append(str(v))
+        res = _guard(report, v, check_vehicle, v)
+        if res:
+            report.diagnostics += res[0]
+            if res[1]:
+                sizes[v.resolve()] = res[1]
+    extra_vehicles = {s.resolve() for a in targets.arenas for s in _siblings(a, "vehicles", VEHICLE_MANIFEST)}
+    for v in sorted(extra_vehicles - set(sizes)):
+        res = _guard(Report(), v, check_vehicle, v, False)  # beside the arena, not being checked: only its size
+        if res and res[1]:
+            sizes[v] = res[1]
+
+    infos: dict[Path, ArenaInfo] = {}
+    for a in targets.arenas:
+        report.files.append(str(a))
+        res = _guard(report, a, check_arena, a, list(sizes.values()))
+        if res:
+            report.diagnostics += res[0]
+            infos[a.resolve()] = res[1]
+    for w in targets.walls:
+        report.files.append(str(w))
+        res = _guard(report, w, check_walls_file, w)
+        if res:
+            report.diagnostics += res
+
+    if targets.vehicles:
+        extra_arenas = {s.resolve() for v in targets.vehicles for s in _siblings(v, "arenas", ARENA_MANIFEST)}
+        for a in sorted(extra_arenas - set(infos)):
+            res = _guard(Report(), a, check_arena, a, [], False)
+            if res:
+                infos[a] = res[1]
+        for v in targets.vehicles:
+            size = sizes.get(v.resolve())
+            if size is None:
+                continue
+            for info in infos.values():
+                res = _guard(report, v, vehicle_fit, size, info)
+                if res:
+                    report.diagnostics += res
+    return report

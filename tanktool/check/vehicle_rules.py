@@ -1,0 +1,294 @@
+"""Rules on vehicle bundles: hull points, sphere tree, mass and drive figures, and
+whether the vehicle fits the bundled arenas.
+
+hull.txt and spheres.txt are scanned line by line with the same field rules as
+:mod:`tanktool.formats.vehicle_bundle` and :mod:`tanktool.geometry.spheres`, so every
+bad line is reported, not only the first.  The geometric rules use the vertices of
+the bundle's model (``model.glb``, already in the vehicle frame).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..formats.vehicle_bundle import DRIVE_KEYS, HULL_MAX, HULL_MIN
+from ..geometry.hull import points_in_prism
+from ..geometry.spheres import SphereTree
+from .arena_rules import ArenaInfo, VehicleSize, components, narrow_passages
+from .diagnostics import Diagnostic, diag, fmt_xz
+from .manifest import Manifest, file_rules, safe_file
+
+#: hull.txt and spheres.txt hold 4 decimals; the tools round so the written shapes still
+#: enclose, float32 storage in model.glb adds ~1e-7 relative: 0.2 mm covers both
+GEOM_TOL = 2e-4
+
+
+def scan_hull(path: Path) -> tuple[np.ndarray, list[Diagnostic]]:
+    out: list[Diagnostic] = []
+    rows: list[list[float]] = []
+    text = path.read_bytes().decode("utf-8", errors="replace")
+    for no, raw in enumerate(text.splitlines(), 1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        parts = line.split()
+        try:
+            xyz = [float(p) for p in parts]
+        except ValueError:
+            xyz = []
+        if len(parts) != 3 or len(xyz) != 3:
+            out.append(diag("V101", str(path), no, f"expected 3 numbers 'x y z', got {line!r}"))
+            continue
+        if not all(math.isfinite(c) for c in xyz):
+            out.append(diag("V101", str(path), no, f"coordinates must be finite numbers, got {line!r}"))
+            continue
+        rows.append(xyz)
+    if not HULL_MIN <= len(rows) <= HULL_MAX and not out:
+        out.append(diag("V102", str(path), 0, f"{len(rows)} hull points; expected {HULL_MIN} to {HULL_MAX}"))
+    return np.array(rows, dtype=np.float64).reshape(-1, 3), out
+
+
+def scan_spheres(path: Path) -> tuple[SphereTree | None, np.ndarray, list[Diagnostic]]:
+    """The sphere tree (None when any line is bad), each sphere's line, diagnostics."""
+    out: list[Diagnostic] = []
+    rows: list[tuple[int, int, int, float, float, float, float]] = []
+    lines: list[int] = []
+    text = path.read_bytes().decode("utf-8", errors="replace")
+    for no, raw in enumerate(text.splitlines(), 1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        parts = line.split()
+        where = (str(path), no)
+        n = len(rows)
+        try:
+            if len(parts) != 7:
+                raise ValueError(f"expected 7 fields 'id parent level cx cy cz r', got {len(parts)}")
+            sid, par, lev = int(parts[0]), int(parts[1]), int(parts[2])
+            cx, cy, cz, r = (float(v) for v in parts[3:])
+        except ValueError as e:
+            msg = str(e) if str(e).startswith("expected 7") else \
+                f"expected integers id parent level then 4 numbers, got {line!r}"
+            out.append(diag("V201", *where, msg))
+            # the line was meant to be sphere n: keep its place so later ids still line up
+            rows.append((n, -2, -1, math.nan, math.nan, math.nan, math.nan))
+            lines.append(no)
+            continue
+        problem = None
+        if not all(math.isfinite(v) for v in (cx, cy, cz, r)):
+            problem = "centre and radius must be finite numbers"
+        elif r < 0:
+            problem = f"radius must not be negative, got {r:g}"
+        elif sid != n:
+            problem = f"expected sphere id {n} (ids count up from 0), got {sid}"
+        elif n == 0 and (par != -1 or lev != 1):
+            problem = "the first sphere must be the root (parent -1, level 1)"
+        elif n > 0 and not 0 <= par < n:
+            problem = f"parent {par} must be an earlier sphere id (0..{n - 1})"
+        elif n > 0 and rows[par][2] >= 1 and lev != rows[par][2] + 1:
+            problem = f"level {lev} must be one more than its parent's ({rows[par][2]})"
+        if problem:
+            out.append(diag("V201", *where, problem))
+        rows.append((n, par, lev, cx, cy, cz, r))
+        lines.append(no)
+    if not rows and not out:
+        out.append(diag("V201", str(path), 0, "no spheres (expected at least the root line)"))
+    if out or not rows:
+        return None, np.array(lines), out
+    arr = np.array(rows, dtype=np.float64)
+    tree = SphereTree(arr[:, 3:6], arr[:, 6], arr[:, 1].astype(np.int64), arr[:, 2].astype(np.int64))
+    return tree, np.array(lines), out
+
+
+def sphere_rules(tree: SphereTree, lines: np.ndarray, vertices: np.ndarray, path: str) -> list[Diagnostic]:
+    """V202: every vertex in some leaf; V203: in every ancestor of a leaf holding it."""
+    v = vertices
+    inside = np.zeros((len(v), len(tree)), dtype=bool)
+    for s in range(len(tree)):  # one sphere at a time keeps memory at (n,) per step
+        inside[:, s] = np.sum((v - tree.centers[s]) ** 2, axis=1) <= (tree.radii[s] + GEOM_TOL) ** 2
+    leaves = tree.leaves()
+    chains = [tree.ancestors(int(leaf)) for leaf in leaves]
+    in_chain = np.zeros(len(v), dtype=bool)
+    for chain in chains:
+        in_chain |= inside[:, chain].all(axis=1)
+    in_leaf = inside[:, leaves].any(axis=1)
+    out = []
+    lost = np.flatnonzero(~in_leaf)
+    if len(lost):
+        p = v[lost[0]]
+        # name the leaf whose centre is nearest: the one that most likely should hold it
+        dc = np.sqrt(np.sum((tree.centers[leaves] - p) ** 2, axis=1))
+        k = int(np.argmin(dc))
+        near = int(leaves[k])
+        out.append(diag("V202", path, int(lines[near]),
+                        f"{len(lost)} of {len(v)} model vertices are in no leaf sphere, e.g. "
+                        f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}), {dc[k] - tree.radii[near]:.3f} m outside leaf {near}"))
+    # vertices some leaf holds but whose every chain breaks: name the parent that lets go
+    broken = np.flatnonzero(in_leaf & ~in_chain)
+    culprits: dict[int, list[int]] = {}
+    for i in broken:
+        for leaf, chain in zip(leaves, chains):
+            if inside[i, leaf]:
+                miss = [a for a in chain if not inside[i, a]]
+                culprits.setdefault(int(miss[0]), []).append(int(leaf))
+                break
+    for parent, kids in sorted(culprits.items()):
+        out.append(diag("V203", path, int(lines[parent]),
+                        f"sphere {parent} does not enclose the part of the model in its descendant leaf "
+                        f"{kids[0]} ({len(kids)} vertices outside it)"))
+    return out
+
+
+def _why_drive(key: str, v: float, mass: float | None) -> tuple[str, str] | None:
+    """(code, why) when a [drive] value is impossible (V302) or implausible (V303)."""
+    if key in ("engine_force", "turn_torque", "strafe_force") and v < 0:
+        return "V302", "a negative force or torque drives the tank backwards from the controls"
+    if key == "friction" and v < 0:
+        return "V302", "negative drag would speed the tank up by itself"
+    if key == "restitution" and not 0 <= v <= 1:
+        return "V302", "restitution must be in [0, 1]: above 1 a collision creates energy, below 0 is meaningless"
+    if key == "top_speed" and v <= 0:
+        return "V302", "the tank could not move"
+    if key == "top_speed" and v > 50:
+        return "V303", "over 50 m/s (180 km/h) is unrealistic: real tanks top out near 20 m/s"
+    if key == "fire_interval" and v <= 0:
+        return "V302", "the interval between shots must be positive"
+    if key == "fire_interval" and v < 0.1:
+        return "V303", "more than 10 shots a second: no tank gun reloads that fast"
+    if key == "shell_speed" and v <= 0:
+        return "V302", "shells must leave the barrel"
+    if key == "shell_speed" and v > 2000:
+        return "V303", "faster than any tank gun (about 1,800 m/s)"
+    if key == "hit_points" and v < 1:
+        return "V302", "a vehicle with no hit points is destroyed before it is hit"
+    if key == "engine_force" and mass and v / mass > 20:
+        return "V303", f"{v / mass:.0f} m/s^2 of acceleration is over 2 g"
+    return None
+
+
+def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnostic], VehicleSize | None]:
+    """Every vehicle rule on ``bundle`` and the vehicle's size; ``model_rules=False``
+    skips loading the model (for vehicles consulted only for their size)."""
+    man = Manifest(bundle / "vehicle.toml")
+    out = list(man.diagnostics)
+    if man.doc is None:
+        return out, None
+    mpath = str(man.path)
+    name = man.get("", "name")
+    name = name if isinstance(name, str) and name else bundle.name
+    out += file_rules(man, bundle, ("hull.txt", "spheres.txt"))
+
+    mass = man.number("mass", "mass", out)
+    inertia = man.number("mass", "inertia", out)
+    for key, val in (("mass", mass), ("inertia", inertia)):
+        if val is not None and val <= 0:
+            out.append(diag("V301", mpath, man.lines.key("mass", key),
+                            f"[mass] {key} = {val:g} must be positive"))
+    if mass is not None and mass > 0 and not 1.0 <= mass <= 1e6:
+        out.append(diag("V303", mpath, man.lines.key("mass", "mass"),
+                        f"[mass] mass = {mass:g} kg: outside 1 kg .. 1,000 t, check the unit"))
+    com = man.get("mass", "centre_of_mass")
+    if not (isinstance(com, list) and len(com) == 3
+            and all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in com)):
+        out.append(man.missing("mass", "centre_of_mass", f"must be 3 finite numbers [x, y, z], got {com!r}"))
+        com = None
+    if man.table("drive") is None:
+        out.append(diag("B102", mpath, 0, "table [drive] is missing"))
+    else:
+        for key in DRIVE_KEYS:
+            val = man.number("drive", key, out)
+            if val is None:
+                continue
+            why = _why_drive(key, val, mass if mass and mass > 0 else None)
+            if why:
+                out.append(diag(why[0], mpath, man.lines.key("drive", key), f"[drive] {key} = {val:g}: {why[1]}"))
+        top, shell = man.get("drive", "top_speed"), man.get("drive", "shell_speed")
+        if (isinstance(top, (int, float)) and isinstance(shell, (int, float)) and 0 < shell <= top):
+            out.append(diag("V303", mpath, man.lines.key("drive", "shell_speed"),
+                            f"[drive] shell_speed = {shell:g} m/s is not faster than top_speed = {top:g} m/s: "
+                            "the tank would drive into its own shells"))
+
+    hull = None
+    hfile = man.string("hull", "file", out, default="hull.txt")
+    hpath = safe_file(bundle, hfile) if hfile else None
+    if hpath is not None and hpath.is_file():
+        pts, hd = scan_hull(hpath)
+        out += hd
+        if not hd:
+            hull = pts
+    tree = None
+    sfile = man.string("spheres", "file", out, default="spheres.txt")
+    spath = safe_file(bundle, sfile) if sfile else None
+    if spath is not None and spath.is_file():
+        tree, slines, sd = scan_spheres(spath)
+        out += sd
+
+    if hull is not None and com is not None and inertia is not None and mass is not None and mass > 0 and inertia > 0:
+        if not points_in_prism(hull, np.array([com], dtype=np.float64), tol=GEOM_TOL)[0]:
+            out.append(diag("V104", mpath, man.lines.key("mass", "centre_of_mass"),
+                            f"centre of mass ({com[0]:g}, {com[1]:g}, {com[2]:g}) is outside the hull"))
+        else:
+            # no body has more inertia than with all its mass on the hull's farthest rim
+            r2 = float(np.max((hull[:, 0] - com[0]) ** 2 + (hull[:, 2] - com[2]) ** 2))
+            if inertia > mass * r2 * (1 + 1e-6):
+                out.append(diag("V302", mpath, man.lines.key("mass", "inertia"),
+                                f"[mass] inertia = {inertia:g} kg m^2 is more than the {mass * r2:.4g} kg m^2 "
+                                "of all the mass on the hull's rim: impossible"))
+
+    model = man.get("model", "file")
+    mfile = safe_file(bundle, model) if isinstance(model, str) and model else None
+    if model_rules and mfile is not None and mfile.is_file() and (hull is not None or tree is not None):
+        from ..errors import FormatError
+        from ..formats.models import load_model
+
+        try:
+            mesh = load_model(mfile, up="y", scale=1.0)
+        except FormatError as e:
+            out.append(diag("B201", mpath, man.lines.key("model", "file"), f"model file cannot be read: {e}"))
+        else:
+            v = np.unique(np.asarray(mesh.vertices, dtype=np.float64), axis=0)
+            if hull is not None:
+                outside = np.flatnonzero(~points_in_prism(hull, v, tol=GEOM_TOL))
+                if len(outside):
+                    p = v[outside[0]]
+                    out.append(diag("V103", str(hpath), 0,
+                                    f"{len(outside)} of {len(v)} model vertices are outside the hull, e.g. "
+                                    f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f})"))
+            if tree is not None:
+                out += sphere_rules(tree, slines, v, str(spath))
+
+    size = None
+    if hull is not None:
+        size = VehicleSize(name, float(np.max(np.hypot(hull[:, 0], hull[:, 2]))), mpath,
+                           man.lines.key("", "footprint_radius") or man.lines.key("hull", "file"))
+    else:
+        r = man.get("", "footprint_radius")
+        if isinstance(r, (int, float)) and not isinstance(r, bool) and math.isfinite(r) and r > 0:
+            size = VehicleSize(name, float(r), mpath, man.lines.key("", "footprint_radius"))
+    return out, size
+
+
+def vehicle_fit(size: VehicleSize, arena: ArenaInfo) -> list[Diagnostic]:
+    """V401: the vehicle cannot get between the spawn points of ``arena``."""
+    fs = arena.fs
+    if fs is None or not arena.good.any():
+        return []
+    xz = arena.spawns[:, :2]
+    idx = np.flatnonzero(arena.good)
+    dist, _ = fs.nearest_wall(xz[idx])
+    where = f"arena {arena.name!r}"
+    out = []
+    tight = idx[dist < size.radius]
+    if len(tight):
+        i = int(tight[0])
+        out.append(diag("V401", size.path, size.line,
+                        f"vehicle {size.name!r} ({2 * size.radius:.2f} m across) does not fit at spawn {i} "
+                        f"{fmt_xz(xz[i])} of {where}"))
+    faces = np.unique(arena.faces[idx])
+    passages = narrow_passages(fs, faces, size, str(arena.path), code="V401", where=size.path)
+    for d in passages:
+        d.message = d.message.replace(f" in arena {arena.path}", f" of {where}")
+    return out + passages

@@ -1,0 +1,180 @@
+"""tanktool check: the broken corpus (one case per rule), clean content, output and exit codes."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from tanktool.check import RULES, run_check
+from tanktool.check.diagnostics import ERROR, WARNING
+from tanktool.check.freespace import UNBOUNDED, analyse
+from tanktool.check.walls_scan import scan_walls_text
+from tanktool.cli.main import cli
+from tanktool.formats.walls_txt import WallList, aux_rectangle
+
+DATA = Path(__file__).resolve().parent / "data"
+BROKEN = DATA / "broken"
+CLEAN = DATA / "check_clean"
+CASES = sorted(p.name for p in BROKEN.iterdir() if (p / "expect.json").is_file())
+
+
+def _rel(path: str, base: Path) -> str:
+    return Path(path).resolve().relative_to(base.resolve()).as_posix()
+
+
+def test_every_rule_has_a_case():
+    covered = {c.split("_", 1)[0] for c in CASES}
+    # X001 is the checker's own safety net, not a content rule
+    assert covered == set(RULES) - {"X001"}
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_broken_case_reports_its_rule_at_its_place(case):
+    base = BROKEN / case
+    exp = json.loads((base / "expect.json").read_text())
+    report = run_check([base / exp["target"]])
+    codes = {d.code for d in report.diagnostics}
+    assert codes == {exp["code"]}, [d.format() for d in report.diagnostics]
+    places = {(_rel(d.path, base), d.line) for d in report.diagnostics}
+    assert any((exp["path"], line) in places for line in exp["lines"]), (places, exp)
+    assert not report.unreadable
+    want = 1 if RULES[exp["code"]].severity == ERROR else 0
+    assert report.exit_code() == want
+    assert report.exit_code(strict=True) == 1
+
+
+def test_clean_content_passes_strict():
+    report = run_check([CLEAN])
+    assert report.diagnostics == []
+    assert len(report.files) == 2
+    assert report.exit_code(strict=True) == 0
+
+
+def test_bundled_content_passes_strict(root_dir):
+    paths = [root_dir / "arenas", root_dir / "vehicles"]
+    paths = [p for p in paths if p.is_dir()]
+    report = run_check(paths)
+    assert [d.format() for d in report.diagnostics] == []
+    assert report.exit_code(strict=True) == 0
+
+
+# ------------------------------------------------------------------ the CLI
+def test_cli_text_output_and_summary():
+    case = BROKEN / "A205_flipped_normal"
+    res = CliRunner().invoke(cli, ["check", str(case / "walls.txt")])
+    assert res.exit_code == 1
+    lines = res.output.strip().splitlines()
+    assert lines[0].startswith(f"{case / 'walls.txt'}:4: A205 error: ")
+    assert lines[0].endswith("(flip the wall's Direction (1 <-> -1))")
+    assert lines[-1] == "1 error, 0 warnings in 1 file"
+
+
+def test_cli_json_document():
+    case = BROKEN / "A305_few_spawns"
+    res = CliRunner().invoke(cli, ["check", "--json", str(case)])
+    assert res.exit_code == 0  # a warning only
+    doc = json.loads(res.output)
+    assert doc["summary"] == {"errors": 0, "warnings": 1}
+    assert doc["files"] == [str(case / "arenas" / "few_spawns")]
+    (d,) = doc["diagnostics"]
+    assert set(d) == {"path", "line", "code", "severity", "message", "hint"}
+    assert d["code"] == "A305" and d["severity"] == WARNING and d["line"] > 0
+
+
+def test_cli_strict_turns_warnings_into_failure():
+    case = BROKEN / "A305_few_spawns"
+    assert CliRunner().invoke(cli, ["check", str(case)]).exit_code == 0
+    assert CliRunner().invoke(cli, ["check", "--strict", str(case)]).exit_code == 1
+
+
+def test_cli_unreadable_path_exits_2(tmp_path):
+    res = CliRunner().invoke(cli, ["check", str(tmp_path / "nope"), str(CLEAN)])
+    assert res.exit_code == 2
+    assert "no such file or folder" in res.output
+    assert "in 2 files" in res.output  # the readable paths are still checked
+
+
+def test_cli_needs_a_path_and_lists_rules():
+    assert CliRunner().invoke(cli, ["check"]).exit_code == 2
+    res = CliRunner().invoke(cli, ["check", "--rules"])
+    assert res.exit_code == 0
+    assert all(code in res.output for code in RULES)
+
+
+@pytest.mark.skipif(os.name != "posix" or os.geteuid() == 0, reason="root reads everything")
+def test_unreadable_file_exits_2(tmp_path):
+    w = tmp_path / "walls.txt"
+    w.write_text("0 0 1 0 1\n")
+    w.chmod(0)
+    try:
+        assert run_check([w]).exit_code() == 2
+    finally:
+        w.chmod(0o644)
+
+
+def test_folder_walk_finds_every_case_once():
+    report = run_check([BROKEN])
+    assert not report.unreadable
+    assert len(report.files) == len(set(report.files))
+    assert len(report.files) >= len(CASES)
+    assert {d.code for d in report.diagnostics} >= set(RULES) - {"X001"}
+
+
+# ------------------------------------------------------------------ rule details
+def test_scanner_reports_every_bad_line_not_only_the_first():
+    text = "0 0 10 0 1\nfoo\n0 0 0 nan 1\n10 0 10 10 3\n1 2 3\n"
+    walls, diags = scan_walls_text(text, "w.txt")
+    got = [(d.line, d.code) for d in diags if d.code != "A104"]
+    assert got == [(2, "A101"), (3, "A102"), (4, "A103"), (5, "A101")]
+    assert len(walls) == 1 and walls.lines.tolist() == [1]
+
+
+def test_touching_solids_share_a_wall_without_complaint():
+    from tanktool.check.walls_rules import check_walls
+
+    def block(x0, x1):  # a solid square, normals outwards (clockwise with Direction +1)
+        p = np.array([[x0, 3], [x0, 6], [x1, 6], [x1, 3]], float)
+        return np.stack([p, np.roll(p, -1, axis=0)], axis=1)
+
+    a, b = block(2, 5), block(5, 8)  # share the edge x = 5 with opposite normals
+    walls = _room(np.concatenate([a, b]), [1] * 8)
+    fs = analyse(walls)
+    assert check_walls(walls, fs, "w.txt") == []
+
+
+def _room(extra_segs=(), extra_dirs=()):
+    pts = np.array([[0, 0], [10, 0], [10, 10], [0, 10]], float)
+    seg = np.stack([pts, np.roll(pts, -1, axis=0)], axis=1)
+    segs = np.concatenate([seg, np.array(extra_segs, float).reshape(-1, 2, 2)])
+    dirs = np.concatenate([np.ones(4, np.int8), np.array(extra_dirs, np.int8)])
+    return WallList(segs, dirs, aux_rectangle(-1, -1, 11, 11), np.arange(1, len(segs) + 1))
+
+
+def test_free_space_faces_and_sides():
+    fs = analyse(_room())
+    assert len(fs.faces) == 1 and fs.free.tolist() == [True]
+    assert (fs.front == 0).all() and (fs.back == UNBOUNDED).all()
+    assert fs.face_of(np.array([[5, 5], [20, 5]])).tolist() == [0, UNBOUNDED]
+    assert len(fs.dangling) == 0
+
+
+def test_t_junction_is_not_a_crossing_but_an_x_is():
+    from tanktool.check.walls_rules import pair_rules
+    t = _room([[[5, 0], [5, 4]]], [1])       # ends on the bottom wall: a T
+    x = _room([[[5, -1], [5, 4]]], [1])      # passes through it: an X
+    assert [d.code for d in pair_rules(t, 1e-7)] == []
+    assert [d.code for d in pair_rules(x, 1e-7)] == ["A204"]
+
+
+def test_passage_width_is_measured_wall_to_wall():
+    # a 3 m door between a partition's end (7, 5) and the right wall x = 10
+    fs = analyse(_room([[[0, 5], [7, 5]]], [1]))
+    width, centre = fs.passage(np.array([8.0, 5.2]), 5.0)
+    assert width == pytest.approx(3.0, abs=0.01)
+    assert centre == pytest.approx([8.5, 5.1], abs=0.01)

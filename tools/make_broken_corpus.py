@@ -1,0 +1,396 @@
+"""Write tests/data/broken/: for every `tanktool check` rule, one small case that
+breaks that rule and nothing else, plus tests/data/check_clean/ (a clean arena and
+vehicle every case is made from).
+
+    python tools/make_broken_corpus.py
+
+Each case is a folder ``tests/data/broken/<CODE>_<what>/`` holding a bare walls.txt or
+``arenas/<name>/`` and/or ``vehicles/<name>/`` bundles, and ``expect.json``:
+``{"code", "target" (what to check, relative to the case), "path" (the file the
+diagnostic names, relative to the case), "lines" (acceptable line numbers)}``.
+Manifests record the sha256 of the files as broken, so a case breaks only its rule
+(except the stale-file case, B203, whose point is the mismatch).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from tanktool.formats.bundle import dumps_toml, sha256_file  # noqa: E402
+from tanktool.formats.vehicle_bundle import format_hull  # noqa: E402
+from tanktool.formats.walls_txt import WallList, aux_rectangle, format_walls  # noqa: E402
+from tanktool.geometry.mass import drive_defaults  # noqa: E402
+from tanktool.geometry.spheres import build_points, build_sphere_tree, format_spheres  # noqa: E402
+
+BROKEN = ROOT / "tests" / "data" / "broken"
+CLEAN = ROOT / "tests" / "data" / "check_clean"
+
+# -------------------------------------------------------------------- the clean arena
+ROOM = 40.0
+BLOCK = (15.0, 15.0, 25.0, 25.0)  # a solid obstacle in the middle
+SPAWNS = [[5, 5, 0], [35, 5, 1.5708], [5, 35, -1.5708], [20, 5, 0], [20, 35, 3.1416],
+          [5, 20, 0], [35, 20, 3.1416], [10, 10, 0.7854]]
+
+
+def loop(pts: list[tuple[float, float]], free_inside: bool) -> tuple[list, list]:
+    """Walls of a closed polygon, normals into free space (see nav/synthetic.py)."""
+    p = np.asarray(pts, dtype=np.float64)
+    seg = np.stack([p, np.roll(p, -1, axis=0)], axis=1)
+    area2 = float(np.sum(p[:, 0] * np.roll(p[:, 1], -1) - np.roll(p[:, 0], -1) * p[:, 1]))
+    d = 1 if (area2 > 0) == free_inside else -1
+    return seg.tolist(), [d] * len(seg)
+
+
+def rect(x0, z0, x1, z1):
+    return [(x0, z0), (x1, z0), (x1, z1), (x0, z1)]
+
+
+def base_walls() -> tuple[list, list]:
+    s1, d1 = loop(rect(0, 0, ROOM, ROOM), True)
+    s2, d2 = loop(rect(*BLOCK), False)
+    return s1 + s2, d1 + d2
+
+
+def walls_text(segs, dirs, aux=(-1.0, -1.0, ROOM + 1, ROOM + 1)) -> str:
+    wl = WallList(np.array(segs, dtype=np.float64), np.array(dirs), aux_rectangle(*aux))
+    return format_walls(wl, header="check corpus")
+
+
+def arena_mesh(segs, bump: bool = False):
+    """Floor quad at y = 0 plus a 3 m high vertical quad per wall (plus a 0.3 m bump)."""
+    import trimesh
+
+    verts = [[-1, 0, -1], [ROOM + 1, 0, -1], [ROOM + 1, 0, ROOM + 1], [-1, 0, ROOM + 1]]
+    faces = [[0, 2, 1], [0, 3, 2]]  # counter-clockwise seen from +y: normal up
+    for (x1, z1), (x2, z2) in segs:
+        b = len(verts)
+        verts += [[x1, 0, z1], [x2, 0, z2], [x2, 3, z2], [x1, 3, z1]]
+        faces += [[b, b + 1, b + 2], [b, b + 2, b + 3]]
+    mesh = trimesh.Trimesh(np.array(verts, float), np.array(faces), process=False)
+    if bump:
+        box = trimesh.creation.box(extents=[2, 0.3, 2])
+        box.apply_translation([8, 0.15, 30])
+        mesh = trimesh.util.concatenate([mesh, box])
+    return mesh
+
+
+def write_arena(out: Path, segs=None, dirs=None, spawns=None, toml_edit=None, bump=False,
+                walls_txt: str | None = None, aux=(-1.0, -1.0, ROOM + 1, ROOM + 1)) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if segs is None:
+        segs, dirs = base_walls()
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "walls.txt").write_text(walls_txt if walls_txt is not None else walls_text(segs, dirs, aux))
+    mesh = arena_mesh(segs, bump)
+    (out / "arena.obj").write_text(mesh.export(file_type="obj"))
+    (out / "model.glb").write_bytes(mesh.export(file_type="glb"))
+    plt.imsave(out / "preview.png", np.zeros((2, 2)))
+    doc = {
+        "name": out.name, "tool_version": "corpus",
+        "bounds": [[aux[0], aux[1]], [aux[2], aux[3]]], "floor_y": 0.0,
+        "spawns": spawns if spawns is not None else SPAWNS,
+        "source": {"file": "arena.obj", "sha256": sha256_file(out / "arena.obj"), "up": "y", "scale": 1.0},
+        "model": {"file": "model.glb"},
+        "walls": {"file": "walls.txt", "height": 1.0, "tolerance": 0.01, "count": len(segs)},
+        "navgrid": {"cell": 1.0, "clearance": 2.5, "quadtree_depth": 5},
+        "derived": {f: sha256_file(out / f) for f in ("model.glb", "walls.txt", "preview.png")},
+    }
+    if toml_edit:
+        toml_edit(doc)
+    (out / "arena.toml").write_text(dumps_toml(doc))
+
+
+# ------------------------------------------------------------------- the clean vehicle
+SIZE = (4.0, 2.0, 2.4)  # length (x), height (y), width (z): footprint radius 2.33 m
+
+
+def write_vehicle(out: Path, hull_edit=None, spheres_edit=None, toml_edit=None) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import trimesh
+
+    out.mkdir(parents=True, exist_ok=True)
+    lx, ly, lz = SIZE
+    mesh = trimesh.creation.box(extents=SIZE)
+    mesh.apply_translation([0, ly / 2, 0])
+    (out / "tank.obj").write_text(mesh.export(file_type="obj"))
+    (out / "model.glb").write_bytes(mesh.export(file_type="glb"))
+    plt.imsave(out / "preview.png", np.zeros((2, 2)))
+    corners = np.array([[lx / 2, lz / 2], [-lx / 2, lz / 2], [-lx / 2, -lz / 2], [lx / 2, -lz / 2]])[::-1]
+    hull = np.vstack([np.column_stack([corners[:, 0], np.full(4, y), corners[:, 1]]) for y in (0.0, ly)])
+    hull_text = format_hull(hull, "check corpus")
+    tree = build_sphere_tree(build_points(np.asarray(mesh.vertices), np.asarray(mesh.faces), 400), 2, 4)
+    spheres_text = format_spheres(tree, "check corpus")
+    (out / "hull.txt").write_text(hull_edit(hull_text) if hull_edit else hull_text)
+    (out / "spheres.txt").write_text(spheres_edit(spheres_text) if spheres_edit else spheres_text)
+    mass = 2000.0 * lx * ly * lz
+    inertia = mass * (lx * lx + lz * lz) / 12.0
+    doc = {
+        "name": out.name, "tool_version": "corpus",
+        "footprint_radius": round(float(np.hypot(lx / 2, lz / 2)), 4),
+        "source": {"file": "tank.obj", "sha256": sha256_file(out / "tank.obj"), "up": "y", "scale": 1.0},
+        "model": {"file": "model.glb"},
+        "mass": {"mass": mass, "inertia": round(inertia, 3), "centre_of_mass": [0.0, ly / 2, 0.0],
+                 "method": "mesh", "volume": lx * ly * lz},
+        "drive": drive_defaults(mass, inertia),
+        "hull": {"file": "hull.txt", "points": 8, "footprint_area": lx * lz, "convex_area": lx * lz},
+        "spheres": {"file": "spheres.txt", "levels": int(tree.levels), "branching": 4, "count": len(tree)},
+        "derived": {f: sha256_file(out / f) for f in ("model.glb", "hull.txt", "spheres.txt", "preview.png")},
+    }
+    if toml_edit:
+        toml_edit(doc)
+    (out / "vehicle.toml").write_text(dumps_toml(doc))
+
+
+# ------------------------------------------------------------------------- helpers
+def line_of(path: Path, needle: str) -> int:
+    for no, line in enumerate(path.read_text().splitlines(), 1):
+        if needle in line:
+            return no
+    raise ValueError(f"{needle!r} not in {path}")
+
+
+def wall_line(path: Path, seg) -> int:
+    """Line of the wall with these end points in a walls.txt."""
+    (x1, z1), (x2, z2) = seg
+    want = [float(x1), float(z1), float(x2), float(z2)]
+    for no, line in enumerate(path.read_text().splitlines(), 1):
+        f = line.split("#", 1)[0].split()
+        if len(f) == 5 and [float(v) for v in f[:4]] == want:
+            return no
+    raise ValueError(f"wall {seg} not in {path}")
+
+
+def spawn_line(path: Path, i: int) -> int:
+    """Line where spawn ``i`` starts in a manifest written by tomli_w (one number a line)."""
+    lines = path.read_text().splitlines()
+    start = next(no for no, ln in enumerate(lines, 1) if ln.startswith("spawns = "))
+    items = [no for no, ln in enumerate(lines, 1) if no > start and ln == "    ["]
+    return items[i]
+
+
+def first_field_line(path: Path, first: str, nfields: int) -> int:
+    """Line of the first data line with ``nfields`` fields starting with ``first``."""
+    for no, line in enumerate(path.read_text().splitlines(), 1):
+        f = line.split("#", 1)[0].split()
+        if len(f) == nfields and f[0] == first:
+            return no
+    raise ValueError(f"no line starting {first!r} with {nfields} fields in {path}")
+
+
+def expect(case: Path, code: str, target: str, path: str, lines: list[int]) -> None:
+    (case / "expect.json").write_text(json.dumps(
+        {"code": code, "target": target, "path": path, "lines": lines}, indent=1) + "\n")
+
+
+def edit_lines(text: str, fn) -> str:
+    return "\n".join(fn(text.splitlines())) + "\n"
+
+
+# --------------------------------------------------------------------------- cases
+def walls_case(name: str, code: str, segs, dirs, mutate=None, aux=(-1.0, -1.0, ROOM + 1, ROOM + 1)):
+    case = BROKEN / f"{code}_{name}"
+    case.mkdir(parents=True)
+    text = walls_text(segs, dirs, aux)
+    if mutate:
+        text = mutate(text)
+    (case / "walls.txt").write_text(text)
+    return case
+
+
+def make_cases() -> None:
+    segs, dirs = base_walls()
+    bottom = segs[0]  # (0,0)-(40,0)
+
+    # --- walls.txt syntax
+    def replace_wall(text, seg, new):
+        (x1, z1), (x2, z2) = seg
+        out = []
+        for line in text.splitlines():
+            f = line.split()
+            if len(f) == 5 and not line.startswith("#") and [float(v) for v in f[:4]] == [x1, z1, x2, z2]:
+                line = new
+            out.append(line)
+        return "\n".join(out) + "\n"
+
+    def insert_line(text, new):  # an extra bad line among the walls: the walls stay closed
+        return text.replace("# auxiliary", new + "\n# auxiliary")
+
+    c = walls_case("bad_fields", "A101", segs, dirs, lambda t: insert_line(t, "12 3 12 4.5"))
+    expect(c, "A101", "walls.txt", "walls.txt", [line_of(c / "walls.txt", "12 3 12 4.5")])
+    c = walls_case("nan", "A102", segs, dirs, lambda t: insert_line(t, "12 3 nan 4.5 1"))
+    expect(c, "A102", "walls.txt", "walls.txt", [line_of(c / "walls.txt", "nan")])
+    c = walls_case("direction", "A103", segs, dirs, lambda t: insert_line(t, "12 3 12 4.5 2"))
+    expect(c, "A103", "walls.txt", "walls.txt", [line_of(c / "walls.txt", "12 3 12 4.5 2")])
+    c = walls_case("no_aux", "A104", segs, dirs, lambda t: t.split("# auxiliary")[0])
+    expect(c, "A104", "walls.txt", "walls.txt", [len((c / "walls.txt").read_text().splitlines())])
+    c = walls_case("aux_not_enclosing", "A105", segs, dirs, aux=(-1.0, -1.0, 30.0, 41.0))
+    expect(c, "A105", "walls.txt", "walls.txt", [line_of(c / "walls.txt", "# auxiliary") + 1])
+
+    # --- wall geometry
+    c = walls_case("zero_length", "A201", segs + [[[10, 10], [10, 10]]], dirs + [1])
+    expect(c, "A201", "walls.txt", "walls.txt", [wall_line(c / "walls.txt", [[10, 10], [10, 10]])])
+    c = walls_case("duplicate", "A202", segs + [segs[1]], dirs + [dirs[1]])
+    n = [no for no, ln in enumerate((c / "walls.txt").read_text().splitlines(), 1) if ln.startswith("40 0 40 40")]
+    expect(c, "A202", "walls.txt", "walls.txt", [n[-1]])
+    c = walls_case("overlap", "A203", segs + [[[10, 0], [30, 0]]], dirs + [dirs[0]])
+    expect(c, "A203", "walls.txt", "walls.txt", [wall_line(c / "walls.txt", [[10, 0], [30, 0]])])
+    c = walls_case("crossing", "A204", segs + [[[12, 20], [20, 20]]], dirs + [1])
+    expect(c, "A204", "walls.txt", "walls.txt",
+           [wall_line(c / "walls.txt", [[12, 20], [20, 20]]), wall_line(c / "walls.txt", [[15, 25], [15, 15]])])
+    flipped = list(dirs)
+    flipped[1] = -flipped[1]
+    c = walls_case("flipped_normal", "A205", segs, flipped)
+    expect(c, "A205", "walls.txt", "walls.txt", [wall_line(c / "walls.txt", segs[1])])
+
+    # --- free space and spawn points (arena bundles)
+    leaky = [[[0, 0], [18, 0]], [[22, 0], [40, 0]]] + segs[1:]
+    c = BROKEN / "A301_leak"
+    write_arena(c / "arenas" / "leaky", leaky, [dirs[0]] + dirs)
+    w = c / "arenas" / "leaky" / "walls.txt"
+    expect(c, "A301", "arenas/leaky", "arenas/leaky/walls.txt", [wall_line(w, leaky[0]), wall_line(w, leaky[1])])
+
+    def spawn_case(code, name, spawns, vehicle=False, segs_=segs, dirs_=dirs, aux=(-1.0, -1.0, ROOM + 1, ROOM + 1)):
+        c = BROKEN / f"{code}_{name}"
+        write_arena(c / "arenas" / name, segs_, dirs_, spawns=spawns, aux=aux)
+        if vehicle:
+            write_vehicle(c / "vehicles" / "tank")
+        return c
+
+    c = spawn_case("A302", "spawn_in_block", SPAWNS + [[20, 20, 0]])
+    expect(c, "A302", "arenas/spawn_in_block", "arenas/spawn_in_block/arena.toml",
+           [spawn_line(c / "arenas/spawn_in_block/arena.toml", 8)])
+    c = spawn_case("A303", "spawn_near_wall", SPAWNS + [[2, 12, 0]], vehicle=True)
+    expect(c, "A303", "arenas/spawn_near_wall", "arenas/spawn_near_wall/arena.toml",
+           [spawn_line(c / "arenas/spawn_near_wall/arena.toml", 8)])
+    s2, d2 = loop(rect(50, 0, 60, 10), True)
+    c = spawn_case("A304", "spawn_cut_off", SPAWNS + [[55, 5, 0]], segs_=segs + s2, dirs_=dirs + d2,
+                   aux=(-1.0, -1.0, 61.0, 41.0))
+    expect(c, "A304", "arenas/spawn_cut_off", "arenas/spawn_cut_off/arena.toml",
+           [spawn_line(c / "arenas/spawn_cut_off/arena.toml", 8)])
+    c = spawn_case("A305", "few_spawns", SPAWNS[:7])
+    expect(c, "A305", "arenas/few_spawns", "arenas/few_spawns/arena.toml",
+           [line_of(c / "arenas/few_spawns/arena.toml", "spawns = ")])
+    # a corner room behind a 3 m door: the 4.66 m tank cannot get in (no spawn is there)
+    part = [[[28, 40], [28, 30]], [[28, 30], [37, 30]]]
+    c = spawn_case("A306", "narrow_door", SPAWNS, vehicle=True, segs_=segs + part, dirs_=dirs + [1, 1])
+    w = c / "arenas/narrow_door/walls.txt"
+    expect(c, "A306", "arenas/narrow_door", "arenas/narrow_door/walls.txt",
+           [wall_line(w, part[1]), wall_line(w, segs[1])])
+    s3, d3 = loop(rect(18, 18, 22, 22), True)  # a courtyard inside the block
+    c = spawn_case("A307", "island", SPAWNS, segs_=segs + s3, dirs_=dirs + d3)
+    w = c / "arenas/island/walls.txt"
+    expect(c, "A307", "arenas/island", "arenas/island/walls.txt", [wall_line(w, s) for s in s3])
+    c = BROKEN / "A308_bumpy_floor"
+    write_arena(c / "arenas" / "bumpy", bump=True)
+    expect(c, "A308", "arenas/bumpy", "arenas/bumpy/arena.toml", [line_of(c / "arenas/bumpy/arena.toml", "floor_y")])
+
+    # --- bundle files
+    c = BROKEN / "B101_bad_toml"
+    write_arena(c / "arenas" / "a")
+    t = c / "arenas/a/arena.toml"
+    t.write_text(t.read_text().replace("floor_y = 0.0", "floor_y = = 0.0"))
+    expect(c, "B101", "arenas/a", "arenas/a/arena.toml", [line_of(t, "floor_y")])
+    c = BROKEN / "B102_bad_key"
+    write_arena(c / "arenas" / "a", toml_edit=lambda d: d.update(floor_y="low"))
+    expect(c, "B102", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", "floor_y")])
+    c = BROKEN / "B201_source_missing"
+    write_arena(c / "arenas" / "a")
+    (c / "arenas/a/arena.obj").unlink()
+    expect(c, "B201", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", 'file = "arena.obj"')])
+    c = BROKEN / "B202_derived_missing"
+    write_arena(c / "arenas" / "a")
+    (c / "arenas/a/preview.png").unlink()
+    expect(c, "B202", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", '"preview.png" = ')])
+    c = BROKEN / "B203_stale"
+    write_arena(c / "arenas" / "a")
+    with open(c / "arenas/a/walls.txt", "a") as f:
+        f.write("# edited by hand after the build\n")
+    expect(c, "B203", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", '"walls.txt" = ')])
+    c = BROKEN / "B204_source_changed"
+    write_arena(c / "arenas" / "a")
+    with open(c / "arenas/a/arena.obj", "a") as f:
+        f.write("# edited\n")
+    expect(c, "B204", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", "sha256")])
+
+    # --- vehicles
+    def vcase(code, name, **kw):
+        c = BROKEN / f"{code}_{name}"
+        write_vehicle(c / "vehicles" / "tank", **kw)
+        return c, c / "vehicles/tank"
+
+    c, v = vcase("V101", "hull_bad_line", hull_edit=lambda t: t.replace("-2.0000 0.0000 -1.2000", "-2.0000 0.0000"))
+    expect(c, "V101", "vehicles/tank", "vehicles/tank/hull.txt", [first_field_line(v / "hull.txt", "-2.0000", 2)])
+    c, v = vcase("V102", "hull_six_points", hull_edit=lambda t: edit_lines(t, lambda ls: ls[:-2]))
+    expect(c, "V102", "vehicles/tank", "vehicles/tank/hull.txt", [0])
+
+    def shrink_hull(t):
+        def f(ls):
+            out = []
+            for ln in ls:
+                p = ln.split()
+                if len(p) == 3 and not ln.startswith("#"):
+                    ln = f"{float(p[0]) * 0.8:.4f} {p[1]} {float(p[2]) * 0.8:.4f}"
+                out.append(ln)
+            return out
+        return edit_lines(t, f)
+    c, v = vcase("V103", "hull_too_small", hull_edit=shrink_hull)
+    expect(c, "V103", "vehicles/tank", "vehicles/tank/hull.txt", [0])
+    c, v = vcase("V104", "com_outside", toml_edit=lambda d: d["mass"].update(centre_of_mass=[5.0, 1.0, 0.0]))
+    expect(c, "V104", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "centre_of_mass")])
+    c, v = vcase("V201", "spheres_bad_line", spheres_edit=lambda t: t.replace("\n1 0 2 ", "\n1 0 2 x "))
+    expect(c, "V201", "vehicles/tank", "vehicles/tank/spheres.txt", [line_of(v / "spheres.txt", "1 0 2 x ")])
+
+    def scale_sphere(t, sid, k):
+        def f(ls):
+            out = []
+            for ln in ls:
+                p = ln.split()
+                if len(p) == 7 and p[0] == str(sid):
+                    p[6] = f"{float(p[6]) * k:.4f}"
+                    ln = " ".join(p)
+                out.append(ln)
+            return out
+        return edit_lines(t, f)
+    c, v = vcase("V202", "leaf_too_small", spheres_edit=lambda t: scale_sphere(t, 1, 0.3))
+    expect(c, "V202", "vehicles/tank", "vehicles/tank/spheres.txt", [first_field_line(v / "spheres.txt", "1", 7)])
+    c, v = vcase("V203", "root_too_small", spheres_edit=lambda t: scale_sphere(t, 0, 0.6))
+    expect(c, "V203", "vehicles/tank", "vehicles/tank/spheres.txt", [first_field_line(v / "spheres.txt", "0", 7)])
+    c, v = vcase("V301", "negative_mass", toml_edit=lambda d: d["mass"].update(mass=-5.0))
+    expect(c, "V301", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "mass = -5")])
+    c, v = vcase("V302", "restitution", toml_edit=lambda d: d["drive"].update(restitution=1.5))
+    expect(c, "V302", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "restitution")])
+    c, v = vcase("V303", "top_speed", toml_edit=lambda d: d["drive"].update(top_speed=80.0))
+    expect(c, "V303", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "top_speed")])
+    c = BROKEN / "V401_does_not_fit"
+    write_vehicle(c / "vehicles" / "tank")
+    write_arena(c / "arenas" / "narrow_door", segs + part, dirs + [1, 1])
+    expect(c, "V401", "vehicles/tank", "vehicles/tank/vehicle.toml",
+           [line_of(c / "vehicles/tank/vehicle.toml", "footprint_radius")])
+
+
+def main() -> int:
+    for d in (BROKEN, CLEAN):
+        if d.exists():
+            shutil.rmtree(d)
+    write_arena(CLEAN / "arenas" / "yard")
+    write_vehicle(CLEAN / "vehicles" / "tank")
+    make_cases()
+    print(f"wrote {len(list(BROKEN.iterdir()))} cases under {BROKEN.relative_to(ROOT)} and {CLEAN.relative_to(ROOT)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
