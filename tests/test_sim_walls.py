@@ -192,3 +192,32 @@ def test_bundled_vehicles_push_into_every_wall(spec):
     for walls in arenas:
         tested, skipped = _push_runs(walls, steps=600, spec=spec)
         assert tested > 0
+
+
+@pytest.mark.parametrize("deg", [8, 20, 45, 90, 150])
+def test_driving_into_a_wedge_corner(deg):
+    """Full throttle into the apex of two walls meeting at ``deg`` degrees: the tank
+    jams but neither crosses a wall nor sinks more than a few millimetres."""
+    a = math.radians(deg)
+    apex = np.array([80.0, 40.0])
+    w1 = [apex, apex + 40 * np.array([-math.cos(a / 2), math.sin(a / 2)])]
+    w2 = [apex, apex + 40 * np.array([-math.cos(a / 2), -math.sin(a / 2)])]
+    from tanktool.formats.walls_txt import WallList, aux_rectangle
+
+    walls = WallList(np.array([w1, w2]), np.ones(2, np.int8), aux_rectangle(0, 0, 100, 80))
+    for spec in [TankSpec.box("b")] + bundled_vehicle_specs():
+        world = World(walls, [spec], [(45.0, 40.0, 0.0)], seed=0)
+        t = world.tanks[0]
+        t.place(45.0, 40.0, 0.0)
+        n = 2400
+        C, H, HD = np.empty((n, 2)), np.empty((n, len(spec.hull_local), 2)), np.empty((n, 2))
+        for i in range(n):
+            world.step(None, [Command(advance=1.0, rotate=0.3 * math.sin(i * 0.01))])
+            C[i], HD[i] = (t.x, t.z), (t.c, t.s)
+            H[i] = t.hull_world()
+        worst, switched = _crossings(C, H, walls.all_segments())
+        assert not switched
+        assert worst <= 0.005, f"{spec.name}: {worst:.4f} m past a wall"
+        assert _ends_inside(C, HD, spec, walls.all_segments()) <= 0.005
+        # it did drive into the wedge (narrow wedges stop it early, at its own width)
+        assert C[:, 0].max() > C[0, 0] + 2.0

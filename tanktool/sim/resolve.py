@@ -69,14 +69,6 @@ def pair_impulse(a: Tank, b: Tank, px: float, pz: float, nx: float, nz: float, e
     return j
 
 
-def push_out_of_wall(t: Tank, nx: float, nz: float, depth: float) -> None:
-    """Translate the tank along n so the contact sits SLOP short of the wall."""
-    d = depth - SLOP
-    if d > 0.0:
-        t.x += nx * d
-        t.z += nz * d
-
-
 def separate_pair(a: Tank, b: Tank, nx: float, nz: float, depth: float) -> None:
     """Move two overlapping tanks apart along n, shared in inverse proportion to mass
     (the centre of mass of the pair stays put, so momentum bookkeeping is untouched)."""
@@ -91,3 +83,35 @@ def separate_pair(a: Tank, b: Tank, nx: float, nz: float, depth: float) -> None:
     a.z += nz * fa
     b.x -= nx * fb
     b.z -= nz * fb
+
+
+def correct_walls(t: Tank, contacts: list[tuple[float, float, float, float, float]]) -> None:
+    """Move a tank out of the walls it overlaps; ``contacts`` holds the deepest contact
+    per wall, deepest first.
+
+    One wall: along its normal.  Two or more: if getting out of the deepest also gets
+    out of the second, that is enough; otherwise the translation d that satisfies both
+    n1·d = depth1 and n2·d = depth2 (the corner's vertex), so a tank wedged in an acute
+    corner comes out in one pass instead of bouncing between the walls.
+    """
+    if not contacts:
+        return
+    _, _, n1x, n1z, d1 = contacts[0]
+    d1 -= SLOP
+    if d1 <= 0.0:
+        return
+    dx, dz = n1x * d1, n1z * d1
+    for _, _, n2x, n2z, d2 in contacts[1:2]:
+        d2 -= SLOP
+        if d2 <= 0.0 or n2x * dx + n2z * dz >= d2:
+            break
+        det = n1x * n2z - n1z * n2x
+        if abs(det) < 0.05:          # nearly parallel walls: the deepest decides
+            break
+        vx = (d1 * n2z - n1z * d2) / det
+        vz = (n1x * d2 - n2x * d1) / det
+        # a vertex far away means walls that almost face each other: do not jump
+        if vx * vx + vz * vz <= (8.0 * max(d1, d2)) ** 2:
+            dx, dz = vx, vz
+    t.x += dx
+    t.z += dz

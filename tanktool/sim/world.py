@@ -31,7 +31,7 @@ from .body import Tank, TankSpec
 from ..nav.quadtree import WallQuadtree
 from .collide import QuadtreeIndex, WallIndex, WallSet, shell_hits_tank, tank_contact, wall_contacts
 from .commands import Command
-from .resolve import SLOP, pair_impulse, push_out_of_wall, separate_pair, wall_impulse
+from .resolve import SLOP, correct_walls, pair_impulse, separate_pair, wall_impulse
 from .weapons import Shell, fire, fly, stop_fraction
 
 DT = 1.0 / 120.0
@@ -366,16 +366,21 @@ class World:
                 t = tanks[i]
                 e = t.spec.restitution
                 jsum = 0.0
-                deepest = found[0]
+                per_wall: dict[int, tuple] = {}
                 for contact, k in found:
                     px, pz, nx, nz, depth = contact
                     jsum += wall_impulse(t, px, pz, nx, nz, e)
-                    if depth > deepest[0][4]:
-                        deepest = (contact, k)
-                (px, pz, nx, nz, depth), k = deepest
-                push_out_of_wall(t, nx, nz, depth)
-                if i not in bumped or jsum > bumped[i][2]:
-                    bumped[i] = (px, pz, jsum + (bumped[i][2] if i in bumped else 0.0), k)
+                    if k not in per_wall or depth > per_wall[k][4]:
+                        per_wall[k] = contact
+                (px, pz, _, _, _), k = max(((c, k) for k, c in per_wall.items()), key=lambda ck: (ck[0][4], -ck[1]))
+                correct_walls(t, sorted(per_wall.values(), key=lambda c: -c[4]))
+                # a bump is located where the first impulse of the step happened;
+                # its value sums the impulses of every pass
+                prev = bumped.get(i)
+                if prev is None or (prev[2] == 0.0 and jsum > 0.0):
+                    bumped[i] = (px, pz, (prev[2] if prev else 0.0) + jsum, k)
+                else:
+                    bumped[i] = (prev[0], prev[1], prev[2] + jsum, prev[3])
                 involved.add(i)
             col = self.detect_collisions(involved)
             col = col.needing_work(tanks)
