@@ -236,3 +236,13 @@ def test_spec_from_vehicle_bundle():
     vb.top_speed = 0.0
     with pytest.raises(VehicleError, match="top_speed"):
         TankSpec.from_vehicle(vb)
+
+
+def test_sim_never_imports_pygame_or_matplotlib():
+    import subprocess
+    import sys
+
+    code = ("import sys, tanktool.sim, tanktool.sim.match, tanktool.sim.driver; "
+            "print('pygame' in sys.modules, 'matplotlib' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "False"]
