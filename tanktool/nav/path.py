@@ -41,10 +41,11 @@ def astar(grid: NavGrid, start: Node, goal: Node, passable: np.ndarray | None = 
 
     best = {s: 0.0}
     came: dict[int, int] = {}
-    heap = [(h(s), 0.0, s)]
+    # ties on f go to the node nearer the goal: far fewer expansions on open ground
+    heap = [(h(s), h(s), 0.0, s)]
     closed = set()
     while heap:
-        f, gc, n = heapq.heappop(heap)
+        f, _, gc, n = heapq.heappop(heap)
         if n == g:
             out = [n]
             while n in came:
@@ -83,7 +84,8 @@ def astar(grid: NavGrid, start: Node, goal: Node, passable: np.ndarray | None = 
             if ng < best.get(m, math.inf):
                 best[m] = ng
                 came[m] = n
-                heapq.heappush(heap, (ng + h(m), ng, m))
+                hm = h(m)
+                heapq.heappush(heap, (ng + hm, hm, ng, m))
     return []
 
 

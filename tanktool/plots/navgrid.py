@@ -125,7 +125,7 @@ def render_navgrid(
     # normals as short ticks into free space, when there are few enough to read
     if 0 < len(seg) <= 400:
         mid = seg.mean(axis=1)
-        tick = walls.normals * (0.02 * view_span)
+        tick = walls.normals * (0.012 * view_span)
         ax.add_collection(LineCollection(np.stack([mid, mid + tick], axis=1), colors=WALL_COLOUR, lw=1.0, zorder=3))
 
     if spawns is not None and len(spawns):
