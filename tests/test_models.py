@@ -122,3 +122,27 @@ def test_refuses_bad_up_and_scale() -> None:
     for bad in (0.0, -1.0, float("nan"), float("inf")):
         with pytest.raises(FormatError, match="--scale"):
             models.load_model(path, scale=bad)
+
+
+@pytest.mark.parametrize("case", ["empty", "truncated"])
+def test_cli_reports_a_bad_3ds_in_one_line(tmp_path: Path, case: str) -> None:
+    """Through the real command line: one ``error:`` line naming the file and byte,
+    exit status 2, no traceback, nothing written."""
+    import subprocess
+    import sys
+
+    if case == "empty":
+        model = MODELS / "invalid_empty.3ds"
+    else:
+        model = tmp_path / "cut.3ds"
+        model.write_bytes((MODELS / "test1.3ds").read_bytes()[:3000])
+    out = tmp_path / "bundle"
+    proc = subprocess.run(
+        [sys.executable, "-m", "tanktool", "import-vehicle", str(model), "-o", str(out)],
+        capture_output=True, text=True, timeout=120,
+    )
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr + proc.stdout
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: {model}: byte 0: ")
+    assert not out.exists()

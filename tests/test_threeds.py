@@ -212,6 +212,28 @@ def test_materials_may_follow_objects_and_unknown_names_are_grey(tmp_path: Path)
     assert scene.geometry["b"].visual.face_colors[0].tolist() == list(threeds.DEFAULT_COLOR)
 
 
+def test_repeated_face_array_replaces_the_first_and_empty_groups() -> None:
+    first = np.array([[0, 1, 2], [2, 1, 0]], dtype="<u2")
+    arr1 = chunk(
+        0x4120,
+        struct.pack("<H", 2),
+        np.column_stack([first, np.zeros(2, "<u2")]).astype("<u2").tobytes(),
+        chunk(0x4130, b"m\0", struct.pack("<HHH", 2, 0, 1)),
+        chunk(0x4150, b"\1\0\0\0\2\0\0\0"),
+    )
+    arr2 = chunk(0x4120, struct.pack("<HHHHH", 1, 0, 2, 1, 7), chunk(0x4130, b"m\0", b"\0\0"))
+    obj = chunk(
+        0x4000,
+        b"o\0",
+        chunk(0x4100, chunk(0x4110, struct.pack("<H9f", 3, 0, 0, 0, 1, 0, 0, 0, 1, 0)), arr1, arr2),
+    )
+    mat = chunk(0xAFFF, chunk(0xA000, b"m\0"))
+    model = read_3ds(model_bytes(mat, obj))
+    (o,) = model.objects
+    assert o.faces.tolist() == [[0, 2, 1]] and o.face_flags.tolist() == [7]
+    assert o.face_material.tolist() == [-1] and o.smoothing is None
+
+
 @pytest.mark.parametrize(
     "data, message",
     [
@@ -307,6 +329,29 @@ def test_writer_splits_big_meshes(tmp_path: Path) -> None:
     assert all(len(o.faces) <= 65535 and len(o.vertices) <= 65535 for o in model.objects)
     got = np.vstack([o.vertices[o.faces] for o in model.objects])
     np.testing.assert_array_equal(got, verts[faces])
+
+    # separate triangles: the vertex limit binds first, at 65535 // 3 faces a part
+    soup = np.random.default_rng(2).random((90000, 3))
+    write_3ds(path, [("soup", soup, np.arange(90000).reshape(-1, 3), (1, 1, 1))])
+    parts = read_3ds(path).objects
+    assert [len(o.faces) for o in parts] == [21845, 8155]
+    assert [len(o.vertices) for o in parts] == [65535, 24465]
+    got = np.vstack([o.vertices[o.faces] for o in parts])
+    np.testing.assert_allclose(got, soup.reshape(-1, 3, 3), rtol=1e-6)
+
+    # random sharing: every part is as long as the limits allow
+    faces = np.random.default_rng(3).integers(0, 100000, (150000, 3))
+    pts = np.random.default_rng(4).random((100000, 3))
+    write_3ds(path, [("mix", pts, faces, (1, 1, 1))])
+    parts = read_3ds(path).objects
+    assert sum(len(o.faces) for o in parts) == len(faces)
+    start = 0
+    for o in parts[:-1]:
+        stop = start + len(o.faces)
+        assert len(o.vertices) == len(np.unique(faces[start:stop])) <= 65535
+        assert len(o.faces) == 65535 or len(np.unique(faces[start : stop + 1])) > 65535
+        start = stop
+    np.testing.assert_allclose(np.vstack([o.vertices[o.faces] for o in parts]), pts[faces], rtol=1e-6)
 
     # many vertices, few faces: the unused vertices are dropped when splitting
     many = np.random.default_rng(1).random((70000, 3))
@@ -445,7 +490,8 @@ def fuzz_cases(count: int, seed: int = 2024) -> list[bytes]:
     # enough cases, else at evenly spread offsets
     base = (MODELS / "test1.3ds").read_bytes()
     spans = chunk_spans(base)
-    n_cut = min(len(base), count // 2)
+    # (the 20,000-case run cuts at every one of its 10,654 offsets)
+    n_cut = len(base) if count >= 2 * len(base) else count // 2
     for i, cut in enumerate(np.linspace(0, len(base) - 1, n_cut).astype(int)):
         cases.append(truncated(base, int(cut), spans) if i % 4 else base[: int(cut)])
     # random damage anywhere in any file: flipped bits, random bytes, and random
@@ -495,6 +541,24 @@ def check_case(data: bytes) -> bool:
     scene = trimesh.load_scene(io.BytesIO(data), file_type="3ds")
     assert len(scene.geometry) == sum(1 for o in model.objects if len(o.faces))
     return False
+
+
+def test_memory_stays_proportional_to_many_tiny_chunks() -> None:
+    """Per-chunk bookkeeping is bounded: 10,000 empty objects / materials / nodes."""
+    units = [
+        chunk(0x3D3D, chunk(0x4000, b"\0", chunk(0x4100, chunk(0x4120, b"\0\0"))) * 10_000),
+        chunk(0x3D3D, chunk(0xAFFF) * 10_000),
+        chunk(0xB000, chunk(0xB002) * 10_000),
+    ]
+    for unit in units:
+        data = chunk(0x4D4D, unit)
+        tracemalloc.start()
+        try:
+            read_3ds(data)
+            _, peak = tracemalloc.get_traced_memory()
+        finally:
+            tracemalloc.stop()
+        assert peak < 40 * len(data), (peak, len(data))
 
 
 def test_chunk_spans_cover_the_tree() -> None:

@@ -11,6 +11,9 @@ produce a :class:`~tanktool.errors.FormatError` naming the file and byte offset:
 * every count read from the file (vertices, faces, UVs, group sizes) is checked
   against the bytes left in its chunk *before* an array is made, so no array is
   ever larger than about twice the bytes it was read from (float32 -> float64).
+  Memory is therefore proportional to the file: about 3x its size for real models;
+  the per-chunk Python objects make the worst case (a file of nothing but empty
+  6-byte material chunks) about 40x.
 
 Only the chunks a static import needs are interpreted (objects, triangle meshes,
 materials, master scale, keyframer node names); everything else, including lights
@@ -118,7 +121,21 @@ _COLOR_PREFERENCE = (LIN_COLOR_F, LIN_COLOR_24, COLOR_F, COLOR_24)
 # plain data
 
 
-@dataclass
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
+
+
+# Shared read-only defaults: a file made of thousands of empty objects must not cost
+# four fresh arrays each (memory stays proportional to the file, see the fuzz test).
+_NO_VERTICES = _frozen(np.zeros((0, 3)))
+_NO_FACES = _frozen(np.zeros((0, 3), dtype=np.int32))
+_NO_FLAGS = _frozen(np.zeros(0, dtype=np.uint16))
+_NO_MATERIALS = _frozen(np.zeros(0, dtype=np.int32))
+_IDENTITY = _frozen(np.eye(4))
+
+
+@dataclass(slots=True)
 class TextureMap:
     """A texture map of a material: image file name and strength (0..1)."""
 
@@ -127,7 +144,7 @@ class TextureMap:
     strength: float | None = None
 
 
-@dataclass
+@dataclass(slots=True)
 class Material:
     """One 0xAFFF material entry.  Colours are RGB floats 0..1; percentages are
     given as fractions (``transparency`` 0 = opaque, 1 = invisible)."""
@@ -159,7 +176,7 @@ class Material:
         return (rgb[0], rgb[1], rgb[2], alpha)
 
 
-@dataclass
+@dataclass(slots=True)
 class MeshObject:
     """One triangle mesh (a 0x4100 inside a 0x4000 named object).
 
@@ -173,6 +190,8 @@ class MeshObject:
     smoothing : (m,) uint32 smoothing-group bit masks or None
     matrix : (4, 4) float64 object matrix from 0x4160 (columns: x, y, z axes and
         origin).  The vertices are already in world space; this is informational.
+        Without a 0x4160 chunk it is a shared read-only identity, and the arrays of
+        an object with no 0x4110 / 0x4120 chunk are shared read-only empties.
     """
 
     name: str
@@ -182,11 +201,11 @@ class MeshObject:
     face_material: np.ndarray
     uv: np.ndarray | None = None
     smoothing: np.ndarray | None = None
-    matrix: np.ndarray = field(default_factory=lambda: np.eye(4))
+    matrix: np.ndarray = field(default_factory=lambda: _IDENTITY)
     offset: int = 0
 
 
-@dataclass
+@dataclass(slots=True)
 class KeyframerNode:
     """An object node (0xB002) of the keyframer: which object it instances."""
 
@@ -236,7 +255,8 @@ class _Reader:
         self.source = source
         # material names of 0x4130 groups, resolved after the whole file is read
         # because materials may follow the objects that use them
-        self.pending_groups: list[tuple[MeshObject, str, np.ndarray]] = []
+        # (the per-face material array the group was checked against, name, faces)
+        self.pending_groups: list[tuple[np.ndarray, str, np.ndarray]] = []
 
     # -- helpers -------------------------------------------------------------
 
@@ -326,8 +346,8 @@ class _Reader:
         for cid, off, body, end in self.children(0, len(data), -1):
             self.main(model, body, end)
             break
-        for obj, name, idx in self.pending_groups:
-            obj.face_material[idx] = model.material_index(name)
+        for face_material, name, idx in self.pending_groups:
+            face_material[idx] = model.material_index(name)
         return model
 
     def main(self, model: Model3DS, start: int, end: int) -> None:
@@ -365,10 +385,10 @@ class _Reader:
     def trimesh(self, name: str, off: int, start: int, end: int) -> MeshObject:
         obj = MeshObject(
             name=name,
-            vertices=np.zeros((0, 3)),
-            faces=np.zeros((0, 3), dtype=np.int32),
-            face_flags=np.zeros(0, dtype=np.uint16),
-            face_material=np.full(0, -1, dtype=np.int32),
+            vertices=_NO_VERTICES,
+            faces=_NO_FACES,
+            face_flags=_NO_FLAGS,
+            face_material=_NO_MATERIALS,
             offset=off,
         )
         face_offset = None
@@ -401,9 +421,14 @@ class _Reader:
     def face_array(self, obj: MeshObject, start: int, end: int) -> None:
         n = self.u16(start, end, FACE_ARRAY, "face count")
         rec = self.array(start + 2, end, n, FACE_DTYPE, f"{n} faces", FACE_ARRAY)
-        obj.faces = rec["vertices"].astype(np.int32)
-        obj.face_flags = rec["flags"].copy()
-        obj.face_material = np.full(n, -1, dtype=np.int32)
+        # a repeated 0x4120 replaces the earlier one, smoothing groups included
+        obj.smoothing = None
+        if n:
+            obj.faces = rec["vertices"].astype(np.int32)
+            obj.face_flags = rec["flags"].copy()
+            obj.face_material = np.full(n, -1, dtype=np.int32)
+        else:
+            obj.faces, obj.face_flags, obj.face_material = _NO_FACES, _NO_FLAGS, _NO_MATERIALS
         for cid, off, body, cend in self.children(start + 2 + n * FACE_DTYPE.itemsize, end, FACE_ARRAY):
             if cid == MSH_MAT_GROUP:
                 name, pos = self.cstring(body, cend, cid)
@@ -415,7 +440,8 @@ class _Reader:
                         f"material group {name!r} names face {int(idx.max())} "
                         f"but the object has {n} faces",
                     )
-                self.pending_groups.append((obj, name, idx.astype(np.int32)))
+                if k:
+                    self.pending_groups.append((obj.face_material, name, idx.astype(np.int32)))
             elif cid == SMOOTH_GROUP:
                 if cend - body != 4 * n:
                     raise self.error(
@@ -642,28 +668,27 @@ def _split_mesh(vertices: np.ndarray, faces: np.ndarray) -> list[tuple[np.ndarra
     """Split a mesh into parts of at most 65535 vertices and 65535 faces (u16 counts).
 
     Faces keep their order; each part takes the longest run of faces whose distinct
-    vertices still fit (binary search: the count only grows with the run).
+    vertices still fit: the run stops at the face that brings in the 65536th
+    distinct vertex, found from the first position of each vertex in the window.
     """
     if len(vertices) <= MAX_COUNT and len(faces) <= MAX_COUNT:
         return [(vertices, faces)]
     parts = []
-    safe = MAX_COUNT // 3  # this many faces always fit: at most 3 new vertices each
     start, m = 0, len(faces)
+    used = np.zeros(len(vertices), dtype=bool)  # reused scratch: O(n) per part, no sort
     while start < m:
-        hi = min(m, start + MAX_COUNT)
-        if len(np.unique(faces[start:hi])) <= MAX_COUNT:
-            stop = hi
-        else:
-            lo = min(m, start + safe)  # known to fit
-            while hi - lo > 1:
-                mid = (lo + hi) // 2
-                if len(np.unique(faces[start:mid])) <= MAX_COUNT:
-                    lo = mid
-                else:
-                    hi = mid
-            stop = lo
-        used, inverse = np.unique(faces[start:stop], return_inverse=True)
-        parts.append((vertices[used], inverse.reshape(-1, 3)))
+        stop = min(m, start + MAX_COUNT)
+        used[:] = False
+        used[faces[start:stop]] = True
+        if np.count_nonzero(used) > MAX_COUNT:
+            _, first = np.unique(faces[start:stop].ravel(), return_index=True)
+            first.sort()
+            # first[MAX_COUNT] >= 65535, so at least 21845 faces are taken: progress
+            stop = start + int(first[MAX_COUNT]) // 3
+            used[:] = False
+            used[faces[start:stop]] = True
+        remap = np.cumsum(used) - 1
+        parts.append((vertices[used], remap[faces[start:stop]]))
         start = stop
     return parts
 
