@@ -1,0 +1,234 @@
+"""Arena bundles: build one from a model (``import-arena``) and read one back.
+
+An arena bundle ``arenas/<name>/`` holds ``arena.toml`` (the manifest), the source
+model (copied under its own name), ``model.glb`` (the model in the world frame, for
+the game), ``walls.txt`` (the 2002 wall list), ``preview.png``, and later
+``navgrid.npz`` / ``quadtree.npz`` written by ``build-navgrid``.  See docs/arenas.md.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from . import __version__
+from .errors import ArenaError, FormatError
+from .formats.walls_txt import WallList
+
+#: defaults of the [navgrid] table until build-navgrid rewrites it
+NAVGRID_DEFAULTS = {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
+MANIFEST = "arena.toml"
+MIN_SPAWNS = 8
+
+
+@dataclass
+class ArenaBundle:
+    """An arena bundle as read from disk.
+
+    walls : the wall list (auxiliary rectangle in ``walls.aux``)
+    bounds : (2, 2) ``[[xmin, zmin], [xmax, zmax]]``
+    spawns : (k, 3) ``[x, z, heading_rad]``
+    toml : the whole manifest
+    """
+
+    name: str
+    path: Path
+    walls: WallList
+    bounds: np.ndarray
+    spawns: np.ndarray
+    floor_y: float
+    toml: dict[str, Any] = field(default_factory=dict)
+
+    def file(self, key: str) -> Path:
+        """Path of a file the manifest names in table ``key`` (e.g. "walls", "model")."""
+        return self.path / str(self.toml.get(key, {}).get("file", ""))
+
+
+def load_arena(path: str | os.PathLike) -> ArenaBundle:
+    """Read an arena bundle folder (or its ``arena.toml``).
+
+    Raises ArenaError / FormatError naming the file and what is wrong.
+    """
+    from .formats.bundle import read_toml
+    from .formats.walls_txt import read_walls
+
+    path = Path(path)
+    if path.is_file() and path.name == MANIFEST:
+        path = path.parent
+    if not path.is_dir():
+        raise ArenaError(f"{path}: no such arena folder")
+    manifest = path / MANIFEST
+    if not manifest.is_file():
+        raise ArenaError(f"{path}: not an arena bundle (no {MANIFEST})")
+    doc = read_toml(manifest)
+    walls_name = doc.get("walls", {}).get("file", "walls.txt")
+    if not isinstance(walls_name, str) or "/" in walls_name or "\\" in walls_name:
+        raise ArenaError(f"{manifest}: [walls] file must be a file name in the bundle, got {walls_name!r}")
+    walls = read_walls(path / walls_name)
+    try:
+        spawns = np.asarray(doc.get("spawns", []), dtype=np.float64).reshape(-1, 3)
+    except (TypeError, ValueError):
+        raise ArenaError(f"{manifest}: 'spawns' must be a list of [x, z, heading] triples") from None
+    if not np.isfinite(spawns).all():
+        raise ArenaError(f"{manifest}: 'spawns' must be finite numbers")
+    raw_bounds = doc.get("bounds")
+    if raw_bounds is None:
+        bounds = walls.bounds
+    else:
+        try:
+            bounds = np.asarray(raw_bounds, dtype=np.float64).reshape(2, 2)
+        except (TypeError, ValueError):
+            raise ArenaError(f"{manifest}: 'bounds' must be [[xmin, zmin], [xmax, zmax]]") from None
+        if not (np.isfinite(bounds).all() and (bounds[1] > bounds[0]).all()):
+            raise ArenaError(f"{manifest}: 'bounds' must be finite with xmin < xmax and zmin < zmax")
+    try:
+        floor_y = float(doc.get("floor_y", 0.0))
+    except (TypeError, ValueError):
+        raise ArenaError(f"{manifest}: 'floor_y' must be a number") from None
+    return ArenaBundle(str(doc.get("name", path.name)), path, walls, bounds, spawns, floor_y, doc)
+
+
+# ---------------------------------------------------------------------------
+# building a bundle
+
+
+@dataclass
+class ImportResult:
+    """What :func:`import_arena` wrote, for the command's summary."""
+
+    path: Path
+    name: str
+    walls: WallList
+    spawns: np.ndarray
+    floor_y: float
+    faces: int
+    thin_walls: int
+    seconds: float
+
+
+_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
+
+
+def _companion_files(model: Path) -> list[Path]:
+    """Files a model needs beside it: an .obj's material libraries."""
+    if model.suffix.lower() != ".obj":
+        return []
+    out = []
+    try:
+        with open(model, "rb") as f:
+            for raw in f:
+                if raw.startswith(b"mtllib"):
+                    for name in raw.split()[1:]:
+                        p = model.parent / name.decode("utf-8", "replace")
+                        if p.is_file() and p.parent == model.parent:
+                            out.append(p)
+    except OSError:
+        return []
+    return out
+
+
+def import_arena(
+    model: str | os.PathLike,
+    out: str | os.PathLike | None = None,
+    name: str | None = None,
+    up: str | None = None,
+    scale: float = 1.0,
+    height: float = 1.0,
+    tolerance: float = 0.01,
+    force: bool = False,
+    navgrid: dict[str, Any] | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> ImportResult:
+    """Read ``model``, extract walls and spawns and write the arena bundle ``out``.
+
+    ``out`` defaults to ``./<name>``; ``name`` to the model's file stem.  ``navgrid``
+    overrides the [navgrid] defaults (used when rebuilding a bundled arena).
+    Everything is written into a temporary folder renamed into place at the end,
+    so a failure leaves nothing behind.
+    """
+    import trimesh
+
+    from .formats.bundle import sha256_file, staged_dir, write_toml
+    from .formats.models import detect_format, load_scene
+    from .formats.walls_txt import write_walls
+    from .geometry.spawns import place_spawns
+    from .geometry.walls import extract_walls
+    from .plots.arena import save_preview
+
+    t0 = time.perf_counter()
+    model = Path(model)
+    fmt = detect_format(model)
+    name = name or model.stem
+    if not _NAME_RE.match(name):
+        raise ArenaError(f"arena name {name!r}: use letters, digits, '.', '_' or '-'")
+    target = Path(out) if out is not None else Path.cwd() / name
+    if target.exists() and not force:
+        raise ArenaError(f"{target}: already exists (use --force to overwrite)")
+    if target.exists() and not target.is_dir():
+        raise ArenaError(f"{target}: exists and is not a folder")
+    if not (math.isfinite(height) and height > 0):
+        raise ArenaError(f"--height must be a positive number of metres, got {height}")
+    if not (math.isfinite(tolerance) and 0 < tolerance < height):
+        raise ArenaError(f"--tolerance must be positive and below --height, got {tolerance}")
+
+    scene = load_scene(model, up=up, scale=scale)
+    meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
+    try:
+        ex = extract_walls(mesh.vertices, mesh.faces, height=height, tolerance=tolerance, progress=progress)
+    except ArenaError as e:
+        raise ArenaError(f"{model}: {e}") from None
+    try:
+        spawns = place_spawns(ex.free, ex.walls.bounds)
+    except ArenaError as e:
+        raise ArenaError(f"{model}: {e}") from None
+    if progress:
+        progress("spawns")
+
+    src_up = up or ("z" if fmt == "3ds" else "y")
+    nav = dict(NAVGRID_DEFAULTS)
+    nav.update(navgrid or {})
+    bounds = ex.walls.bounds
+    with staged_dir(target, force=force) as tmp:
+        copied = [model, *_companion_files(model)]
+        for f in copied:
+            shutil.copyfile(f, tmp / f.name)
+        glb = scene.export(file_type="glb")
+        (tmp / "model.glb").write_bytes(glb)
+        header = (f"arena {name}: walls of {model.name} cut {height:g} m above the floor (y={ex.floor_y:.4g})\n"
+                  f"made by tanktool {__version__} import-arena; normals point into free space")
+        write_walls(tmp / "walls.txt", ex.walls, header=header)
+        title = (f"{name}: {len(ex.walls)} walls + 4 auxiliary, {len(spawns)} spawns, "
+                 f"{bounds[1, 0] - bounds[0, 0]:.0f} x {bounds[1, 1] - bounds[0, 1]:.0f} m")
+        save_preview(tmp / "preview.png", ex.walls, spawns, title, ex.free)
+        if progress:
+            progress("files")
+        doc = {
+            "name": name,
+            "tool_version": __version__,
+            "bounds": [[_r(bounds[0, 0]), _r(bounds[0, 1])], [_r(bounds[1, 0]), _r(bounds[1, 1])]],
+            "floor_y": _r(ex.floor_y),
+            "spawns": [[_r(x), _r(z), _r(h, 6)] for x, z, h in spawns],
+            "source": {"file": model.name, "sha256": sha256_file(model), "up": src_up, "scale": float(scale)},
+            "model": {"file": "model.glb"},
+            "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
+                      "count": len(ex.walls)},
+            "navgrid": nav,
+            "derived": {f: sha256_file(tmp / f) for f in ("walls.txt", "model.glb", "preview.png")},
+        }
+        write_toml(tmp / MANIFEST, doc)
+    return ImportResult(target, name, ex.walls, spawns, ex.floor_y, len(mesh.faces), ex.thin_walls,
+                        time.perf_counter() - t0)
+
+
+def _r(v: float, nd: int = 4) -> float:
+    v = round(float(v), nd)
+    return 0.0 if v == 0.0 else v  # no "-0.0" in the manifest

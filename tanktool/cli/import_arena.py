@@ -1,0 +1,60 @@
+"""``tanktool import-arena``: an arena model in, an arena bundle out."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from .options import force_option, name_option, progress, scale_option, up_option
+
+#: models with more faces than this get a progress bar
+PROGRESS_FACES = 100_000
+#: the stages import_arena reports
+STAGES = ("floor", "cut", "sections", "free", "spawns", "files")
+
+
+def _face_count_guess(model: Path) -> int:
+    """A cheap over-estimate of the face count from the file size (no parsing)."""
+    try:
+        size = model.stat().st_size
+    except OSError:
+        return 0
+    # ~40 bytes a face in .obj text, ~14 in .3ds; either way a big file is a big model
+    return size // 20
+
+
+@click.command("import-arena")
+@click.argument("model", type=click.Path(path_type=Path))
+@click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
+              help="Bundle folder to write (default: ./<name>).")
+@name_option
+@up_option
+@scale_option
+@click.option("--height", type=float, default=1.0, show_default=True,
+              help="Cut height above the floor, in metres: what crosses it is a wall.")
+@click.option("--tolerance", type=float, default=0.01, show_default=True,
+              help="Shortest wall kept and snapping grid, in metres.")
+@force_option
+def import_arena(model: Path, out: Path | None, name: str | None, up: str | None, scale: float,
+                 height: float, tolerance: float, force: bool) -> None:
+    """Turn an arena MODEL (.3ds .obj .glb .stl .ply .off) into an arena bundle.
+
+    \b
+    Writes arena.toml, the model, model.glb, walls.txt, preview.png:
+      tanktool import-arena castle.3ds -o arenas/castle --height 1.2
+    """
+    from ..arena import import_arena as run
+    from .main import echo
+
+    if _face_count_guess(model) > PROGRESS_FACES:
+        with progress(length=len(STAGES), label=f"importing {model.name}") as bar:
+            result = run(model, out, name, up, scale, height, tolerance, force, progress=lambda _s: bar.update(1))
+    else:
+        result = run(model, out, name, up, scale, height, tolerance, force)
+    (x0, z0), (x1, z1) = result.walls.bounds
+    thin = f" ({result.thin_walls} from thin walls)" if result.thin_walls else ""
+    echo(f"arena {result.name!r}: {len(result.walls)} walls{thin} + 4 auxiliary, {len(result.spawns)} spawns")
+    echo(f"  bounds x {x0:g}..{x1:g}, z {z0:g}..{z1:g} m ({x1 - x0:.1f} x {z1 - z0:.1f} m), "
+         f"floor y={result.floor_y:.3f}, {result.faces} faces")
+    echo(f"  wrote {result.path} in {result.seconds:.2f} s")

@@ -1,0 +1,494 @@
+"""Wall extraction: from a 3D arena model to the 2002 top-view wall list.
+
+The pipeline, each step a function below:
+
+1. :func:`find_floor` -- the floor is the lowest *large* horizontal surface.  Faces
+   whose normal points up (``n_y >= 0.9``, within ~25 degrees of vertical) are
+   grouped into height levels (sorted by centroid height, a new level wherever two
+   consecutive heights differ by more than 5 cm); a level is *large* when its area
+   is at least a quarter of the largest level's area.  Small low pieces (stair
+   treads, a sunken pit, the bottom of a basement ramp) are thereby skipped, and on
+   a multi-storey model the ground storey wins over a bigger upper one only when it
+   is at least a quarter of its size.
+2. :func:`slice_mesh` -- cut every triangle with the plane ``y = floor + height``
+   (numpy, all crossing triangles at once).  A vertex exactly on the plane counts as
+   above it, so a shared edge always yields the same cut point and loops close.
+   Each cut segment keeps the horizontal part of its face normal: it says which
+   side is solid.
+3. :func:`cross_sections` -- join the segments into closed rings and open chains
+   (shapely ``line_merge`` per connected component), simplify within the tolerance,
+   and decide for each ring whether its inside is solid (the face normals point
+   out of it) or free (a room's inner wall face: normals point into it).  When a
+   ring's normals disagree (badly wound models), nesting parity decides instead.
+   The solid cross-section is then the set of points of positive winding number
+   over all rings, so overlapping or nested boxes are one solid and no wall is
+   left buried inside solid material.
+4. Free space is the part of the floor's bounding rectangle not covered by solid
+   that holds floor (area-weighted sample points of the floor level fall in it).
+   Regions that touch the rectangle's border lie outside the outer walls and are
+   dropped whenever at least one enclosed region exists; an open arena (no outer
+   walls) keeps them, bounded by the floor's rectangle.  Slivers thinner than the
+   tolerance vanish (coordinates are snapped to the tolerance grid).
+5. The walls are the boundary of the free space, oriented so that each normal
+   points into free space, collinear pieces merged, pieces shorter than the
+   tolerance dropped.  Open chains (single-quad walls, zero-thickness fences,
+   non-watertight pieces that do not close) are *thin walls*: where they cross free
+   space they become two walls on the same segment with opposite Direction, so a
+   vehicle meets a wall from either side.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+import shapely
+
+from ..errors import ArenaError
+from ..formats.walls_txt import WallList, aux_rectangle
+
+#: an upward face has a normal within ~25 degrees of +y
+UP_NORMAL_MIN = 0.9
+#: heights closer than this belong to the same floor level (m)
+LEVEL_GAP = 0.05
+#: a level is "large" at this fraction of the largest level's area
+LARGE_LEVEL_FRACTION = 0.25
+#: free regions narrower than this everywhere (ledges, sills) are dropped (m)
+MIN_FREE_WIDTH = 1.0
+
+
+@dataclass
+class FloorLevel:
+    """The chosen floor: its height and the faces that make it up."""
+
+    y: float
+    area: float
+    faces: np.ndarray  # (k,) indices of the floor level's upward faces
+    levels: list[tuple[float, float]] = field(default_factory=list)  # (height, area) per level
+
+
+@dataclass
+class WallExtraction:
+    """Everything :func:`extract_walls` found; ``walls`` is what ``walls.txt`` holds."""
+
+    walls: WallList
+    floor_y: float
+    cut_y: float
+    free: Any  # shapely (Multi)Polygon: the free space at the cut height
+    solid: Any  # shapely geometry: the solid cross-section
+    thin_walls: int  # how many of the walls are halves of thin (zero-thickness) walls
+    rings: int
+    chains: int
+    raw_segments: int
+    timings: dict[str, float] = field(default_factory=dict)
+
+
+# ---------------------------------------------------------------------------
+# 1. the floor
+
+
+def find_floor(vertices: np.ndarray, faces: np.ndarray) -> FloorLevel:
+    """The lowest large horizontal upward surface (rule in the module docstring).
+
+    vertices (n, 3) world frame (Y up), faces (m, 3) int.  Raises ArenaError when
+    the model has no upward-facing faces at all.
+    """
+    tri = vertices[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area2 = np.linalg.norm(normal, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ny = np.where(area2 > 0, normal[:, 1] / area2, 0.0)
+    up = np.flatnonzero(ny >= UP_NORMAL_MIN)
+    if len(up) == 0:
+        if np.any(ny <= -UP_NORMAL_MIN):
+            raise ArenaError("no upward-facing floor: the model's faces seem wound inside out "
+                             "(or its up axis is wrong: try --up)")
+        raise ArenaError("no horizontal surface to stand on (no face has a vertical normal; try --up)")
+    height = tri[up, :, 1].mean(axis=1)
+    area = area2[up] / 2
+    order = np.argsort(height, kind="stable")
+    h = height[order]
+    split = np.flatnonzero(np.diff(h) > LEVEL_GAP) + 1
+    starts = np.concatenate([[0], split])
+    level_area = np.add.reduceat(area[order], starts)
+    level_h = np.add.reduceat(area[order] * h, starts) / np.maximum(level_area, 1e-300)
+    large = np.flatnonzero(level_area >= LARGE_LEVEL_FRACTION * level_area.max())
+    k = int(large[0])
+    stop = starts[k + 1] if k + 1 < len(starts) else len(h)
+    levels = [(float(a), float(b)) for a, b in zip(level_h, level_area)]
+    return FloorLevel(float(level_h[k]), float(level_area[k]), up[order[starts[k]:stop]], levels)
+
+
+def floor_faces(vertices: np.ndarray, faces: np.ndarray, floor_y: float, cut_y: float) -> np.ndarray:
+    """Indices of the upward faces from the floor level up to the cut height."""
+    tri = vertices[faces]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area2 = np.linalg.norm(normal, axis=1)
+    h = tri[:, :, 1].mean(axis=1)
+    up = normal[:, 1] >= UP_NORMAL_MIN * area2
+    return np.flatnonzero(up & (area2 > 0) & (h >= floor_y - LEVEL_GAP) & (h < cut_y))
+
+
+# ---------------------------------------------------------------------------
+# 2. the cut
+
+
+def slice_mesh(vertices: np.ndarray, faces: np.ndarray, y: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cut triangles with the plane ``Y = y``.
+
+    Returns ``segments`` (s, 2, 2) in (x, z), ``normals`` (s, 2) the horizontal part
+    of each face normal (not normalised) and ``nodes`` (s, 2) int, an id per cut
+    point shared by every segment through it (same mesh edge, or same position).
+    Each segment is ordered so that its face normal lies on its right-hand side,
+    i.e. for outward normals the solid is on the left.
+    """
+    d = vertices[:, 1] - y
+    above = d >= 0.0  # on the plane counts as above: shared edges cut identically
+    fa = above[faces]
+    count = fa.sum(axis=1)
+    crossing = (count == 1) | (count == 2)
+    f = faces[crossing]
+    fa = fa[crossing]
+    if len(f) == 0:
+        return np.zeros((0, 2, 2)), np.zeros((0, 2)), np.zeros((0, 2), dtype=np.int64)
+    # the lone vertex (the one on its own side) goes first; the cyclic order is kept
+    lone = np.where(count[crossing] == 1, np.argmax(fa, axis=1), np.argmin(fa, axis=1))
+    rows = np.arange(len(f))[:, None]
+    f = f[rows, (lone[:, None] + np.arange(3)) % 3]
+    # merge vertices at the same position (split seams of .3ds/.obj files) so that
+    # neighbouring triangles share edge ids; only the crossing triangles' vertices
+    used, inv = np.unique(f, return_inverse=True)
+    pos = np.ascontiguousarray(vertices[used])
+    _, merged = np.unique(pos.view(np.dtype((np.void, 24))).reshape(-1), return_inverse=True)
+    g = merged.reshape(-1)[inv.reshape(f.shape)]
+    # edges (lone, next) and (lone, prev): canonical (low id, high id) order so the
+    # arithmetic, and hence the cut point, is identical in both adjacent triangles
+    ends = []
+    keys = []
+    for other in (1, 2):
+        a = np.minimum(g[:, 0], g[:, other])
+        b = np.maximum(g[:, 0], g[:, other])
+        swap = g[:, 0] > g[:, other]
+        ia = np.where(swap, f[:, other], f[:, 0])
+        ib = np.where(swap, f[:, 0], f[:, other])
+        pa = vertices[ia]
+        pb = vertices[ib]
+        da = pa[:, 1] - y
+        db = pb[:, 1] - y
+        t = da / (da - db)
+        p = pa + t[:, None] * (pb - pa)
+        ends.append(p[:, [0, 2]])
+        keys.append(a.astype(np.int64) * (len(used) + 1) + b)
+    p0, p1 = ends
+    tri = vertices[f]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])[:, [0, 2]]
+    seg = np.stack([p0, p1], axis=1)
+    # the normal must be on the right of p0 -> p1: right of (dx, dz) is (dz, -dx)
+    dx = p1 - p0
+    flip = (dx[:, 1] * n[:, 0] - dx[:, 0] * n[:, 1]) < 0
+    seg[flip] = seg[flip][:, ::-1]
+    k0, k1 = keys
+    _, node = np.unique(np.concatenate([k0, k1]), return_inverse=True)
+    node = node.reshape(2, -1).T
+    node[flip] = node[flip][:, ::-1]
+    keep = np.any(seg[:, 0] != seg[:, 1], axis=1)  # a triangle touching the plane at a vertex
+    return seg[keep], n[keep], node[keep]
+
+
+# ---------------------------------------------------------------------------
+# 3. rings, chains and the solid cross-section
+
+
+def _components(nodes: np.ndarray) -> np.ndarray:
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    m = int(nodes.max()) + 1 if len(nodes) else 0
+    graph = coo_matrix((np.ones(len(nodes)), (nodes[:, 0], nodes[:, 1])), shape=(m, m))
+    _, label = connected_components(graph, directed=False)
+    return label[nodes[:, 0]]
+
+
+def cross_sections(segments: np.ndarray, normals: np.ndarray, nodes: np.ndarray, tolerance: float,
+                   floor: Any = None):
+    """Solid cross-section and thin-wall chains from oriented cut segments.
+
+    The segments come ordered "face normal on the right", so around a solid with
+    outward normals they run counter-clockwise: the solid is where the winding
+    number of the segments is positive.  Segments are grouped into components
+    (connected through shared cut points):
+
+    * closed (every cut point used an even number of times) and *consistent*
+      (as many segments enter each cut point as leave it) with positive area: the
+      boundary of solid material;
+    * the same with negative area (normals point into the loop): free space inside
+      solid when it lies within a positive solid (a room inside a thick wall ring),
+      otherwise, with floor all around its outside, a solid wound inside out
+      (taken as solid), and without, a one-sided shell seen from inside (levels
+      built of single faces): thin walls;
+    * open, or closed with inconsistent normals: thin walls, since nothing says
+      which side is solid.
+
+    Returns ``(solid, chains, n_closed)``: a shapely geometry, a list of shapely
+    LineStrings (thin walls before clipping) and the number of closed components.
+    """
+    if len(segments) == 0:
+        return shapely.Polygon(), [], 0
+    comp = _components(nodes)
+    ncomp = int(comp.max()) + 1
+    nn = int(nodes.max()) + 1
+    out_deg = np.bincount(nodes[:, 0], minlength=nn)
+    in_deg = np.bincount(nodes[:, 1], minlength=nn)
+    odd = (out_deg + in_deg) % 2 == 1
+    unbalanced = out_deg != in_deg
+    comp_odd = np.bincount(comp, weights=odd[nodes].any(axis=1), minlength=ncomp) > 0
+    comp_unbal = np.bincount(comp, weights=unbalanced[nodes].any(axis=1), minlength=ncomp) > 0
+    x0, z0 = segments[:, 0, 0], segments[:, 0, 1]
+    x1, z1 = segments[:, 1, 0], segments[:, 1, 1]
+    signed = np.bincount(comp, weights=(x0 * z1 - x1 * z0) / 2, minlength=ncomp)
+    consistent = ~comp_odd & ~comp_unbal
+    positive = consistent & (signed > 0)
+    negative = consistent & (signed < 0)
+    seg_pos = positive[comp]
+    solid = _winding_region(segments[seg_pos], tolerance) if seg_pos.any() else shapely.Polygon()
+    hole = np.zeros(ncomp, dtype=bool)
+    if negative.any() and not solid.is_empty:
+        seg_neg = negative[comp]
+        mid = segments[seg_neg].mean(axis=1)
+        # a negative loop lying within solid (up to its own outline) is a hole in it
+        near = shapely.dwithin(solid, shapely.points(mid), tolerance)
+        votes = np.bincount(comp[seg_neg], weights=near, minlength=ncomp)
+        total = np.bincount(comp[seg_neg], minlength=ncomp)
+        hole = negative & (votes > 0.5 * np.maximum(total, 1))
+        if hole.any():
+            solid = _winding_region(segments[(positive | hole)[comp]], tolerance)
+    lone = negative & ~hole
+    if lone.any() and floor is not None and not floor.is_empty:
+        # a lone inward loop with floor all around its outside is a solid whose
+        # faces are wound inside out; with no floor outside it is a room's shell
+        sel = lone[comp]
+        n = normals[sel]
+        n = n / np.maximum(np.hypot(n[:, 0], n[:, 1]), 1e-300)[:, None]
+        probe = segments[sel].mean(axis=1) - 4 * tolerance * n
+        outside = shapely.contains_xy(floor, probe[:, 0], probe[:, 1])
+        votes = np.bincount(comp[sel], weights=outside, minlength=ncomp)
+        total = np.bincount(comp[sel], minlength=ncomp)
+        inverted = lone & (votes > 0.5 * np.maximum(total, 1))
+        if inverted.any():
+            flip = inverted[comp]
+            segments = segments.copy()
+            segments[flip] = segments[flip][:, ::-1]
+            positive = positive | inverted
+            solid = _winding_region(segments[(positive | hole)[comp]], tolerance)
+    thin = ~(positive | hole)
+    chains: list = []
+    if thin.any():
+        sel = thin[comp]
+        order = np.argsort(comp[sel], kind="stable")
+        s = segments[sel][order]
+        lines = shapely.linestrings(s.reshape(-1, 2), indices=np.repeat(np.arange(len(s)), 2))
+        groups = shapely.multilinestrings(lines, indices=np.unique(comp[sel][order], return_inverse=True)[1])
+        chains = list(shapely.get_parts(shapely.line_merge(groups)))
+    return solid, chains, int((~comp_odd).sum())
+
+
+# ---------------------------------------------------------------------------
+# 4-5. free space and its outline
+
+
+def _merge_positions(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Faces re-indexed so that vertices at the same position share one id."""
+    used, inv = np.unique(faces, return_inverse=True)
+    pos = np.ascontiguousarray(vertices[used], dtype=np.float64)
+    _, merged = np.unique(pos.view(np.dtype((np.void, pos.itemsize * 3))).reshape(-1), return_inverse=True)
+    return merged.reshape(-1)[inv.reshape(faces.shape)]
+
+
+def floor_region(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
+    """The top-view outline of upward faces: a shapely (Multi)Polygon.
+
+    Uses only the faces' boundary edges (edges used by one face), directed so the
+    floor is on their left, and the winding number of the faces of their
+    arrangement; overlapping floor pieces and T-junctions come out right, and no
+    polygon per triangle is ever built.
+    """
+    g = _merge_positions(vertices, faces)
+    # upward faces are clockwise in (x, z); reversing them puts the face on the left
+    e = np.stack([g[:, [0, 2]], g[:, [2, 1]], g[:, [1, 0]]], axis=1).reshape(-1, 2)
+    ev = np.stack([faces[:, [0, 2]], faces[:, [2, 1]], faces[:, [1, 0]]], axis=1).reshape(-1, 2)
+    key = np.minimum(e[:, 0], e[:, 1]) * (int(g.max()) + 1) + np.maximum(e[:, 0], e[:, 1])
+    _, inv, count = np.unique(key, return_inverse=True, return_counts=True)
+    boundary = count[inv.reshape(-1)] == 1
+    seg = vertices[ev[boundary]][:, :, [0, 2]]
+    return _winding_region(seg, tolerance)
+
+
+def _winding_region(seg: np.ndarray, tolerance: float):
+    """Points of positive winding number about directed segments (region on their left)."""
+    if len(seg) == 0:
+        return shapely.Polygon()
+    lines = shapely.linestrings(seg.reshape(-1, 2), indices=np.repeat(np.arange(len(seg)), 2))
+    chains = shapely.get_parts(shapely.line_merge(shapely.multilinestrings(lines), directed=True))
+    chains = shapely.simplify(chains, tolerance / 2)
+    coords, index = shapely.get_coordinates(chains, return_index=True)
+    same = index[1:] == index[:-1]
+    a = coords[:-1][same]
+    b = coords[1:][same]
+    noded = shapely.union_all(chains)
+    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
+    if len(faces) == 0:
+        return shapely.Polygon()
+    rep = shapely.get_coordinates(shapely.point_on_surface(faces))
+    winding = np.zeros(len(rep))
+    # crossing number with signs, a block of faces at a time to bound memory
+    block = max(1, 2_000_000 // max(1, len(a)))
+    for s in range(0, len(rep), block):
+        p = rep[s:s + block, None, :]
+        up = (a[None, :, 1] <= p[..., 1]) & (b[None, :, 1] > p[..., 1])
+        down = (a[None, :, 1] > p[..., 1]) & (b[None, :, 1] <= p[..., 1])
+        side = (b[None, :, 0] - a[None, :, 0]) * (p[..., 1] - a[None, :, 1]) - \
+               (p[..., 0] - a[None, :, 0]) * (b[None, :, 1] - a[None, :, 1])
+        winding[s:s + block] = (up & (side > 0)).sum(axis=1) - (down & (side < 0)).sum(axis=1)
+    return shapely.union_all(faces[winding > 0])
+
+
+def free_space(solid, floor):
+    """The free space: the floor minus the solid, without what lies outside the
+    outer walls (see the module docstring)."""
+    region = shapely.difference(floor, solid)
+    parts = shapely.get_parts(region)
+    if len(parts) == 0:
+        return shapely.Polygon()
+    x0, z0, x1, z1 = shapely.bounds(floor)
+    b = shapely.bounds(parts)
+    eps = 1e-6 * max(1.0, x1 - x0, z1 - z0)
+    touches = (b[:, 0] <= x0 + eps) | (b[:, 1] <= z0 + eps) | (b[:, 2] >= x1 - eps) | (b[:, 3] >= z1 - eps)
+    area = shapely.area(parts)
+    if not touches[int(np.argmax(area))]:
+        parts = parts[~touches]  # the main space is walled in: drop the strips outside
+    return shapely.union_all(parts)
+
+
+def _ring_walls(ring: np.ndarray) -> np.ndarray:
+    """(k, 2, 2) walls along a closed ring (last point == first), starting at its
+    lowest-left vertex."""
+    pts = ring[:-1]
+    start = int(np.lexsort((pts[:, 1], pts[:, 0]))[0])
+    pts = np.roll(pts, -start, axis=0)
+    return np.stack([pts, np.roll(pts, -1, axis=0)], axis=1)
+
+
+def outline_walls(free, tolerance: float) -> np.ndarray:
+    """Walls along the boundary of ``free`` with free space on their left, so that
+    Direction +1 gives normals into free space.  (n, 2, 2)."""
+    free = shapely.simplify(free, tolerance, preserve_topology=True)
+    free = shapely.orient_polygons(free, exterior_cw=False)  # exterior CCW, holes CW
+    out = []
+    for poly in shapely.get_parts(free):
+        for ring in [poly.exterior, *poly.interiors]:
+            out.append(_ring_walls(np.asarray(ring.coords)))
+    if not out:
+        return np.zeros((0, 2, 2))
+    walls = np.concatenate(out)
+    length = np.hypot(*(walls[:, 1] - walls[:, 0]).T)
+    return walls[length >= tolerance]
+
+
+def thin_walls(chains: list, free, tolerance: float) -> np.ndarray:
+    """Open cut chains where they cross free space, as (n, 2, 2) segments."""
+    if not chains or free.is_empty:
+        return np.zeros((0, 2, 2))
+    lines = shapely.simplify(np.array(chains, dtype=object), tolerance)
+    inside = shapely.intersection(lines, free)
+    # a chain lying on the free space's outline is already a wall there
+    inside = shapely.difference(inside, shapely.buffer(shapely.boundary(free), tolerance, cap_style="flat"))
+    parts = shapely.get_parts(shapely.line_merge(shapely.union_all(inside)))
+    parts = parts[shapely.get_type_id(parts) == 1]
+    if len(parts) == 0:
+        return np.zeros((0, 2, 2))
+    coords, index = shapely.get_coordinates(parts, return_index=True)
+    same = index[1:] == index[:-1]
+    seg = np.stack([coords[:-1][same], coords[1:][same]], axis=1)
+    length = np.hypot(*(seg[:, 1] - seg[:, 0]).T)
+    return seg[length >= tolerance]
+
+
+#: gap between the walls' extent and the auxiliary rectangle (m)
+AUX_MARGIN = 1.0
+
+
+def _plane_clear_of_vertices(vertices: np.ndarray, y: float) -> float:
+    """Nudge the cut plane off any vertex lying on it (no on-plane special cases)."""
+    step = 1e-6 * max(1.0, abs(y))
+    for _ in range(8):
+        if not np.any(np.abs(vertices[:, 1] - y) < step / 4):
+            return y
+        y -= step
+    return y
+
+
+def extract_walls(vertices: np.ndarray, faces: np.ndarray, height: float = 1.0, tolerance: float = 0.01,
+                  progress: Callable[[str], None] | None = None) -> WallExtraction:
+    """Extract the wall list of an arena model (world frame, Y up, metres).
+
+    vertices (n, 3) float, faces (m, 3) int.  ``height`` is the cut height above
+    the floor, ``tolerance`` the shortest wall kept and the snapping grid.  Raises
+    ArenaError when no free space remains at that height.
+    """
+    if not (math.isfinite(height) and height > 0):
+        raise ArenaError(f"--height must be a positive number of metres, got {height}")
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise ArenaError(f"--tolerance must be a positive number of metres, got {tolerance}")
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    if len(faces) == 0:
+        raise ArenaError("the model has no triangles")
+    if not np.isfinite(vertices).all():
+        raise ArenaError("the model has non-finite vertices (NaN or inf)")
+    step = progress or (lambda _name: None)
+    t = {}
+    t0 = time.perf_counter()
+    floor = find_floor(vertices, faces)
+    cut_y = _plane_clear_of_vertices(vertices, floor.y + height)
+    t["floor"] = time.perf_counter() - t0
+    step("floor")
+    t0 = time.perf_counter()
+    seg, nrm, nodes = slice_mesh(vertices, faces, cut_y)
+    t["cut"] = time.perf_counter() - t0
+    step("cut")
+    t0 = time.perf_counter()
+    # everything horizontal from the floor level up to the cut is ground a tank
+    # stands on (kerbs, low platforms); higher surfaces are tops of walls
+    ground = floor_faces(vertices, faces, floor.y, cut_y)
+    floor_poly = floor_region(vertices, faces[ground], tolerance)
+    solid, chains, nrings = cross_sections(seg, nrm, nodes, tolerance, floor_poly)
+    t["sections"] = time.perf_counter() - t0
+    step("sections")
+    t0 = time.perf_counter()
+    free = shapely.set_precision(free_space(solid, floor_poly), tolerance)
+    parts = shapely.get_parts(free)
+    # ledges and sills narrower than MIN_FREE_WIDTH everywhere are not arena space
+    wide = ~shapely.is_empty(shapely.buffer(parts, -MIN_FREE_WIDTH / 2, quad_segs=2))
+    free = shapely.union_all(parts[wide]) if wide.any() else shapely.Polygon()
+    if free.is_empty:
+        raise ArenaError(
+            f"no free space at {height:g} m above the floor (floor at y={floor.y:.3f}): "
+            "the cut lies inside solid material everywhere there is floor"
+        )
+    outline = outline_walls(free, tolerance)
+    thin = thin_walls(chains, free, tolerance)
+    t["free"] = time.perf_counter() - t0
+    step("free")
+    segments = np.concatenate([outline, thin, thin[:, ::-1]]) if len(thin) else outline
+    # thin walls: the same segment twice, the copy reversed, both with Direction +1,
+    # i.e. one normal on each side
+    direction = np.ones(len(segments), dtype=np.int8)
+    pts = segments.reshape(-1, 2)
+    lo = pts.min(axis=0) - AUX_MARGIN
+    hi = pts.max(axis=0) + AUX_MARGIN
+    walls = WallList(segments, direction, aux_rectangle(lo[0], lo[1], hi[0], hi[1]))
+    return WallExtraction(walls, floor.y, float(floor.y + height), free, solid, 2 * len(thin), nrings,
+                          len(chains), len(seg), t)

@@ -1,0 +1,166 @@
+"""``tanktool import-arena`` end to end, bad input, and the arena bundle loader."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+from click.testing import CliRunner
+
+from tanktool.arena import load_arena
+from tanktool.cli.main import cli
+from tanktool.errors import ArenaError
+from tanktool.formats.bundle import read_toml, sha256_file
+from tanktool.formats.walls_txt import read_walls
+
+DATA = Path(__file__).resolve().parent / "data"
+
+
+def _box(x0, z0, x1, z1, y0, y1):
+    b = trimesh.creation.box(extents=[x1 - x0, y1 - y0, z1 - z0])
+    b.apply_translation([(x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2])
+    return b
+
+
+def write_room(path: Path, size: float = 30.0) -> Path:
+    parts = [_box(0, 0, size, size, -0.5, 0), _box(0, 0, size, 1, 0, 3), _box(0, size - 1, size, size, 0, 3),
+             _box(0, 0, 1, size, 0, 3), _box(size - 1, 0, size, size, 0, 3), _box(12, 12, 16, 16, 0, 3)]
+    trimesh.util.concatenate(parts).export(path)
+    return path
+
+
+def run(*args: str):
+    return CliRunner().invoke(cli, list(args), catch_exceptions=False)
+
+
+def test_import_writes_a_complete_bundle(tmp_path):
+    model = write_room(tmp_path / "room.obj")
+    out = tmp_path / "arenas" / "room"
+    r = run("import-arena", str(model), "-o", str(out))
+    assert r.exit_code == 0, r.output
+    assert "8 walls" in r.output and "8 spawns" in r.output
+    for f in ("arena.toml", "room.obj", "model.glb", "walls.txt", "preview.png"):
+        assert (out / f).is_file(), f
+    doc = read_toml(out / "arena.toml")
+    assert doc["name"] == "room"
+    assert doc["source"] == {"file": "room.obj", "sha256": sha256_file(model), "up": "y", "scale": 1.0}
+    assert doc["walls"]["count"] == 8 and doc["walls"]["height"] == 1.0
+    assert doc["navgrid"] == {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
+    for f, digest in doc["derived"].items():
+        assert sha256_file(out / f) == digest
+    assert len(doc["spawns"]) >= 8
+    walls = read_walls(out / "walls.txt")
+    assert walls.aux is not None and len(walls) == 8
+    assert np.allclose(doc["bounds"], walls.bounds)
+    # the glb is in the world frame: its floor top is at y = 0
+    scene = trimesh.load(out / "model.glb", force="scene")
+    assert scene.bounds[1][1] == pytest.approx(3.0)
+    assert (out / "preview.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_load_arena_reads_the_bundle(tmp_path):
+    model = write_room(tmp_path / "room.obj", 40)
+    out = tmp_path / "room"
+    assert run("-q", "import-arena", str(model), "-o", str(out), "--name", "hall").exit_code == 0
+    a = load_arena(out)
+    assert a.name == "hall"
+    assert a.spawns.shape == (8, 3)
+    assert len(a.walls) == 8
+    # spawns lie in free space: inside the room, off the pillar, facing the centre
+    x, z = a.spawns[:, 0], a.spawns[:, 1]
+    assert ((x > 1) & (x < 39) & (z > 1) & (z < 39)).all()
+    assert not ((x > 12) & (x < 16) & (z > 12) & (z < 16)).any()
+    assert load_arena(out / "arena.toml").name == "hall"
+    with pytest.raises(ArenaError, match="no arena.toml"):
+        load_arena(tmp_path)
+
+
+def test_refuses_to_overwrite_without_force(tmp_path):
+    model = write_room(tmp_path / "room.obj")
+    out = tmp_path / "room"
+    assert run("import-arena", str(model), "-o", str(out)).exit_code == 0
+    before = sha256_file(out / "walls.txt")
+    r = run("import-arena", str(model), "-o", str(out), "--height", "2")
+    assert r.exit_code == 2 and "--force" in r.output
+    assert sha256_file(out / "walls.txt") == before
+    r = run("import-arena", str(model), "-o", str(out), "--height", "2", "--force")
+    assert r.exit_code == 0
+    assert read_toml(out / "arena.toml")["walls"]["height"] == 2.0
+
+
+def test_default_output_is_named_after_the_model(tmp_path, monkeypatch):
+    model = write_room(tmp_path / "src.obj")
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
+    assert run("import-arena", str(model)).exit_code == 0
+    assert (work / "src" / "arena.toml").is_file()
+
+
+def _bad_inputs(tmp_path: Path) -> dict[str, tuple[Path, str]]:
+    text = tmp_path / "notes.obj"
+    text.write_text("this is not a model\n")
+    nan = tmp_path / "nan.obj"
+    nan.write_text("v 0 0 0\nv 1 0 0\nv nan 0 1\nf 1 2 3\n")
+    empty3ds = tmp_path / "empty.3ds"
+    empty3ds.write_bytes(b"")
+    block = tmp_path / "block.obj"
+    trimesh.util.concatenate([_box(0, 0, 10, 10, -1, 0), _box(0, 0, 10, 10, 0, 5)]).export(block)
+    wall = tmp_path / "wall.obj"
+    wall.write_text("v 0 0 0\nv 1 0 0\nv 1 3 0\nf 1 2 3\n")
+    return {
+        "missing": (tmp_path / "nope.obj", "no such file"),
+        "not a model": (text, "no triangles"),
+        "nan": (nan, "not finite"),
+        "empty 3ds": (empty3ds, "empty"),
+        "no free space": (block, "no free space"),
+        "no floor": (wall, "horizontal surface"),
+        "unknown kind": (tmp_path / "notes.txt", "no such file"),
+    }
+
+
+@pytest.mark.parametrize("case", ["missing", "not a model", "nan", "empty 3ds", "no free space", "no floor",
+                                  "unknown kind"])
+def test_bad_input_is_one_line_exit_2_nothing_written(tmp_path, case):
+    path, expect = _bad_inputs(tmp_path)[case]
+    out = tmp_path / "out"
+    r = CliRunner().invoke(cli, ["import-arena", str(path), "-o", str(out)])
+    assert r.exit_code == 2, r.output
+    assert expect in r.output
+    err = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert len(err) == 1 and err[0].startswith("error: ")
+    assert not out.exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".out")]
+
+
+def test_bad_options_exit_2(tmp_path):
+    model = write_room(tmp_path / "room.obj")
+    for opts in (["--height", "-1"], ["--tolerance", "0"], ["--height", "nan"]):
+        r = CliRunner().invoke(cli, ["import-arena", str(model), "-o", str(tmp_path / "o"), *opts])
+        assert r.exit_code == 2, (opts, r.output)
+        assert not (tmp_path / "o").exists()
+
+
+def test_3ds_model_is_read_z_up(tmp_path):
+    from tanktool.formats.threeds import scene_to_3ds_objects, write_3ds
+
+    room = trimesh.load(write_room(tmp_path / "room.obj"), force="mesh")
+    write_3ds(tmp_path / "room.3ds", scene_to_3ds_objects(room))
+    out = tmp_path / "r3"
+    assert run("import-arena", str(tmp_path / "room.3ds"), "-o", str(out)).exit_code == 0
+    doc = read_toml(out / "arena.toml")
+    assert doc["source"]["up"] == "z"
+    assert doc["walls"]["count"] == 8
+    assert doc["floor_y"] == pytest.approx(0.0, abs=1e-6)
+
+
+@pytest.mark.skipif(not (DATA / "arenas_obj" / "dungeon.obj").exists(), reason="test model missing")
+def test_dungeon_imports(tmp_path):
+    out = tmp_path / "dungeon"
+    r = run("import-arena", str(DATA / "arenas_obj" / "dungeon.obj"), "-o", str(out))
+    assert r.exit_code == 0, r.output
+    a = load_arena(out)
+    assert a.floor_y == pytest.approx(10.0, abs=0.05)
+    assert len(a.walls) > 100 and len(a.spawns) == 8

@@ -1,0 +1,175 @@
+"""Wall extraction on small hand-made arenas and on a real level mesh."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+import trimesh
+
+from tanktool.errors import ArenaError
+from tanktool.geometry.spawns import place_spawns
+from tanktool.geometry.walls import extract_walls, find_floor, slice_mesh
+
+DATA = Path(__file__).resolve().parent / "data"
+
+
+def slab(x0, z0, x1, z1, y0=-0.5, y1=0.0):
+    """An axis-aligned box from (x0, y0, z0) to (x1, y1, z1)."""
+    b = trimesh.creation.box(extents=[x1 - x0, y1 - y0, z1 - z0])
+    b.apply_translation([(x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2])
+    return b
+
+
+def room(size=40.0, t=1.0, h=4.0):
+    """A floor slab and four wall boxes: free inside [t, size - t]^2."""
+    return [
+        slab(0, 0, size, size),
+        slab(0, 0, size, t, 0, h), slab(0, size - t, size, size, 0, h),
+        slab(0, 0, t, size, 0, h), slab(size - t, 0, size, size, 0, h),
+    ]
+
+
+def join(parts):
+    m = trimesh.util.concatenate(parts)
+    return m.vertices, m.faces
+
+
+def midpoints_inside(solid, walls, eps=1e-3):
+    """Wall midpoints pushed a little against their normal must be in solid
+    (or on a thin wall, nothing): used to check normals face free space."""
+    mid = walls.segments.mean(axis=1)
+    n = walls.normals
+    into_free = mid + eps * n
+    into_solid = mid - eps * n
+    return into_free, into_solid
+
+
+def test_room_is_four_walls_with_inward_normals():
+    ex = extract_walls(*join(room()))
+    w = ex.walls
+    assert len(w) == 4
+    assert ex.floor_y == pytest.approx(0.0)
+    pts = w.segments.reshape(-1, 2)
+    assert np.allclose(np.sort(np.unique(pts[:, 0])), [1, 39])
+    assert np.allclose(np.sort(np.unique(pts[:, 1])), [1, 39])
+    # every normal points to the centre of the room
+    mid = w.segments.mean(axis=1)
+    assert ((np.array([20, 20]) - mid) * w.normals).sum(axis=1).min() > 0
+    # auxiliary rectangle encloses the walls with a margin
+    (x0, z0), (x1, z1) = w.bounds
+    assert x0 < 1 and z0 < 1 and x1 > 39 and z1 > 39
+    assert shapely.area(ex.free) == pytest.approx(38 * 38, rel=1e-6)
+
+
+def test_overlapping_boxes_leave_no_wall_buried_in_solid():
+    parts = room() + [slab(10, 10, 20, 20, 0, 3), slab(15, 15, 25, 25, 0, 3), slab(17, 17, 19, 19, 0, 3.5)]
+    ex = extract_walls(*join(parts))
+    w = ex.walls
+    into_free, into_solid = midpoints_inside(ex.solid, w)
+    # the small box is inside the overlap: nothing of it may remain
+    assert not np.any(np.all((w.segments > 16.9) & (w.segments < 19.1), axis=(1, 2)))
+    # the union outline of the two pillars is 8 walls, plus the room's 4
+    assert len(w) == 12
+    assert shapely.contains_xy(ex.free, into_free[:, 0], into_free[:, 1]).all()
+    assert not shapely.contains_xy(ex.free, into_solid[:, 0], into_solid[:, 1]).any()
+
+
+def test_single_quad_wall_is_a_thin_wall_with_both_normals():
+    quad = trimesh.Trimesh(vertices=[[10, 0, 20], [30, 0, 20], [30, 3, 20], [10, 3, 20]], faces=[[0, 1, 2], [0, 2, 3]])
+    ex = extract_walls(*join(room() + [quad]))
+    w = ex.walls
+    on_line = np.all(np.isclose(w.segments[:, :, 1], 20), axis=1)
+    assert on_line.sum() == 2
+    assert ex.thin_walls == 2
+    seg = w.segments[on_line]
+    assert np.allclose(np.sort(seg[:, :, 0], axis=1), [[10, 30], [10, 30]])
+    normals = w.normals[on_line]
+    assert np.allclose(sorted(normals[:, 1]), [-1, 1])
+
+
+def test_collinear_pieces_merge_and_floating_geometry_is_ignored():
+    # the north wall made of four abutting boxes, and a box floating at 5 m
+    parts = [slab(0, 0, 40, 40), slab(0, 0, 40, 1, 0, 4), slab(0, 0, 1, 40, 0, 4), slab(39, 0, 40, 40, 0, 4)]
+    parts += [slab(10 * k, 39, 10 * k + 10, 40, 0, 4) for k in range(4)]
+    parts += [slab(15, 15, 25, 25, 5, 6)]
+    ex = extract_walls(*join(parts))
+    assert len(ex.walls) == 4
+    north = ex.walls.segments[np.all(np.isclose(ex.walls.segments[:, :, 1], 39), axis=1)]
+    assert len(north) == 1
+    assert abs(north[0, 1, 0] - north[0, 0, 0]) == pytest.approx(38)
+
+
+def test_inverted_winding_and_duplicate_vertices():
+    pillar = slab(18, 18, 22, 22, 0, 3)
+    pillar.invert()  # normals point in: its winding alone would call it a hole
+    m = trimesh.util.concatenate(room() + [pillar])
+    # split every face's vertices apart, as .3ds files with seams do
+    v = m.vertices[m.faces.reshape(-1)]
+    f = np.arange(len(v)).reshape(-1, 3)
+    ex = extract_walls(v, f)
+    assert len(ex.walls) == 8
+    assert not shapely.contains_xy(ex.free, 20.0, 20.0)
+    assert shapely.contains_xy(ex.free, 10.0, 10.0)
+
+
+def test_pieces_shorter_than_tolerance_are_dropped():
+    # a 4 mm bump on the east wall
+    parts = room() + [slab(38.996, 10, 39.0, 30, 0, 4)]
+    ex = extract_walls(*join(parts), tolerance=0.01)
+    assert len(ex.walls) == 4
+    ex_fine = extract_walls(*join(parts), tolerance=0.001)
+    assert len(ex_fine.walls) == 8
+
+
+def test_floor_rule_picks_lowest_large_level():
+    # a small sunken pit at -2 (4 m^2) and the big floor at 0
+    pit = slab(5, 5, 7, 7, -3, -2)
+    fl = find_floor(*join(room() + [pit]))
+    assert fl.y == pytest.approx(0.0)
+    assert [h for h, _ in fl.levels][0] == pytest.approx(-2.0)
+
+
+def test_cut_inside_solid_is_an_error():
+    block = slab(0, 0, 40, 40, -0.5, 5)
+    with pytest.raises(ArenaError, match="no (free space|upward)"):
+        extract_walls(*join([slab(0, 0, 40, 40, -1, -0.5), block]))
+
+
+def test_slice_segments_close_into_rings_and_carry_normals():
+    b = slab(0, 0, 2, 2, 0, 2)
+    seg, nrm, nodes = slice_mesh(b.vertices, b.faces, 1.0)
+    assert len(seg) == 8
+    assert (np.bincount(nodes.ravel()) == 2).all()
+    # normals on the right of each segment and pointing out of the box
+    mid = seg.mean(axis=1)
+    assert ((mid - 1.0) * nrm).sum(axis=1).min() > 0
+
+
+def test_spawns_spread_and_face_the_centre():
+    ex = extract_walls(*join(room(60)))
+    sp = place_spawns(ex.free, ex.walls.bounds)
+    assert sp.shape == (8, 3)
+    d = np.hypot(*(sp[:, None, :2] - sp[None, :, :2]).transpose(2, 0, 1))
+    assert d[~np.eye(8, dtype=bool)].min() > 10  # spread over a 58 m room
+    wall_dist = np.min(np.abs(np.concatenate([sp[:, :2] - 1, 59 - sp[:, :2]], axis=1)), axis=1)
+    assert wall_dist.min() >= 2.5 - 1e-9
+    to_c = np.array([30, 30]) - sp[:, :2]
+    f = np.stack([np.cos(sp[:, 2]), np.sin(sp[:, 2])], axis=1)
+    assert ((f * to_c).sum(axis=1) / np.hypot(*to_c.T)).min() > 0.999
+
+
+@pytest.mark.skipif(not (DATA / "arenas_obj" / "dungeon.obj").exists(), reason="test model missing")
+def test_dungeon_main_level():
+    m = trimesh.load(DATA / "arenas_obj" / "dungeon.obj", force="mesh", process=False)
+    ex = extract_walls(m.vertices, m.faces)
+    # the big storey at y ~ 10 (1200 m^2 of floor), not the small pieces near y = 0
+    assert ex.floor_y == pytest.approx(10.0, abs=0.05)
+    assert 1000 < ex.free.area < 1400
+    w = ex.walls
+    into_free = w.segments.mean(axis=1) + 0.02 * w.normals
+    assert shapely.contains_xy(ex.free, into_free[:, 0], into_free[:, 1]).mean() > 0.95
+    sp = place_spawns(ex.free, w.bounds)
+    assert shapely.contains_xy(ex.free, sp[:, 0], sp[:, 1]).all()
