@@ -32,6 +32,7 @@ def test_headings_follow_the_world_convention():
     assert [turn_left(turn_right(h)) for h in ("+x", "+z", "-x", "-z")] == ["+x", "+z", "-x", "-z"]
     with pytest.raises(ValueError, match="heading must be one of"):
         turn_left("north")
+    assert turn_left(math.pi) == "+z"  # angles are snapped
 
 
 def test_nodes_ahead_mapping_for_all_four_headings():
@@ -82,6 +83,7 @@ def test_unambiguous_right_turn():
     assert kids["ahead"].node == (3, 3) and kids["ahead"].heading == "+x" and kids["ahead"].ahead == 1
     assert kids["right"].node == (4, 3) and kids["right"].heading == "+z" and kids["right"].ahead == 5
     assert choose_next(g, (3, 2), "+x") == (4, 3)
+    assert choose_next(g, (3, 2), 0.1) == (4, 3)  # a world angle snaps to +x
     # mirrored (rows reversed): the long corridor is now on the left
     m = grid_from_mask(mask(UNAMBIGUOUS)[::-1])
     assert choose_next(m, (7, 2), "+x") == (6, 3)

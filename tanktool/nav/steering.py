@@ -55,9 +55,12 @@ def turn_left(heading: str) -> str:
     return HEADINGS[(HEADINGS.index(_check(heading)) - 1) % 4]
 
 
-def _check(heading: str) -> str:
+def _check(heading: str | float) -> str:
+    """A grid heading; a number is taken as a world heading angle and snapped."""
+    if isinstance(heading, (int, float)) and not isinstance(heading, bool):
+        return heading_from_angle(float(heading))
     if heading not in STEPS:
-        raise ValueError(f"heading must be one of {', '.join(HEADINGS)}, got {heading!r}")
+        raise ValueError(f"heading must be one of {', '.join(HEADINGS)} or an angle in radians, got {heading!r}")
     return heading
 
 
@@ -120,8 +123,13 @@ def decide(scores: dict[str, int]) -> str | None:
     return None  # unreachable
 
 
-def choose_next(grid: NavGrid, node: Node, heading: str) -> Node | None:
-    """The node to move to next from ``node`` facing ``heading`` (see the module doc)."""
+def choose_next(grid: NavGrid, node: Node, heading: str | float) -> Node | None:
+    """The node to move to next from ``node`` facing ``heading`` (see the module doc).
+
+    ``heading`` is "+x", "+z", "-x" or "-z", or a world heading angle in radians
+    (snapped to the nearest of the four).
+    """
+    heading = _check(heading)
     kids = {c.name: c for c in children(grid, node, heading)}
     pick = decide({k: c.ahead for k, c in kids.items()})
     if pick is not None:
