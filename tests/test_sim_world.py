@@ -246,3 +246,17 @@ def test_sim_never_imports_pygame_or_matplotlib():
             "print('pygame' in sys.modules, 'matplotlib' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.split() == ["False", "False"]
+
+
+def test_bounds_become_walls_when_the_list_has_no_auxiliary_rectangle():
+    from tanktool.formats.walls_txt import WallList
+
+    walls = WallList(np.array([[[20.0, 0.0], [20.0, 10.0]]]), np.ones(1, np.int8), None)
+    spec = TankSpec.box("t")
+    w = World(walls, [spec], [(10.0, 20.0, math.pi / 2)], bounds=[[0.0, 0.0], [40.0, 30.0]])
+    t = w.tanks[0]
+    t.place(10.0, 20.0, math.pi / 2)
+    for _ in range(1200):
+        w.step(None, [Command(advance=1.0)])
+    assert len(w.walls) == 5
+    assert max(z for _, z in t.hull_world()) <= 30.0 + 1e-3 and t.wall_bumps >= 1

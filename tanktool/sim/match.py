@@ -37,6 +37,7 @@ class ArenaInfo:
     walls: Any                    # WallList
     spawns: np.ndarray            # (k, 3) [x, z, heading]
     path: Path | None
+    bounds: np.ndarray | None = None
 
 
 @dataclass
@@ -83,7 +84,7 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
 
         bundle = load_arena(path)
         spawns = np.asarray(bundle.spawns, dtype=np.float64).reshape(-1, 3)
-        return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path))
+        return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path), np.asarray(bundle.bounds, float))
     from ..formats.bundle import read_toml
     from ..formats.walls_txt import read_walls
 
@@ -97,7 +98,13 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
         raise ArenaError(f"{manifest}: 'spawns' must be a list of [x, z, heading] triples") from None
     if not np.isfinite(spawns).all():
         raise ArenaError(f"{manifest}: spawns must be finite numbers")
-    return ArenaInfo(str(doc.get("name", path.name)), walls, spawns, path)
+    bounds = None
+    if doc.get("bounds") is not None:
+        try:
+            bounds = np.asarray(doc["bounds"], dtype=np.float64).reshape(2, 2)
+        except (TypeError, ValueError):
+            raise ArenaError(f"{manifest}: 'bounds' must be [[xmin, zmin], [xmax, zmax]]") from None
+    return ArenaInfo(str(doc.get("name", path.name)), walls, spawns, path, bounds)
 
 
 def load_tank_spec(ref: str | Path | None) -> TankSpec:
@@ -124,7 +131,8 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
     if not (seconds > 0 and math.isfinite(seconds)):
         raise TanktoolError(f"--seconds must be a positive number, got {seconds}")
     names = [f"bot{i + 1}" for i in range(bots)]
-    world = World(arena.walls, [spec] * bots, arena.spawns, seed=seed, dt=dt, integrator=integrator, names=names)
+    world = World(arena.walls, [spec] * bots, arena.spawns, seed=seed, dt=dt, integrator=integrator, names=names,
+                  bounds=arena.bounds)
     drivers = make_drivers(world)
     steps = int(round(seconds / dt))
     events = []

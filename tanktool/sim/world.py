@@ -86,6 +86,8 @@ class World:
     seed : seeds the world's random generator (initial spawn order, respawn choice)
     dt : default step length [s]
     integrator : "semi-implicit" (default) or "euler"
+    bounds : (2, 2) arena bounds (default: the wall list's); when the wall list has no
+             auxiliary rectangle, this rectangle is added as walls
     wall_index : the wall quadtree (``nav.quadtree.WallQuadtree``, built here by default
                  with leaves of about 12 m, or ``quadtree_depth``) or any object with
                  exact ``query_point`` and ``query_segment``
@@ -94,18 +96,27 @@ class World:
     def __init__(self, walls: Any, specs: Sequence[TankSpec], spawns: Any, *, seed: int = 0,
                  dt: float = DT, integrator: str = "semi-implicit", wall_index: WallIndex | None = None,
                  names: Sequence[str] | None = None, respawn_delay: float = 3.0,
-                 max_iterations: int = 8, wall_slack: float = 2.0, quadtree_depth: int | None = None) -> None:
+                 max_iterations: int = 8, wall_slack: float = 2.0, quadtree_depth: int | None = None,
+                 bounds: Any = None) -> None:
         if integrator not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
         if not (dt > 0 and math.isfinite(dt)):
             raise ValueError(f"dt must be a positive number of seconds, got {dt}")
         if hasattr(walls, "all_segments"):
             segments = walls.all_segments()
-            self.bounds = np.asarray(walls.bounds, dtype=np.float64)
+            has_aux = getattr(walls, "aux", None) is not None
+            wb = np.asarray(walls.bounds, dtype=np.float64)
         else:
             segments = np.asarray(walls, dtype=np.float64).reshape(-1, 2, 2)
+            has_aux = False
             pts = segments.reshape(-1, 2)
-            self.bounds = np.array([pts.min(axis=0), pts.max(axis=0)])
+            wb = np.array([pts.min(axis=0), pts.max(axis=0)]) if len(pts) else np.zeros((2, 2))
+        self.bounds = wb if bounds is None else np.asarray(bounds, dtype=np.float64).reshape(2, 2)
+        if not has_aux and bounds is not None:
+            # nothing may leave the arena: its bounding rectangle becomes four more walls
+            (x0, z0), (x1, z1) = self.bounds.tolist()
+            rect = np.array([[[x0, z0], [x1, z0]], [[x1, z0], [x1, z1]], [[x1, z1], [x0, z1]], [[x0, z1], [x0, z0]]])
+            segments = np.concatenate([segments.reshape(-1, 2, 2), rect])
         if wall_index is None:
             span = float(np.max(self.bounds[1] - self.bounds[0])) if len(segments) else 1.0
             depth = quadtree_depth if quadtree_depth is not None else int(min(max(round(math.log2(max(span, 1.0) / 12.0)), 2), 6))
