@@ -30,12 +30,18 @@ import os
 import struct
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, BinaryIO, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, BinaryIO, Iterator, Sequence, Union
 
 import numpy as np
 
 from ..errors import FormatError
 from .bundle import atomic_write_bytes
+
+if TYPE_CHECKING:
+    import trimesh
+
+#: what :func:`write_3ds` takes: (name, vertices (n, 3) Z-up, faces (m, 3), diffuse rgb 0..1)
+Object3DS = tuple[str, np.ndarray, np.ndarray, tuple[float, float, float]]
 
 __all__ = [
     "DEFAULT_COLOR",
@@ -43,6 +49,7 @@ __all__ = [
     "Material",
     "MeshObject",
     "Model3DS",
+    "Object3DS",
     "TextureMap",
     "encode_3ds",
     "load_scene",
@@ -614,7 +621,7 @@ def _scene_metadata(model: Model3DS) -> dict[str, Any]:
     }
 
 
-def load_scene(path: str | os.PathLike):
+def load_scene(path: str | os.PathLike) -> "trimesh.Scene":
     """Read ``path`` as a ``trimesh.Scene`` in the file's own axes (Z up).
 
     One geometry per mesh object with faces, named after the object; per-face
@@ -822,7 +829,7 @@ def _mesh_face_rgb(mesh: Any) -> np.ndarray:
     return np.tile(np.array(DEFAULT_COLOR[:3], dtype=np.uint8), (m, 1))
 
 
-def scene_to_3ds_objects(geometry: Any) -> list[tuple[str, np.ndarray, np.ndarray, tuple[float, float, float]]]:
+def scene_to_3ds_objects(geometry: Union["trimesh.Trimesh", "trimesh.Scene"]) -> list[Object3DS]:
     """Turn a Y-up ``trimesh.Trimesh`` or ``trimesh.Scene`` into :func:`write_3ds` objects.
 
     Scene transforms are applied; axes go back to the 3DS convention
