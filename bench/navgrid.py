@@ -2,10 +2,9 @@
 
 Cases:
 
-* **dungeon**: Recast's ``dungeon.obj`` (../shared/testdata/arenas_obj/), cell 0.3 m,
-  clearance 0.6 m (Recast's demo settings).  Its walls are a horizontal section
-  of the mesh 1 m above its main floor (the floor height with the largest area,
-  y = 10), cut here with trimesh, face normals giving each wall's Direction.
+* **dungeon**: Recast's ``dungeon.obj`` (tests/data/arenas_obj/), cell 0.3 m,
+  clearance 0.6 m (Recast's demo settings), walls extracted as ``import-arena``
+  does (a section 1 m above the floor, solids by winding number, thin walls).
 * **maze 1000x1000**: a block maze 100 m square at cell 0.1 m = 1,000,000 nodes.
 
 For each: ``ours`` is the whole build (free-space classification, clearance, row and
@@ -48,61 +47,27 @@ from tanktool.nav.navgrid import (  # noqa: E402
 from tanktool.nav.quadtree import WallQuadtree  # noqa: E402
 from tanktool.nav.synthetic import block_maze  # noqa: E402
 
-DUNGEON = ROOT.parent / "shared" / "testdata" / "arenas_obj" / "dungeon.obj"
+DUNGEON = [ROOT / "tests" / "data" / "arenas_obj" / "dungeon.obj",
+           ROOT.parent / "shared" / "testdata" / "arenas_obj" / "dungeon.obj"]
 GOALS = {"dungeon_ms": 30.0, "grid1000_ms": 150.0, "vs_2002": 100.0}
 
 
-def dungeon_walls(path: Path = DUNGEON) -> tuple[WallList, str]:
-    """Walls of the dungeon's main level: a section 1 m above its largest floor."""
+def dungeon_walls(path: Path | None = None) -> tuple[WallList, np.ndarray, str]:
+    """The dungeon's walls and spawn points as ``import-arena`` makes them."""
     import trimesh
 
-    m = trimesh.load(str(path), force="mesh")
-    up = m.face_normals[:, 1] > 0.9
-    heights = np.round(m.triangles_center[up][:, 1])
-    levels, inv = np.unique(heights, return_inverse=True)
-    floor = float(levels[np.argmax(np.bincount(inv, weights=m.area_faces[up]))])
-    y = floor + 1.0
-    lines, faces = trimesh.intersections.mesh_plane(m, [0, 1, 0], [0, y, 0], return_faces=True)
-    seg = np.round(lines[:, :, [0, 2]], 4)  # as walls.txt stores them
-    d = seg[:, 1] - seg[:, 0]
-    keep = np.hypot(d[:, 0], d[:, 1]) > 0
-    seg, d, faces = seg[keep], d[keep], faces[keep]
-    # the face normal points out of the solid, i.e. into free space
-    fn = m.face_normals[faces][:, [0, 2]]
-    left = np.stack([-d[:, 1], d[:, 0]], axis=1)
-    direction = np.where((left * fn).sum(axis=1) >= 0, 1, -1).astype(np.int8)
-    lo = np.floor(seg.reshape(-1, 2).min(axis=0)) - 1
-    hi = np.ceil(seg.reshape(-1, 2).max(axis=0)) + 1
-    walls = WallList(seg, direction, aux_rectangle(lo[0], lo[1], hi[0], hi[1]))
-    walls, added = close_gaps(walls, 0.5)
-    return walls, f"trimesh section at y = {y:g} (main floor {floor:g} + 1 m), {added} gaps < 0.5 m closed"
+    from tanktool.formats.models import load_scene
+    from tanktool.geometry.spawns import place_spawns
+    from tanktool.geometry.walls import extract_walls
 
-
-def close_gaps(walls: WallList, tol: float) -> tuple[WallList, int]:
-    """Join loose wall ends closer than ``tol`` (the mesh is not watertight): each end
-    where a wall arrives is joined to the nearest end where one leaves."""
-    A, B = _oriented(walls)
-    pts = np.concatenate([A, B])
-    verts, inv = np.unique(pts, axis=0, return_inverse=True)
-    inv = inv.reshape(-1)
-    bal = np.bincount(inv[: len(A)], minlength=len(verts)) - np.bincount(inv[len(A):], minlength=len(verts))
-    arrive = list(np.flatnonzero(bal < 0))   # more walls end here than start
-    leave = set(np.flatnonzero(bal > 0).tolist())
-    new = []
-    for a in arrive:
-        if not leave:
-            break
-        cand = np.array(sorted(leave))
-        d = np.hypot(*(verts[cand] - verts[a]).T)
-        k = int(np.argmin(d))
-        if d[k] <= tol:
-            new.append([verts[a], verts[cand[k]]])
-            leave.discard(int(cand[k]))
-    if not new:
-        return walls, 0
-    seg = np.concatenate([walls.segments, np.array(new)])
-    direction = np.concatenate([walls.direction, np.ones(len(new), dtype=np.int8)])  # oriented: free on the left
-    return WallList(seg, direction, walls.aux), len(new)
+    path = path or next(p for p in DUNGEON if p.exists())
+    scene = load_scene(path)
+    meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
+    ex = extract_walls(mesh.vertices, mesh.faces, height=1.0, tolerance=0.01)
+    spawns = place_spawns(ex.free, ex.walls.bounds)
+    return ex.walls, spawns, (f"tanktool.geometry.walls.extract_walls, cut at y = {ex.cut_y:g} "
+                      f"(floor {ex.floor_y:g} + 1 m), {ex.thin_walls} thin-wall halves")
 
 
 def free_polygon(walls: WallList):
@@ -184,9 +149,9 @@ def main(argv: list[str] | None = None) -> int:
 
     rows = []
     source = None
-    if DUNGEON.exists():
-        walls, source = dungeon_walls()
-        rows.append(run_case("dungeon", walls, 0.3, 0.6, np.array([[0.0, -20.0, 0.0]]), walls.bounds,
+    if any(p.exists() for p in DUNGEON):
+        walls, spawns, source = dungeon_walls()
+        rows.append(run_case("dungeon", walls, 0.3, 0.6, spawns, walls.bounds,
                              args.repeat, args.sample, rng))
     maze = block_maze(1, n=12)  # 25 x 25 blocks of 4 m = 100 m
     rows.append(run_case("maze 1000x1000", maze, 0.1, 0.6, np.array([[6.0, 6.0, 0.0]]),

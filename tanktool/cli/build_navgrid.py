@@ -44,10 +44,8 @@ class Target:
 
 
 def open_target(path: Path) -> Target:
-    """An arena bundle folder (or its arena.toml), or a bare walls file."""
-    import numpy as np
-
-    from ..formats.bundle import read_toml
+    """An arena bundle folder (or its arena.toml), read by ``load_arena``, or a bare walls file."""
+    from ..arena import load_arena
     from ..formats.walls_txt import read_walls
 
     if path.is_file() and path.name == "arena.toml":
@@ -61,29 +59,11 @@ def open_target(path: Path) -> Target:
         # outputs next to it; named after it unless it is the usual walls.txt
         prefix = "" if path.name == "walls.txt" else f"{path.stem}."
         return Target(walls, path.parent, path.stem, walls.bounds, prefix=prefix)
-    manifest = path / "arena.toml"
-    if not manifest.exists():
-        raise ArenaError(f"{path}: not an arena bundle (no arena.toml)")
-    doc = read_toml(manifest)
-    wfile = path / str(doc.get("walls", {}).get("file", "walls.txt"))
-    walls = read_walls(wfile)
-    if len(walls) == 0:
-        raise ArenaError(f"{wfile}: no walls")
-    bounds = walls.bounds
-    if "bounds" in doc:
-        try:
-            bounds = np.array(doc["bounds"], dtype=np.float64).reshape(2, 2)
-        except (TypeError, ValueError):
-            raise ArenaError(f"{manifest}: bounds must be [[xmin, zmin], [xmax, zmax]], got {doc['bounds']!r}") from None
-        if not (np.isfinite(bounds).all() and (bounds[1] > bounds[0]).all()):
-            raise ArenaError(f"{manifest}: bounds {bounds.tolist()} have no area")
-    spawns = None
-    if doc.get("spawns"):
-        try:
-            spawns = np.array(doc["spawns"], dtype=np.float64).reshape(len(doc["spawns"]), 3)
-        except (TypeError, ValueError):
-            raise ArenaError(f"{manifest}: spawns must be a list of [x, z, heading], got {doc['spawns']!r}") from None
-    return Target(walls, path, str(doc.get("name", path.name)), bounds, spawns, manifest, doc)
+    arena = load_arena(path)
+    if len(arena.walls) == 0:
+        raise ArenaError(f"{arena.file('walls')}: no walls")
+    spawns = arena.spawns if len(arena.spawns) else None
+    return Target(arena.walls, arena.path, arena.name, arena.bounds, spawns, arena.path / "arena.toml", arena.toml)
 
 
 def default_clearance(target: Target) -> tuple[float, str]:
