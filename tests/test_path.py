@@ -151,3 +151,29 @@ def test_grid_line_of_sight_equals_dense_sampling():
                 cells |= set(zip(zi[inside].tolist(), xj[inside].tolist()))
         expect = all(valid[c] for c in cells)
         assert grid_line_of_sight(g, a, b) == expect, (a, b)
+
+
+def test_find_path_in_world_coordinates():
+    from tanktool.nav.path import find_path
+
+    w = block_maze(3, n=4)
+    g = build_navgrid(w, cell=0.5, clearance=1.0)
+    q = WallQuadtree.build(w.segments, w.bounds)
+    free = g.centres(np.argwhere(g.valid))
+    start, goal = tuple(free[0]), tuple(free[-1])
+    for pts in (find_path(g, start, goal), find_path(g, start, goal, quadtree=q)):
+        assert np.allclose(pts[0], start) and np.allclose(pts[-1], goal) and len(pts) >= 2
+        s = w.segments
+        for a, b in zip(pts, pts[1:]):  # every leg keeps (almost) the clearance
+            assert segment_segment_dist2(a, b, s[:, 0], s[:, 1]).min() > 0.5 ** 2
+    # starting inside the clearance band snaps to the nearest valid node
+    near_wall = (free[0][0] - 0.6, free[0][1])
+    assert len(find_path(g, near_wall, goal)) >= 2
+    # a point deep inside solid ground (the maze's outer blocks are 4 m, 8 cells,
+    # thick): no valid node within 4 cells, so no path
+    from scipy.ndimage import binary_dilation
+
+    near_valid = binary_dilation(g.valid, iterations=5, structure=np.ones((3, 3), bool))
+    deep = np.argwhere(~near_valid)
+    assert len(deep)
+    assert find_path(g, g.centre(*deep[len(deep) // 2]), goal).shape == (0, 2)

@@ -182,3 +182,33 @@ def smooth_path(
     if nodes_given:
         return [tuple(map(int, path[k])) for k in keep]
     return pts[keep]
+
+
+def find_path(
+    grid: NavGrid, start: tuple[float, float], goal: tuple[float, float], *,
+    quadtree: WallQuadtree | None = None, clearance: float | None = None, snap: int = 4,
+) -> np.ndarray:
+    """World waypoints (k, 2) from world point ``start`` to ``goal``; (0, 2) when none.
+
+    Both ends snap to the nearest valid node within ``snap`` cells (an agent may stand
+    inside the clearance band); the A* path is smoothed against the quadtree with
+    ``clearance`` (default: the grid's own, a hair less) when one is given, else against
+    the grid.  The first and last waypoints are the given points themselves.
+    """
+    from .navgrid import nearest_valid_node
+
+    s = nearest_valid_node(grid.valid, grid.node_of(*start), snap)
+    g = nearest_valid_node(grid.valid, grid.node_of(*goal), snap)
+    if s is None or g is None:
+        return np.zeros((0, 2))
+    nodes = astar(grid, s, g)
+    if not nodes:
+        return np.zeros((0, 2))
+    if quadtree is not None:
+        r = clearance if clearance is not None else (grid.clearance * 0.999 if np.isfinite(grid.clearance) else 0.0)
+        kept = smooth_path(quadtree, nodes, grid=grid, clearance=r)
+    else:
+        kept = smooth_path(grid, nodes)
+    pts = grid.centres(np.array(kept))
+    return np.concatenate([np.asarray(start, dtype=np.float64)[None], pts[1:-1], np.asarray(goal, dtype=np.float64)[None]]) \
+        if len(pts) >= 2 else np.array([start, goal], dtype=np.float64)
