@@ -33,6 +33,31 @@ def _faces_2d(ax, vertices: np.ndarray, faces: np.ndarray, colours: np.ndarray, 
                                      linewidths=0.3, zorder=1))
 
 
+def _render_view(vertices: np.ndarray, faces: np.ndarray, colours: np.ndarray, axes: tuple[int, int],
+                 depth: int, xlim: tuple[float, float], ylim: tuple[float, float], width_px: int) -> np.ndarray:
+    """The model seen along ``depth`` as an RGBA image covering xlim x ylim.
+
+    Drawn once per view and shown in every panel of that row, so a 30,000-face model
+    costs two renders instead of one per panel.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    aspect = abs(ylim[1] - ylim[0]) / abs(xlim[1] - xlim[0])
+    dpi = 100
+    fig = Figure(figsize=(width_px / dpi, max(width_px * aspect, 1) / dpi), dpi=dpi)
+    fig.patch.set_alpha(0)
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.set_axis_off()
+    ax.patch.set_alpha(0)
+    _faces_2d(ax, vertices, faces, colours, axes, depth, True)
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    return np.asarray(canvas.buffer_rgba()).copy()
+
+
 def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: str = "") -> None:
     """Write the preview PNG for a vehicle-frame ``mesh`` with its hull and sphere tree."""
     import matplotlib
@@ -67,15 +92,18 @@ def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: s
     views = [((0, 2), 1, True, "top (from +y)", "z (m, right side down)"),
              ((0, 1), 2, True, "side (from the right, +z)", "y (m)")]
     for row, (axes, depth, toward, label, ylabel) in enumerate(views):
+        xlim = (lo[axes[0]], hi[axes[0]])
+        # top view: z grows downwards (looking down from +y); side view: y up
+        ylim = (hi[2], lo[2]) if row == 0 else (lo[1], hi[1])
+        image = _render_view(v, f, colours, axes, depth, xlim, ylim, width_px=720)
         for col in range(ncol):
             ax = axs[row, col]
-            _faces_2d(ax, v, f, colours, axes, depth, toward)
+            # extent is (left, right, bottom, top) in data units, matching ylim's order
+            ax.imshow(image, extent=(xlim[0], xlim[1], ylim[0], ylim[1]), origin="upper",
+                      interpolation="antialiased", zorder=1)
             ax.set_aspect("equal")
-            ax.set_xlim(lo[axes[0]], hi[axes[0]])
-            if row == 0:
-                ax.set_ylim(hi[2], lo[2])  # z grows downwards: looking down from +y
-            else:
-                ax.set_ylim(lo[1], hi[1])
+            ax.set_xlim(*xlim)
+            ax.set_ylim(*ylim)
             ax.tick_params(labelsize=7)
             ax.grid(True, lw=0.3, alpha=0.5, zorder=0)
             if col == 0:
