@@ -18,8 +18,9 @@ import shapely
 
 from ..errors import ArenaError
 
-#: default distance from a spawn point to the nearest wall (m)
-SPAWN_CLEARANCE = 2.5
+#: default distance from a spawn point to the nearest wall (m): the bundled heavy
+#: tank's footprint radius is 4.6 m, so it spawns clear of every wall
+SPAWN_CLEARANCE = 5.0
 #: default number of spawn points
 SPAWN_COUNT = 8
 #: upper bound on grid candidates (sets the grid step on big arenas)
