@@ -161,3 +161,17 @@ def test_progress_bar_on_large_grids(bundle, monkeypatch):
     assert "classifying 1,792 nodes" in r.output
     r = CliRunner().invoke(cli, ["-q", "build-navgrid", str(bundle), "--clearance", "1", "--annotate", "none"])
     assert r.exit_code == 0 and r.output == ""
+
+
+@pytest.mark.parametrize("table,message", [
+    ({"cell": "half"}, "[navgrid] cell must be a number > 0, got 'half'"),
+    ({"cell": -1.0}, "[navgrid] cell must be a number > 0"),
+    ({"quadtree_depth": 2.5}, "[navgrid] quadtree_depth must be an integer 0..10"),
+])
+def test_bad_navgrid_table_in_arena_toml(bundle, table, message):
+    doc = read_toml(bundle / "arena.toml")
+    doc["navgrid"].update(table)
+    write_toml(bundle / "arena.toml", doc)
+    r = run(bundle, "--clearance", 1)
+    assert r.exit_code == 2 and r.output.startswith("error: ") and message in r.output, r.output
+    assert "arena.toml" in r.output and not (bundle / "navgrid.npz").exists()

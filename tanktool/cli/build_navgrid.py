@@ -152,13 +152,17 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quad
         raise ArenaError(f"--quadtree-depth must be 0..10, got {quadtree_depth}")
     target = open_target(arena)
     nav_t = target.toml.get("navgrid", {})
+    if not isinstance(nav_t, dict):
+        raise ArenaError(f"{target.manifest}: [navgrid] must be a table")
     if cell is None:
         cell = nav_t.get("cell", DEFAULTS["cell"])
-        _number_option("cell (arena.toml [navgrid])", cell, 0.0, True)
+        if isinstance(cell, bool) or not isinstance(cell, (int, float)) or not (math.isfinite(cell) and cell > 0):
+            raise ArenaError(f"{target.manifest}: [navgrid] cell must be a number > 0, got {cell!r}")
+        cell = float(cell)
     if quadtree_depth is None:
-        quadtree_depth = int(nav_t.get("quadtree_depth", DEFAULTS["quadtree_depth"]))
-        if not 0 <= quadtree_depth <= 10:
-            raise ArenaError(f"{target.manifest}: [navgrid] quadtree_depth must be 0..10, got {quadtree_depth}")
+        quadtree_depth = nav_t.get("quadtree_depth", DEFAULTS["quadtree_depth"])
+        if isinstance(quadtree_depth, bool) or not isinstance(quadtree_depth, int) or not 0 <= quadtree_depth <= 10:
+            raise ArenaError(f"{target.manifest}: [navgrid] quadtree_depth must be an integer 0..10, got {quadtree_depth!r}")
     source = "--clearance"
     if clearance is None:
         clearance, source = default_clearance(target)
@@ -227,7 +231,7 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quad
         f"{n_valid:,} valid, {n_reach:,} reachable, {n_valid - n_reach:,} unreachable "
         f"({t_build * 1000:.0f} ms)"
     )
-    if target.spawns is not None and len(grid.spawn_nodes) < len(target.spawns):
+    if target.spawns is not None and len(grid.spawn_nodes) < len(target.spawns) and not is_quiet():
         click.echo(f"warning: {len(target.spawns) - len(grid.spawn_nodes)} spawn point(s) have no valid node nearby", err=True)
     wrote = [str(grid_path), f"{tree_path} ({len(tree.leaves)} leaves, depth {tree.max_depth})", str(plot_path)]
     if table_path is not None:
