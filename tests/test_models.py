@@ -146,3 +146,32 @@ def test_cli_reports_a_bad_3ds_in_one_line(tmp_path: Path, case: str) -> None:
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"error: {model}: byte 0: ")
     assert not out.exists()
+
+
+def test_truncated_files_are_format_errors(tmp_path: Path) -> None:
+    box = trimesh.creation.box(extents=(2.0, 1.0, 3.0))
+    for ext in ("stl", "ply", "glb", "off", "obj"):
+        data = box.export(file_type=ext)
+        data = data.encode() if isinstance(data, str) else data
+        path = tmp_path / f"cut.{ext}"
+        path.write_bytes(data[: len(data) // 2])
+        with pytest.raises(FormatError, match=rf"cut\.{ext}: "):
+            models.load_model(path)
+    stl = tmp_path / "cut.stl"
+    with pytest.raises(FormatError, match=r"byte 80: binary STL says 12 triangles \(684 bytes\) but the file has 342"):
+        models.load_model(stl)
+    # an ASCII STL is left to trimesh
+    ascii_stl = tmp_path / "ascii.stl"
+    ascii_stl.write_text(box.export(file_type="stl_ascii"))
+    assert len(models.load_model(ascii_stl).faces) == 12
+
+
+def test_gltf_with_its_buffers(tmp_path: Path) -> None:
+    box = trimesh.creation.box(extents=(2.0, 1.0, 3.0))
+    path = tmp_path / "box.gltf"
+    box.export(path)
+    assert len(models.load_model(path).faces) == 12
+    for buffer in tmp_path.glob("*.bin"):
+        buffer.unlink()
+    with pytest.raises(FormatError, match=r"box\.gltf: cannot read as \.gltf"):
+        models.load_model(path)

@@ -51,6 +51,29 @@ def detect_format(path: str | os.PathLike) -> str:
     raise FormatError(f"{path}: not a model file this tool reads (expected one of {kinds})")
 
 
+def _check_binary_stl(path: Path) -> None:
+    """Refuse a damaged binary STL with the byte offset, before trimesh sees it.
+
+    A binary STL is an 80-byte header, a u32 triangle count at byte 80 and 50 bytes
+    per triangle.  trimesh falls back to the ASCII reader when the length is wrong,
+    which fails with an unrelated message; ASCII files start with ``solid``.
+    """
+    size = path.stat().st_size
+    with open(path, "rb") as f:
+        head = f.read(84)
+    if size >= 84 and size == 84 + 50 * int.from_bytes(head[80:84], "little"):
+        return  # consistent binary STL (some start with "solid" too)
+    if head[:5].lower() == b"solid":
+        return  # ASCII STL: trimesh's own reader judges it
+    if size < 84:
+        raise FormatError(f"{path}: byte {size}: binary STL needs an 84-byte header, file has {size} bytes")
+    count = int.from_bytes(head[80:84], "little")
+    raise FormatError(
+        f"{path}: byte 80: binary STL says {count} triangles ({84 + 50 * count} bytes) "
+        f"but the file has {size} bytes"
+    )
+
+
 def default_up(fmt: str) -> str:
     return "z" if fmt == "3ds" else "y"
 
@@ -77,6 +100,8 @@ def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.
         if fmt == "3ds":
             scene = threeds.load_scene(path)
         else:
+            if fmt == "stl":
+                _check_binary_stl(path)
             scene = trimesh.load(str(path), file_type=fmt, force="scene", process=False)
     except FormatError:
         raise
