@@ -178,3 +178,47 @@ def test_passage_width_is_measured_wall_to_wall():
     width, centre = fs.passage(np.array([8.0, 5.2]), 5.0)
     assert width == pytest.approx(3.0, abs=0.01)
     assert centre == pytest.approx([8.5, 5.1], abs=0.01)
+
+
+def test_spawn_clearance_uses_the_footprint_and_heading():
+    from tanktool.check.arena_rules import VehicleSize, blocked_spawns
+
+    # a 4 x 2 m tank 1.5 m from the bottom wall: fine side-on, not facing the wall
+    tank = VehicleSize("t", float(np.hypot(2, 1)), footprint=np.array([[2, 1], [-2, 1], [-2, -1], [2, -1]], float))
+    assert tank.width == pytest.approx(2.0)
+    fs = analyse(_room())
+    spawns = np.array([[5, 1.5, 0.0], [5, 1.5, np.pi / 2]])
+    assert blocked_spawns(fs, spawns, np.array([True, True]), tank) == [1]
+
+
+def test_a_gap_to_the_middle_of_a_wall_is_measured():
+    # the right wall stops 0.5 m short of the top wall, which runs on past it
+    segs = [[[0, 0], [10, 0]], [[10, 0], [10, 9.5]], [[12, 10], [0, 10]], [[0, 10], [0, 0]]]
+    walls = WallList(np.array(segs, float), np.ones(4), aux_rectangle(-1, -1, 13, 11), np.arange(1, 5))
+    from tanktool.check.walls_rules import bare_walls_leaks
+
+    (d,) = bare_walls_leaks(analyse(walls), "w.txt")
+    assert d.code == "A301" and d.line == 2
+    assert "0.50 m wide at (10.00, 9.75)" in d.message
+
+
+def test_glb_reader_matches_trimesh():
+    from tanktool.check.glb import read_glb_triangles
+    from tanktool.formats.models import load_model
+
+    for path in sorted(CLEAN.glob("*/*/model.glb")):
+        v, f = read_glb_triangles(path)
+        mesh = load_model(path, up="y")
+        mine = np.sort(v[f].sum(axis=1), axis=0)
+        theirs = np.sort(np.asarray(mesh.vertices)[np.asarray(mesh.faces)].sum(axis=1), axis=0)
+        assert np.allclose(mine, theirs, atol=1e-6)
+
+
+def test_glb_reader_refuses_what_it_does_not_read(tmp_path):
+    from tanktool.check.glb import read_glb_triangles
+
+    bad = tmp_path / "x.glb"
+    bad.write_bytes(b"glTF\x02\x00\x00\x00\x10\x00\x00\x00garbage")
+    assert read_glb_triangles(bad) is None
+    bad.write_bytes(b"not a glb at all")
+    assert read_glb_triangles(bad) is None

@@ -283,8 +283,8 @@ def make_cases() -> None:
     c = spawn_case("A305", "few_spawns", SPAWNS[:7])
     expect(c, "A305", "arenas/few_spawns", "arenas/few_spawns/arena.toml",
            [line_of(c / "arenas/few_spawns/arena.toml", "spawns = ")])
-    # a corner room behind a 3 m door: the 4.66 m tank cannot get in (no spawn is there)
-    part = [[[28, 40], [28, 30]], [[28, 30], [37, 30]]]
+    # a corner room behind a 2 m door: the 2.4 m wide tank cannot get in (no spawn is there)
+    part = [[[28, 40], [28, 30]], [[28, 30], [38, 30]]]
     c = spawn_case("A306", "narrow_door", SPAWNS, vehicle=True, segs_=segs + part, dirs_=dirs + [1, 1])
     w = c / "arenas/narrow_door/walls.txt"
     expect(c, "A306", "arenas/narrow_door", "arenas/narrow_door/walls.txt",

@@ -2,9 +2,13 @@
 the free space they stand in (A3xx), and the floor of the model.
 
 The free space holding the spawn points is the set of faces (see
-:mod:`tanktool.check.freespace`) the spawns fall in.  Clearance, reachability and
-passages are measured with one disc: the footprint radius of the largest vehicle
-known (the bundled vehicles beside the arena, or those being checked with it).
+:mod:`tanktool.check.freespace`) the spawns fall in.  The vehicles measured against
+it are the bundled vehicles beside the arena and those checked with it; "the largest"
+is the widest.  A spawn point must hold the vehicle's footprint polygon, placed with
+the spawn's heading, clear of every wall.  A passage is too narrow when it is
+narrower than the vehicle is wide: the free space shrunk by half that width falls
+apart there (a vehicle may still need more room to turn; that is the AI grid's
+business, with its own clearance).
 """
 
 from __future__ import annotations
@@ -30,10 +34,42 @@ ISLAND_MIN_AREA = 0.01     # m^2: smaller faces are slivers of the wall drawing,
 
 @dataclass
 class VehicleSize:
+    """What the arena rules need to know of a vehicle."""
+
     name: str
-    radius: float            # footprint radius, m
+    radius: float            # footprint radius (farthest hull point from the origin), m
     path: str = ""           # its vehicle.toml, where V401 points
     line: int = 0
+    footprint: np.ndarray | None = None   # (k, 2) convex footprint (x forward, z right), vehicle frame
+    width: float = 0.0                    # narrowest extent of the footprint, m
+
+    def __post_init__(self) -> None:
+        if self.footprint is not None and len(self.footprint) >= 3:
+            self.width = min_width(self.footprint)
+        elif not self.width:
+            self.width = 2.0 * self.radius
+
+    def placed(self, x: float, z: float, heading: float):
+        """The footprint polygon at a pose (heading about +y, +x forward -> (cos, sin))."""
+        if self.footprint is None or len(self.footprint) < 3:
+            return shapely.Point(x, z).buffer(self.radius, quad_segs=8)
+        c, s = math.cos(heading), math.sin(heading)
+        fx, fz = self.footprint[:, 0], self.footprint[:, 1]
+        return shapely.Polygon(np.column_stack([x + c * fx - s * fz, z + s * fx + c * fz]))
+
+
+def min_width(poly: np.ndarray) -> float:
+    """Narrowest extent of a convex polygon: over its edge directions, the largest
+    distance of a vertex from the edge's line (rotating calipers, all edges at once)."""
+    p = np.asarray(poly, dtype=np.float64)
+    e = np.roll(p, -1, axis=0) - p
+    L = np.hypot(e[:, 0], e[:, 1])
+    ok = L > 0
+    if not ok.any():
+        return 0.0
+    e, a = e[ok] / L[ok, None], p[ok]
+    d = np.abs(e[:, None, 0] * (p[None, :, 1] - a[:, None, 1]) - e[:, None, 1] * (p[None, :, 0] - a[:, None, 0]))
+    return float(d.max(axis=1).min())
 
 
 @dataclass
@@ -109,12 +145,15 @@ def check_arena(bundle: Path, vehicles: list[VehicleSize], model_rules: bool = T
         out.append(diag("A305", str(man.path), man.lines.key("", "spawns"),
                         f"{len(spawns)} spawn points; a full match needs {MIN_SPAWNS}"))
     if model_rules:
-        out += floor_rules(man, bundle)
+        region = None
+        if info.fs is not None and info.good.any():
+            region = info.fs.region(np.unique(info.faces[info.good]))
+        out += floor_rules(man, bundle, region)
     return out, info
 
 
 def _largest(vehicles: list[VehicleSize]) -> VehicleSize | None:
-    return max(vehicles, key=lambda v: v.radius) if vehicles else None
+    return max(vehicles, key=lambda v: (v.width, v.radius)) if vehicles else None
 
 
 def spawn_rules(fs: FreeSpace, spawns: np.ndarray, lines: list[int], man: Manifest, wpath: str,
@@ -151,19 +190,18 @@ def spawn_rules(fs: FreeSpace, spawns: np.ndarray, lines: list[int], man: Manife
     info.good = good
 
     big = _largest(vehicles)
-    radius = big.radius if big else 0.0
+    half = 0.5 * big.width if big else 0.0
+    placed = good.copy()
     if big:
-        for i in np.flatnonzero(good & (dist < radius)):
+        for i in blocked_spawns(fs, spawns, good, big):
             out.append(diag("A303", mpath, lines[i],
-                            f"spawn {i} at {fmt_xz(xz[i])} is {dist[i]:.2f} m from the wall at "
-                            f"{wpath}:{_wl(walls, wall[i])}; vehicle {big.name!r} needs {radius:.2f} m"))
-        placed = good & (dist >= radius)
-    else:
-        placed = good
+                            f"spawn {i} at {fmt_xz(xz[i])}: vehicle {big.name!r} placed there touches the wall at "
+                            f"{wpath}:{_wl(walls, wall[i])} ({dist[i]:.2f} m from the spawn point)"))
+            placed[i] = False
 
-    out += reachability(fs, xz, face, placed, lines, mpath, radius, big)
+    out += reachability(fs, xz, face, placed, lines, mpath, half, big)
     if big:
-        out += narrow_passages(fs, np.unique(face[good]), big, wpath)
+        out += passage_diagnostics(fs, np.unique(face[good]), big, wpath)
     out += islands(fs, set(int(f) for f in face[good]), wpath)
     return out
 
@@ -181,6 +219,19 @@ def apply_spawn_vote(fs: FreeSpace, spawns: np.ndarray) -> None:
         top = int(np.argmax(counts))
         if counts[top] * 2 > len(spawns):
             fs.free[top] = True
+
+
+def blocked_spawns(fs: FreeSpace, spawns: np.ndarray, good: np.ndarray, size: VehicleSize) -> list[int]:
+    """Spawn points where the vehicle's footprint, placed with the spawn's heading,
+    touches or overlaps a wall."""
+    out = []
+    if fs.noded is None:
+        return out
+    for i in np.flatnonzero(good):
+        x, z, h = spawns[i]
+        if shapely.intersects(size.placed(x, z, h), fs.noded):
+            out.append(int(i))
+    return out
 
 
 def _wl(walls: WallList, i: int) -> int:
@@ -243,30 +294,40 @@ def reachability(fs: FreeSpace, xz: np.ndarray, face: np.ndarray, placed: np.nda
     return out
 
 
-def narrow_passages(fs: FreeSpace, face_ids, big: VehicleSize, wpath: str, code: str = "A306",
-                    where: str | None = None) -> list[Diagnostic]:
-    """Places where the free space of one face falls apart for a disc of the vehicle's radius."""
-    out = []
+def narrow_passages(fs: FreeSpace, face_ids, size: VehicleSize) -> list[tuple[float, np.ndarray, int]]:
+    """Passages of the given faces narrower than ``size`` is wide, narrowest first.
+
+    Shrinking a face's free space by half the vehicle's width splits it into pieces
+    exactly where a passage is too narrow; between two pieces the shortest line runs
+    through the passage, and the walls on either side of its middle give the width.
+    Returns ``(width, centre, wall index next to it)``, one per passage.
+    """
+    found: dict[tuple[int, int], tuple[float, np.ndarray, int]] = {}
+    half = 0.5 * size.width
     for f in face_ids:
         if f < 0:
             continue
-        parts = components(fs, [f], big.radius)
+        parts = components(fs, [f], half)
         if len(parts) < 2:
             continue
         parts.sort(key=lambda p: -p.area)
-        for p in parts[1:20]:
+        for p in parts[1:50]:
             others = shapely.union_all([q for q in parts if q is not p])
-            line = shapely.shortest_line(p, others)
-            c = np.asarray(line.coords, dtype=np.float64)
-            width, mid = fs.passage(c.mean(axis=0), 2.0 * big.radius)
+            c = np.asarray(shapely.shortest_line(p, others).coords, dtype=np.float64)
+            width, mid = fs.passage(c.mean(axis=0), 2.0 * size.width)
+            width = min(width, size.width)  # the split proves it; the measure is approximate
             _, w = fs.nearest_wall(mid[None])
-            msg = (f"a passage about {width:.2f} m wide at {fmt_xz(mid)} is narrower than vehicle "
-                   f"{big.name!r} ({2 * big.radius:.2f} m across)")
-            if code == "A306":
-                out.append(diag("A306", wpath, _wl(fs.walls, int(w[0])), msg))
-            else:
-                out.append(diag(code, where or big.path, big.line, f"{msg} in arena {wpath}"))
-    return out
+            key = (int(round(mid[0] / max(half, 1e-6))), int(round(mid[1] / max(half, 1e-6))))
+            if key not in found:
+                found[key] = (float(width), mid, int(w[0]))
+    return sorted(found.values(), key=lambda t: t[0])
+
+
+def passage_diagnostics(fs: FreeSpace, face_ids, big: VehicleSize, wpath: str) -> list[Diagnostic]:
+    return [diag("A306", wpath, _wl(fs.walls, w),
+                 f"a passage about {width:.2f} m wide at {fmt_xz(mid)} is narrower than vehicle "
+                 f"{big.name!r} ({big.width:.2f} m wide)")
+            for width, mid, w in narrow_passages(fs, face_ids, big)]
 
 
 def islands(fs: FreeSpace, spawn_faces: set[int], wpath: str) -> list[Diagnostic]:
@@ -286,8 +347,13 @@ def islands(fs: FreeSpace, spawn_faces: set[int], wpath: str) -> list[Diagnostic
 
 
 # ----------------------------------------------------------------- the floor
-def floor_rules(man: Manifest, bundle: Path) -> list[Diagnostic]:
-    """A308: upward faces below the wall slice height (what tanks drive on) at one height."""
+def floor_rules(man: Manifest, bundle: Path, region=None) -> list[Diagnostic]:
+    """A308: the upward faces below the wall slice height over the free space (what
+    tanks drive on, since no wall stands there) must all be at one height.
+
+    ``region`` is the free space holding the spawn points (a shapely geometry); without
+    one (an arena that leaks) every such face counts.
+    """
     floor_y = man.get("", "floor_y")
     mfile = man.get("model", "file")
     if isinstance(floor_y, bool) or not isinstance(floor_y, (int, float)) or not math.isfinite(floor_y):
@@ -300,19 +366,21 @@ def floor_rules(man: Manifest, bundle: Path) -> list[Diagnostic]:
     height = man.get("walls", "height")
     height = float(height) if isinstance(height, (int, float)) and not isinstance(height, bool) and height > 0 else 1.0
     from ..errors import FormatError
-    from ..formats.models import load_model
+    from .glb import load_triangles
 
     try:
-        mesh = load_model(mpath, up="y", scale=1.0)
+        v, f = load_triangles(mpath)
     except FormatError as e:
         return [diag("B201", str(man.path), man.lines.key("model", "file"), f"model file cannot be read: {e}")]
-    v = np.asarray(mesh.vertices, dtype=np.float64)
-    tri = v[np.asarray(mesh.faces, dtype=np.int64)]
+    tri = v[f]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     nl = np.linalg.norm(n, axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
         up = np.where(nl > 0, n[:, 1] / nl, 0.0)
     floor = (up > 0.7) & (tri[:, :, 1].max(axis=1) < float(floor_y) + height)
+    if region is not None and not region.is_empty and floor.any():
+        c = tri[floor].mean(axis=1)
+        floor[np.flatnonzero(floor)[~shapely.contains_xy(region, c[:, 0], c[:, 2])]] = False
     if not floor.any():
         return []
     ys = tri[floor][:, :, 1]

@@ -23,6 +23,7 @@ from shapely import STRtree
 
 from ..formats.walls_txt import WallList
 
+MAX_GAP_ENDS = 1000
 UNBOUNDED = -1
 NO_FACE = -2  # the "face" of a zero-length wall, which has no sides
 
@@ -51,7 +52,6 @@ class FreeSpace:
     _face_tree: STRtree | None = field(default=None, repr=False)
     _wall_tree: STRtree | None = field(default=None, repr=False)
     _wall_ids: np.ndarray | None = field(default=None, repr=False)
-    _buffers: dict = field(default_factory=dict, repr=False)
 
     # ------------------------------------------------------------------ lookups
     def face_of(self, points: np.ndarray) -> np.ndarray:
@@ -109,13 +109,19 @@ class FreeSpace:
     def clear_region(self, face_ids, radius: float) -> object:
         """Where the centre of a disc of ``radius`` can stand in those faces without
         touching any wall (walls inside a face, like a lone fence, count too)."""
-        region = self.region(face_ids)
+        ids = sorted(set(int(f) for f in face_ids if f >= 0))
+        region = self.region(ids)
         if radius <= 0 or region.is_empty or self.noded is None:
             return region
-        key = round(float(radius), 9)
-        if key not in self._buffers:
-            self._buffers[key] = shapely.buffer(self.noded, float(radius), quad_segs=8)
-        return shapely.difference(region, self._buffers[key])
+        # the faces' own boundaries are walls: shrinking the polygons handles them, far
+        # faster than buffering every wall; only walls lying inside a face (both sides
+        # in it, e.g. a fence or a loose end) need their own buffer
+        clear = shapely.buffer(region, -float(radius), quad_segs=8)
+        inner = np.flatnonzero((self.front == self.back) & np.isin(self.front, ids))
+        if len(inner):
+            clear = shapely.difference(clear, shapely.buffer(shapely.union_all(self.lines[inner]),
+                                                             float(radius), quad_segs=8))
+        return clear
 
     def flipped(self) -> np.ndarray:
         """(n,) bool: walls whose normal points into solid while their back faces free space."""
@@ -192,32 +198,44 @@ def _dangling_ends(snapped: np.ndarray, live: np.ndarray, lines, g: float) -> tu
 
 
 def gaps(fs: FreeSpace) -> list[tuple[int, int, np.ndarray, np.ndarray]]:
-    """Pairs of dangling wall ends that most likely belong together, closest first.
+    """The gaps at loose wall ends, narrowest first: ``(wall_a, wall_b, end_a, point_b)``.
 
-    Returns ``(wall_a, wall_b, end_a, end_b)``; each end is used once and the two ends
-    of one wall are never paired (that would be the wall itself).
+    Each loose end is joined to the nearest point of any other wall (another loose
+    end, or the middle of a wall the end stops short of).  A gap whose far point is
+    itself a loose end uses that end up, so the two sides of one gap are reported once
+    and an end that merely overshoots a corner does not count as a second gap.  Only
+    the first MAX_GAP_ENDS loose ends are looked at: a file with more is broken beyond
+    what a list of gaps can help with.
     """
-    k = len(fs.dangling)
-    if k < 2:
+    k = min(len(fs.dangling), MAX_GAP_ENDS)
+    if k == 0 or fs._wall_tree is None:
         return []
-    from scipy.spatial import cKDTree
-
-    tree = cKDTree(fs.dangling)
-    kk = min(k, 6)
-    dist, idx = tree.query(fs.dangling, k=kk)
+    seg = fs.walls.segments.reshape(-1, 2)
+    reach = 0.25 * float(np.hypot(*np.ptp(seg, axis=0)))
     cand = []
-    for i in range(k):
-        for d, j in zip(np.atleast_1d(dist[i])[1:], np.atleast_1d(idx[i])[1:]):
-            if j < k and i < j and fs.dangling_wall[i] != fs.dangling_wall[j]:
-                cand.append((float(d), i, int(j)))
-            elif j < k and j < i and fs.dangling_wall[i] != fs.dangling_wall[j]:
-                cand.append((float(d), int(j), i))
-    cand = sorted(set(cand))
+    for e in range(k):
+        p = fs.dangling[e]
+        own = int(fs.dangling_wall[e])
+        pt = shapely.points(p)
+        near_ids = fs._wall_tree.query(pt, predicate="dwithin", distance=reach)
+        near_ids = near_ids[fs._wall_ids[near_ids] != own]
+        if not len(near_ids):
+            continue
+        near = shapely.get_coordinates(shapely.shortest_line(pt, fs._wall_tree.geometries[near_ids]))[1::2]
+        d = np.hypot(*(near - p).T)
+        j = int(np.argmin(d))
+        cand.append((float(d[j]), e, int(fs._wall_ids[near_ids[j]]), near[j]))
+    cand.sort(key=lambda c: (c[0], c[1]))
     used = np.zeros(k, dtype=bool)
     out = []
-    for _, i, j in cand:
-        if used[i] or used[j]:
+    tol = 4.0 * fs.grid
+    for _, e, wall_b, q in cand:
+        if used[e]:
             continue
-        used[i] = used[j] = True
-        out.append((int(fs.dangling_wall[i]), int(fs.dangling_wall[j]), fs.dangling[i], fs.dangling[j]))
+        at_end = np.flatnonzero(np.abs(fs.dangling[:k] - q).max(axis=1) <= tol)
+        if used[at_end].any():
+            continue
+        used[e] = True
+        used[at_end] = True
+        out.append((int(fs.dangling_wall[e]), wall_b, fs.dangling[e], q))
     return out

@@ -112,13 +112,21 @@ def _walk(root: Path, t: Targets) -> None:
                     t.add("walls", d / f)
 
 
+def _shown(p: Path) -> Path:
+    """``p`` relative to the working folder when it is inside it (for messages)."""
+    try:
+        return p.resolve().relative_to(Path.cwd().resolve())
+    except (ValueError, OSError):
+        return p
+
+
 def _siblings(bundle: Path, kind: str, manifest: str) -> list[Path]:
     """Bundled ``kind`` ('arenas'/'vehicles') next to the collection holding ``bundle``."""
     folder = bundle.resolve().parent.parent / kind
     if not folder.is_dir():
         return []
     try:
-        return sorted(p.parent for p in folder.glob(f"*/{manifest}"))
+        return sorted(_shown(p.parent) for p in folder.glob(f"*/{manifest}"))
     except OSError:
         return []
 
@@ -149,11 +157,13 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
             report.diagnostics += res[0]
             if res[1]:
                 sizes[v.resolve()] = res[1]
-    extra_vehicles = {s.resolve() for a in targets.arenas for s in _siblings(a, "vehicles", VEHICLE_MANIFEST)}
-    for v in sorted(extra_vehicles - set(sizes)):
+    extra_vehicles = {s for a in targets.arenas for s in _siblings(a, "vehicles", VEHICLE_MANIFEST)}
+    for v in sorted(extra_vehicles, key=str):
+        if v.resolve() in sizes:
+            continue
         res = _guard(Report(), v, check_vehicle, v, False)  # beside the arena, not being checked: only its size
         if res and res[1]:
-            sizes[v] = res[1]
+            sizes[v.resolve()] = res[1]
 
     infos: dict[Path, ArenaInfo] = {}
     for a in targets.arenas:
@@ -169,11 +179,13 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
             report.diagnostics += res
 
     if targets.vehicles:
-        extra_arenas = {s.resolve() for v in targets.vehicles for s in _siblings(v, "arenas", ARENA_MANIFEST)}
-        for a in sorted(extra_arenas - set(infos)):
+        extra_arenas = {s for v in targets.vehicles for s in _siblings(v, "arenas", ARENA_MANIFEST)}
+        for a in sorted(extra_arenas, key=str):
+            if a.resolve() in infos:
+                continue
             res = _guard(Report(), a, check_arena, a, [], False)
             if res:
-                infos[a] = res[1]
+                infos[a.resolve()] = res[1]
         for v in targets.vehicles:
             size = sizes.get(v.resolve())
             if size is None:

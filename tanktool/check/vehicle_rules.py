@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 
 from ..formats.vehicle_bundle import DRIVE_KEYS, HULL_MAX, HULL_MIN
-from ..geometry.hull import points_in_prism
+from ..geometry.hull import convex_hull_2d, points_in_prism
 from ..geometry.spheres import SphereTree
-from .arena_rules import ArenaInfo, VehicleSize, components, narrow_passages
+from .arena_rules import ArenaInfo, VehicleSize, blocked_spawns, narrow_passages
 from .diagnostics import Diagnostic, diag, fmt_xz
 from .manifest import Manifest, file_rules, safe_file
 
@@ -242,14 +242,14 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
     mfile = safe_file(bundle, model) if isinstance(model, str) and model else None
     if model_rules and mfile is not None and mfile.is_file() and (hull is not None or tree is not None):
         from ..errors import FormatError
-        from ..formats.models import load_model
+        from .glb import load_triangles
 
         try:
-            mesh = load_model(mfile, up="y", scale=1.0)
+            verts, _ = load_triangles(mfile)
         except FormatError as e:
             out.append(diag("B201", mpath, man.lines.key("model", "file"), f"model file cannot be read: {e}"))
         else:
-            v = np.unique(np.asarray(mesh.vertices, dtype=np.float64), axis=0)
+            v = np.unique(verts, axis=0)
             if hull is not None:
                 outside = np.flatnonzero(~points_in_prism(hull, v, tol=GEOM_TOL))
                 if len(outside):
@@ -263,7 +263,8 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
     size = None
     if hull is not None:
         size = VehicleSize(name, float(np.max(np.hypot(hull[:, 0], hull[:, 2]))), mpath,
-                           man.lines.key("", "footprint_radius") or man.lines.key("hull", "file"))
+                           man.lines.key("", "footprint_radius") or man.lines.key("hull", "file"),
+                           footprint=convex_hull_2d(hull[:, [0, 2]]))
     else:
         r = man.get("", "footprint_radius")
         if isinstance(r, (int, float)) and not isinstance(r, bool) and math.isfinite(r) and r > 0:
@@ -272,23 +273,26 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
 
 
 def vehicle_fit(size: VehicleSize, arena: ArenaInfo) -> list[Diagnostic]:
-    """V401: the vehicle cannot get between the spawn points of ``arena``."""
+    """V401: the vehicle does not fit at a spawn point or through a passage of ``arena``
+    (one diagnostic per arena, naming the worst place)."""
     fs = arena.fs
     if fs is None or not arena.good.any():
         return []
-    xz = arena.spawns[:, :2]
-    idx = np.flatnonzero(arena.good)
-    dist, _ = fs.nearest_wall(xz[idx])
-    where = f"arena {arena.name!r}"
     out = []
-    tight = idx[dist < size.radius]
-    if len(tight):
-        i = int(tight[0])
+    where = f"arena {arena.name!r} ({arena.path})"
+    blocked = blocked_spawns(fs, arena.spawns, arena.good, size)
+    if blocked:
+        i = blocked[0]
+        more = f" and {len(blocked) - 1} more" if len(blocked) > 1 else ""
         out.append(diag("V401", size.path, size.line,
-                        f"vehicle {size.name!r} ({2 * size.radius:.2f} m across) does not fit at spawn {i} "
-                        f"{fmt_xz(xz[i])} of {where}"))
-    faces = np.unique(arena.faces[idx])
-    passages = narrow_passages(fs, faces, size, str(arena.path), code="V401", where=size.path)
-    for d in passages:
-        d.message = d.message.replace(f" in arena {arena.path}", f" of {where}")
-    return out + passages
+                        f"vehicle {size.name!r} placed at spawn {i} {fmt_xz(arena.spawns[i, :2])}{more} of {where} "
+                        "touches a wall"))
+    passages = narrow_passages(fs, np.unique(arena.faces[arena.good]), size)
+    if passages:
+        width, mid, _ = passages[0]
+        n = len(passages)
+        out.append(diag("V401", size.path, size.line,
+                        f"vehicle {size.name!r} ({size.width:.2f} m wide) does not fit through "
+                        f"{n} passage{'s' if n > 1 else ''} of {where}; the narrowest is about {width:.2f} m "
+                        f"wide at {fmt_xz(mid)}"))
+    return out
