@@ -40,7 +40,7 @@ def run(*args):
 
 
 def test_bundle_outputs_and_hashes(bundle):
-    r = run(bundle, "--cell", 0.5, "--clearance", 1.0)
+    r = run(bundle, "--cell", 0.5, "--clearance", 1.0, "--annotate", "none")
     assert r.exit_code == 0, r.output
     assert "rooms: 28 x 64 nodes at 0.5 m, clearance 1 m" in r.output
     doc = read_toml(bundle / "arena.toml")
@@ -95,7 +95,7 @@ def test_bare_walls_file_svg_table_and_region(tmp_path, monkeypatch):
     assert float(x) >= 2 and float(z) >= 2 and int(ri) == g.row_index[int(i), int(j)]
     # walls.txt itself keeps the plain names
     write_walls(tmp_path / "walls.txt", w)
-    assert run(tmp_path / "walls.txt", "--clearance", 0.6).exit_code == 0
+    assert run(tmp_path / "walls.txt", "--clearance", 0.6, "--annotate", "none").exit_code == 0
     assert (tmp_path / "navgrid.npz").exists() and (tmp_path / "navgrid.png").exists()
 
 
