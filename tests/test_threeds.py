@@ -253,7 +253,8 @@ def test_repeated_face_array_replaces_the_first_and_empty_groups() -> None:
             r"chunk 0x4120: 9 faces: 72 bytes needed but only 8 left",
         ),
         (model_bytes(tri_object(b"o", [[0, 0, 0]], [[0, 1, 0]])), r"object 'o': face 0 uses vertex 1 but the object has 1 vertices"),
-        (model_bytes(tri_object(b"o", [[0, np.nan, 0]], [])), r"vertices not finite"),
+        # byte 38 = 3 headers (18) + name (2) + 0x4100 and 0x4110 headers (12) + count (2) + x (4)
+        (model_bytes(tri_object(b"o", [[0, np.nan, 0]], [])), r"byte 38: chunk 0x4110: 1 vertices: value not finite"),
         (
             model_bytes(tri_object(b"o", *TRIANGLE, chunk(0x4130, b"m\0", struct.pack("<HH", 1, 5)))),
             "material group 'm' names face 5 but the object has 1 faces",

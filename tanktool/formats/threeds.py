@@ -260,9 +260,9 @@ class _Reader:
     def __init__(self, data: bytes, source: str) -> None:
         self.data = data
         self.source = source
-        # material names of 0x4130 groups, resolved after the whole file is read
-        # because materials may follow the objects that use them
-        # (the per-face material array the group was checked against, name, faces)
+        # 0x4130 groups as (the per-face material array they were checked against,
+        # material name, face indices), resolved once the whole file is read because
+        # materials may follow the objects that use them
         self.pending_groups: list[tuple[np.ndarray, str, np.ndarray]] = []
 
     # -- helpers -------------------------------------------------------------
@@ -332,8 +332,10 @@ class _Reader:
 
     def floats(self, offset: int, end: int, n: int, cid: int, what: str) -> np.ndarray:
         arr = self.array(offset, end, n, np.dtype("<f4"), what, cid).astype(np.float64)
-        if not np.isfinite(arr).all():
-            raise self.error(offset, f"chunk 0x{cid:04X}: {what} not finite (NaN or inf)")
+        bad = ~np.isfinite(arr)
+        if bad.any():
+            at = offset + 4 * int(np.flatnonzero(bad)[0])
+            raise self.error(at, f"chunk 0x{cid:04X}: {what}: value not finite (NaN or inf)")
         return arr
 
     # -- the tree ------------------------------------------------------------
@@ -353,8 +355,11 @@ class _Reader:
         for cid, off, body, end in self.children(0, len(data), -1):
             self.main(model, body, end)
             break
+        index: dict[str, int] = {}
+        for i, m in enumerate(model.materials):
+            index.setdefault(m.name, i)  # the first of equal names wins, as in lookups
         for face_material, name, idx in self.pending_groups:
-            face_material[idx] = model.material_index(name)
+            face_material[idx] = index.get(name, -1)
         return model
 
     def main(self, model: Model3DS, start: int, end: int) -> None:
