@@ -176,3 +176,29 @@ def test_heading_of_move():
     assert heading_of_move((3, 3), (4, 4), "+x") == "+z"   # ahead-right of +x
     assert heading_of_move((3, 3), (2, 4), "+x") == "-z"   # ahead-left of +x
     assert heading_of_move((3, 3), (3, 2), "+z") == "-x"
+
+
+ROOT = __import__("pathlib").Path(__file__).resolve().parent.parent
+BUNDLED = sorted(p.parent for p in ROOT.glob("arenas/*/arena.toml"))
+
+
+@pytest.mark.parametrize("folder", BUNDLED, ids=[p.name for p in BUNDLED])
+def test_agent_walk_on_bundled_arenas(folder):
+    """An agent steering by the heuristic alone from each spawn point never leaves the
+    valid nodes, and every move is one of the three children or a turn in place."""
+    from tanktool.arena import load_arena
+    from tanktool.nav.navgrid import build_navgrid
+
+    arena = load_arena(folder)
+    g = build_navgrid(arena.walls, 1.0, 2.0, spawns=arena.spawns)
+    assert g.spawn_nodes
+    for spawn, node in zip(arena.spawns, g.spawn_nodes):
+        h = heading_from_angle(spawn[2])
+        for _ in range(150):
+            nxt = choose_next(g, node, h)
+            assert nxt is not None and g.valid[nxt] and g.reachable[nxt]
+            ahead = {c.node for c in children(g, node, h)}
+            di, dj = nxt[0] - node[0], nxt[1] - node[1]
+            assert nxt in ahead or (abs(di) + abs(dj) == 1 and not ahead)
+            h = heading_of_move(node, nxt, h)
+            node = nxt
