@@ -177,3 +177,18 @@ def test_find_path_in_world_coordinates():
     deep = np.argwhere(~near_valid)
     assert len(deep)
     assert find_path(g, g.centre(*deep[len(deep) // 2]), goal).shape == (0, 2)
+
+
+def test_move_masks_equal_a_naive_check():
+    from tanktool.nav.path import move_masks
+
+    rng = np.random.default_rng(9)
+    ok = rng.random((9, 11)) < 0.7
+    m = move_masks(ok)
+    moves = [(0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1)]
+    cell = lambda i, j: 0 <= i < 9 and 0 <= j < 11 and ok[i, j]  # noqa: E731
+    for i in range(9):
+        for j in range(11):
+            for k, (di, dj) in enumerate(moves):
+                allowed = cell(i, j) and cell(i + di, j + dj) and (not (di and dj) or (cell(i + di, j) and cell(i, j + dj)))
+                assert bool(m[i, j] >> k & 1) == allowed

@@ -14,6 +14,23 @@ from .quadtree import WallQuadtree
 _SQRT2 = math.sqrt(2.0)
 
 
+def move_masks(passable: np.ndarray) -> np.ndarray:
+    """(nz, nx) uint8: bit k set when move k is allowed from the node.
+
+    Moves in bit order: +x, -x, +z, -z, then the diagonals +z+x, +z-x, -z+x, -z-x; a
+    diagonal needs both orthogonal neighbours it passes (no corner cutting).
+    """
+    nz, nx = passable.shape
+    p = np.zeros((nz + 2, nx + 2), dtype=bool)
+    p[1:-1, 1:-1] = passable
+    c = p[1:-1, 1:-1]
+    e, w, n, s = p[1:-1, 2:], p[1:-1, :-2], p[2:, 1:-1], p[:-2, 1:-1]
+    m = (c & e) * 1 | (c & w) * 2 | (c & n) * 4 | (c & s) * 8
+    m |= (c & n & e & p[2:, 2:]) * 16 | (c & n & w & p[2:, :-2]) * 32
+    m |= (c & s & e & p[:-2, 2:]) * 64 | (c & s & w & p[:-2, :-2]) * 128
+    return m.astype(np.uint8)
+
+
 def astar(grid: NavGrid, start: Node, goal: Node, passable: np.ndarray | None = None) -> list[Node]:
     """Shortest 8-connected path of valid nodes from ``start`` to ``goal`` (both included).
 
@@ -30,22 +47,27 @@ def astar(grid: NavGrid, start: Node, goal: Node, passable: np.ndarray | None = 
             raise ValueError(f"node {(i, j)} is outside the {nz} x {nx} grid")
     if not (ok[si, sj] and ok[gi, gj]):
         return []
-    flat = ok.ravel().tolist()  # list indexing is much faster than numpy scalars here
+    # the allowed moves of every node in one vectorised pass; the search loop then
+    # only looks up a small int per node (lists beat numpy scalars here)
+    masks = move_masks(ok).ravel().tolist()
+    offsets = [(1, 1.0), (-1, 1.0), (nx, 1.0), (-nx, 1.0),
+               (nx + 1, _SQRT2), (nx - 1, _SQRT2), (-nx + 1, _SQRT2), (-nx - 1, _SQRT2)]
+    table = [[offsets[k] for k in range(8) if b >> k & 1] for b in range(256)]
     s, g = si * nx + sj, gi * nx + gj
-    k = _SQRT2 - 2.0
+    k2 = _SQRT2 - 2.0
 
     def h(n: int) -> float:
         di = abs(n // nx - gi)
         dj = abs(n % nx - gj)
-        return di + dj + k * min(di, dj)
+        return di + dj + k2 * (di if di < dj else dj)
 
     best = {s: 0.0}
     came: dict[int, int] = {}
-    # ties on f go to the node nearer the goal: far fewer expansions on open ground
-    heap = [(h(s), h(s), 0.0, s)]
-    closed = set()
+    closed: set[int] = set()
+    heap = [(h(s), 0.0, s)]
+    pop, push = heapq.heappop, heapq.heappush
     while heap:
-        f, _, gc, n = heapq.heappop(heap)
+        _, gc, n = pop(heap)
         if n == g:
             out = [n]
             while n in came:
@@ -55,37 +77,15 @@ def astar(grid: NavGrid, start: Node, goal: Node, passable: np.ndarray | None = 
         if n in closed:
             continue
         closed.add(n)
-        i, j = divmod(n, nx)
-        e = j + 1 < nx and flat[n + 1]
-        w = j > 0 and flat[n - 1]
-        no = i + 1 < nz and flat[n + nx]
-        so = i > 0 and flat[n - nx]
-        steps = []
-        if e:
-            steps.append((n + 1, 1.0))
-        if w:
-            steps.append((n - 1, 1.0))
-        if no:
-            steps.append((n + nx, 1.0))
-            if e and flat[n + nx + 1]:
-                steps.append((n + nx + 1, _SQRT2))
-            if w and flat[n + nx - 1]:
-                steps.append((n + nx - 1, _SQRT2))
-        if so:
-            steps.append((n - nx, 1.0))
-            if e and flat[n - nx + 1]:
-                steps.append((n - nx + 1, _SQRT2))
-            if w and flat[n - nx - 1]:
-                steps.append((n - nx - 1, _SQRT2))
-        for m, c in steps:
+        for off, cost in table[masks[n]]:
+            m = n + off
             if m in closed:
                 continue
-            ng = gc + c
+            ng = gc + cost
             if ng < best.get(m, math.inf):
                 best[m] = ng
                 came[m] = n
-                hm = h(m)
-                heapq.heappush(heap, (ng + hm, hm, ng, m))
+                push(heap, (ng + h(m), ng, m))
     return []
 
 
