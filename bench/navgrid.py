@@ -33,7 +33,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from tanktool.formats.walls_txt import WallList, aux_rectangle  # noqa: E402
+from tanktool.formats.walls_txt import WallList  # noqa: E402
 from tanktool.nav.navgrid import (  # noqa: E402
     build_navgrid,
     classify_reference,
