@@ -14,7 +14,7 @@ loops with consistent normals -- the walls of any solid sliced at a height -- th
 is the winding number of the oriented walls: 1 in free space, 0 in solids and outside,
 the same along every line, and shared edges of touching solids (opposite normals)
 cancel.  :func:`open_ends` lists the vertices where that fails (loose ends, flipped
-normals); there the two classifiers below can disagree, and nothing else can.
+normals); only near those can the two classifiers below disagree.
 
 A node is **valid** when it is in free space and its distance to every wall is at
 least the clearance (and not zero: a node on a wall is never valid).
@@ -26,8 +26,8 @@ Two classifiers, which agree exactly on every node farther than rounding from a 
   sorted into a list and walked from both ends; clearance by brute force.
 * :func:`classify`, the vectorised default: the same count along each grid row (one
   crossing list per row, a cumulative sum per node), and clearance by rasterising each
-  wall's capsule row by row and testing only the nodes under it with the same exact
-  distance kernel.  Crossings use a half-open rule on the row's z (an end point exactly
+  wall's capsule row by row: nodes well inside it are marked at once, the few near
+  its edge are decided by the same exact distance kernel the reference uses.  Crossings use a half-open rule on the row's z (an end point exactly
   on the row counts as above it), so a line through a vertex is never counted twice.
 """
 
