@@ -222,3 +222,16 @@ def test_glb_reader_refuses_what_it_does_not_read(tmp_path):
     assert read_glb_triangles(bad) is None
     bad.write_bytes(b"not a glb at all")
     assert read_glb_triangles(bad) is None
+
+
+def test_vehicles_meet_only_their_own_arenas_and_the_checked_ones():
+    fit = BROKEN / "V401_does_not_fit" / "vehicles" / "tank"
+    other = BROKEN / "V302_restitution" / "vehicles" / "tank"
+    report = run_check([other, fit])
+    v401 = [d for d in report.diagnostics if d.code == "V401"]
+    assert [Path(d.path).parent for d in v401] == [fit]  # not the vehicle of another collection
+    # checked together with the narrow arena, the other vehicle meets it too (and the
+    # arena, checked, reports its narrow passage)
+    report = run_check([other, BROKEN / "V401_does_not_fit" / "arenas"])
+    assert {(d.code, Path(d.path).parent.parent.parent.name) for d in report.diagnostics} == {
+        ("V302", "V302_restitution"), ("V401", "V302_restitution"), ("A306", "V401_does_not_fit")}

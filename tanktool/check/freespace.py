@@ -49,7 +49,6 @@ class FreeSpace:
     grid: float                      # snapping grid, metres
     lines: object                    # (n,) shapely LineStrings of the walls (None for zero-length)
     noded: object                    # the walls as one noded geometry
-    _face_tree: STRtree | None = field(default=None, repr=False)
     _wall_tree: STRtree | None = field(default=None, repr=False)
     _wall_ids: np.ndarray | None = field(default=None, repr=False)
 
@@ -60,9 +59,9 @@ class FreeSpace:
         out = np.full(len(pts), UNBOUNDED, dtype=np.int64)
         if not self.faces or not len(pts):
             return out
-        if self._face_tree is None:
-            self._face_tree = STRtree(self.faces)
-        pi, fi = self._face_tree.query(shapely.points(pts), predicate="within")
+        # the faces are the query side: shapely prepares each one once, so a face with
+        # thousands of vertices answers its candidate points in log time each
+        fi, pi = STRtree(shapely.points(pts)).query(self.faces, predicate="contains_properly")
         out[pi] = fi
         return out
 

@@ -157,18 +157,21 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
             report.diagnostics += res[0]
             if res[1]:
                 sizes[v.resolve()] = res[1]
-    extra_vehicles = {s for a in targets.arenas for s in _siblings(a, "vehicles", VEHICLE_MANIFEST)}
-    for v in sorted(extra_vehicles, key=str):
-        if v.resolve() in sizes:
-            continue
-        res = _guard(Report(), v, check_vehicle, v, False)  # beside the arena, not being checked: only its size
-        if res and res[1]:
-            sizes[v.resolve()] = res[1]
-
+    checked_vehicles = set(sizes)
     infos: dict[Path, ArenaInfo] = {}
     for a in targets.arenas:
         report.files.append(str(a))
-        res = _guard(report, a, check_arena, a, list(sizes.values()))
+        # each arena meets the vehicles being checked and the bundled ones beside it
+        mine = set(checked_vehicles)
+        for v in _siblings(a, "vehicles", VEHICLE_MANIFEST):
+            key = v.resolve()
+            if key not in sizes:
+                res = _guard(Report(), v, check_vehicle, v, False)  # only its size is needed
+                if not res or not res[1]:
+                    continue
+                sizes[key] = res[1]
+            mine.add(key)
+        res = _guard(report, a, check_arena, a, [sizes[k] for k in sorted(mine, key=str)])
         if res:
             report.diagnostics += res[0]
             infos[a.resolve()] = res[1]
@@ -179,19 +182,25 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
             report.diagnostics += res
 
     if targets.vehicles:
-        extra_arenas = {s for v in targets.vehicles for s in _siblings(v, "arenas", ARENA_MANIFEST)}
-        for a in sorted(extra_arenas, key=str):
-            if a.resolve() in infos:
-                continue
-            res = _guard(Report(), a, check_arena, a, [], False)
-            if res:
-                infos[a.resolve()] = res[1]
+        # each vehicle meets the arenas being checked and the bundled ones beside it
+        checked = set(infos)
         for v in targets.vehicles:
             size = sizes.get(v.resolve())
             if size is None:
                 continue
-            for info in infos.values():
-                res = _guard(report, v, vehicle_fit, size, info)
+            mine = set(checked)
+            for a in _siblings(v, "arenas", ARENA_MANIFEST):
+                key = a.resolve()
+                if key not in infos:
+                    res = _guard(Report(), a, check_arena, a, [], False)
+                    if not res:
+                        continue
+                    infos[key] = res[1]
+                mine.add(key)
+            for key in sorted(mine, key=str):
+                res = _guard(report, v, vehicle_fit, size, infos[key])
                 if res:
                     report.diagnostics += res
+    # a compiler's order: file by file, top to bottom (stable, so rules keep their order on a line)
+    report.diagnostics.sort(key=lambda d: (d.path, d.line))
     return report
