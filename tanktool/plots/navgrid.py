@@ -71,14 +71,17 @@ def render_navgrid(
 
     b = grid.bounds
     view = b.copy() if region is None else np.asarray(region, dtype=np.float64).reshape(2, 2)
-    view_span = float(np.max(view[1] - view[0]))
-    pad = 0.02 * view_span if region is None else 0.5 * grid.cell
-    view = view + np.array([[-pad], [pad]])
-    # nodes in view decide how big the figure must be for labels to fit
+    # the cells the view touches; they decide how big the figure must be for labels
     j0 = max(0, int(math.floor((view[0, 0] - grid.origin[0]) / grid.cell)))
     j1 = min(grid.nx, int(math.ceil((view[1, 0] - grid.origin[0]) / grid.cell)))
     i0 = max(0, int(math.floor((view[0, 1] - grid.origin[1]) / grid.cell)))
     i1 = min(grid.nz, int(math.ceil((view[1, 1] - grid.origin[1]) / grid.cell)))
+    if region is not None:  # widen a region to whole cells, so no label is cut
+        view = grid.origin + grid.cell * np.array([[j0, i0], [j1, i1]], dtype=np.float64)
+    view_span = float(np.max(view[1] - view[0]))
+    if region is None:
+        pad = 0.02 * view_span
+        view = view + np.array([[-pad], [pad]])
     across = max(1, j1 - j0)
     tall = max(1, i1 - i0)
     aspect = (view[1, 1] - view[0, 1]) / max(view[1, 0] - view[0, 0], 1e-9)
@@ -144,10 +147,13 @@ def render_navgrid(
         ii, jj = ii + i0, jj + j0
         for i, j in zip(ii.tolist(), jj.tolist()):
             x, z = grid.centre(i, j)
+            if not (view[0, 0] <= x <= view[1, 0] and view[0, 1] <= z <= view[1, 1]):
+                continue  # a label must not spill over the axes
             r = f"{grid.row_index[i, j]}/{grid.row_total[i, j]}"
             c = f"{grid.col_index[i, j]}/{grid.col_total[i, j]}"
             text = {"rows": r, "cols": c, "both": f"{r}\n{c}"}[annotate]
-            ax.text(x, z, text, ha="center", va="center", fontsize=font, color="#10301a", linespacing=0.95, zorder=4)
+            ax.text(x, z, text, ha="center", va="center", fontsize=font, color="#10301a", linespacing=0.95,
+                    zorder=4, clip_on=True)
             labelled += 1
 
     ax.set_xlim(view[0, 0], view[1, 0])
