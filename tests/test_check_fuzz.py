@@ -1,7 +1,8 @@
 """Fuzzing ``tanktool check`` with mutated real walls.txt files: it must never crash.
 
 Sources: the bundled arenas' walls.txt when there are any, and the clean corpus
-arena.  Each case applies 1-4 random mutations (lines deleted, duplicated, swapped or
+arena.  A second test mutates the clean corpus bundles' manifests, hull.txt and
+spheres.txt the same way.  Each case applies 1-4 random mutations (lines deleted, duplicated, swapped or
 garbled; numbers replaced by huge, tiny, negative, NaN or copied values; Directions
 flipped; the auxiliary marker dropped or doubled; bytes that are not UTF-8), then
 checks the result both as a bare walls.txt and inside a copy of an arena bundle (so
@@ -124,3 +125,56 @@ def test_fuzz_mutated_walls_never_crash(tmp_path):
 @pytest.mark.slow
 def test_fuzz_mutated_walls_never_crash_long(tmp_path):
     _fuzz(10 * DEFAULT_CASES, tmp_path, first_seed=100_000)
+
+
+# ------------------------------------------------------------------ bundle files
+VALUES = ["nan", "inf", "-1", "0", "1e308", '"text"', "[]", "[1, 2]", "true", "{}", "-0.0", "1e-300", "3"]
+
+
+def mutate_bundle_file(text: str, rng: random.Random) -> str:
+    """Line mutations for TOML manifests, hull.txt and spheres.txt."""
+    lines = text.splitlines()
+    for _ in range(rng.randint(1, 3)):
+        if not lines:
+            break
+        i = rng.randrange(len(lines))
+        op = rng.randrange(5)
+        if op == 0:
+            del lines[i]
+        elif op == 1 and "=" in lines[i]:
+            key = lines[i].split("=", 1)[0]
+            lines[i] = f"{key}= {rng.choice(VALUES)}"
+        elif op == 2:
+            fields = lines[i].split()
+            if fields:
+                fields[rng.randrange(len(fields))] = rng.choice(VALUES + ["-5", "0.1", "99"])
+                lines[i] = " ".join(fields)
+        elif op == 3:
+            lines.insert(i, lines[rng.randrange(len(lines))])
+        else:
+            lines = lines[: rng.randrange(len(lines) + 1)]
+    return "\n".join(lines) + "\n"
+
+
+def _fuzz_bundles(cases: int, tmp_path: Path, first_seed: int = 0) -> None:
+    for seed in range(first_seed, first_seed + cases):
+        rng = random.Random(seed)
+        case = tmp_path / f"b{seed}"
+        shutil.copytree(CLEAN, case)
+        kind = rng.choice(["arenas/yard/arena.toml", "vehicles/tank/vehicle.toml",
+                           "vehicles/tank/hull.txt", "vehicles/tank/spheres.txt"])
+        f = case / kind
+        f.write_text(mutate_bundle_file(f.read_text(), rng))
+        report = run_check([case])
+        crashes = [d.format() for d in report.diagnostics if d.code == "X001"]
+        assert not crashes, (seed, kind, f.read_text()[:3000], crashes)
+        assert report.exit_code() in (0, 1)
+
+
+def test_fuzz_mutated_bundles_never_crash(tmp_path):
+    _fuzz_bundles(max(30, DEFAULT_CASES // 3), tmp_path)
+
+
+@pytest.mark.slow
+def test_fuzz_mutated_bundles_never_crash_long(tmp_path):
+    _fuzz_bundles(10 * DEFAULT_CASES, tmp_path, first_seed=100_000)

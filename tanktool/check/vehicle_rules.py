@@ -227,7 +227,9 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
         out += sd
 
     if hull is not None and com is not None and inertia is not None and mass is not None and mass > 0 and inertia > 0:
-        if not points_in_prism(hull, np.array([com], dtype=np.float64), tol=GEOM_TOL)[0]:
+        with np.errstate(all="ignore"):  # a degenerate hull (repeated corners) makes 0/0: outside
+            com_inside = points_in_prism(hull, np.array([com], dtype=np.float64), tol=GEOM_TOL)[0]
+        if not com_inside:
             out.append(diag("V104", mpath, man.lines.key("mass", "centre_of_mass"),
                             f"centre of mass ({com[0]:g}, {com[1]:g}, {com[2]:g}) is outside the hull"))
         else:
@@ -251,7 +253,8 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
         else:
             v = np.unique(verts, axis=0)
             if hull is not None:
-                outside = np.flatnonzero(~points_in_prism(hull, v, tol=GEOM_TOL))
+                with np.errstate(all="ignore"):
+                    outside = np.flatnonzero(~points_in_prism(hull, v, tol=GEOM_TOL))
                 if len(outside):
                     p = v[outside[0]]
                     out.append(diag("V103", str(hpath), 0,
