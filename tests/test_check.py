@@ -235,3 +235,27 @@ def test_vehicles_meet_only_their_own_arenas_and_the_checked_ones():
     report = run_check([other, BROKEN / "V401_does_not_fit" / "arenas"])
     assert {(d.code, Path(d.path).parent.parent.parent.name) for d in report.diagnostics} == {
         ("V302", "V302_restitution"), ("V401", "V302_restitution"), ("A306", "V401_does_not_fit")}
+
+
+def test_toml_lines_find_keys_and_array_items():
+    from tanktool.check.manifest import TomlLines
+
+    text = ('name = "a[1]"\nspawns = [[1, 2, 3], [4, 5, 6]]\n\n[source]\nfile = "x.obj"\n'
+            'sha256 = "ab"\n\n[derived]\n"walls.txt" = "cd"\n'
+            'more = [\n  [1, 2, 3],\n  [4, 5, 6],\n]\n')
+    t = TomlLines(text)
+    assert t.key("", "spawns") == 2 and t.key("source", "file") == 5
+    assert t.key("derived", "walls.txt") == 9
+    assert t.items("", "spawns", 2) == [2, 2]
+    assert t.items("derived", "more", 2) == [11, 12]
+    assert t.key("source", "nope") == 4  # falls back to the table's line
+    assert t.key("nope", "nope") == 0
+
+
+def test_vehicle_with_a_missing_hull_file_is_reported(tmp_path):
+    shutil.copytree(CLEAN / "vehicles" / "tank", tmp_path / "tank")
+    toml = tmp_path / "tank" / "vehicle.toml"
+    toml.write_text(toml.read_text().replace('file = "hull.txt"', 'file = "elsewhere.txt"'))
+    report = run_check([tmp_path / "tank"])
+    assert [(d.code, d.line) for d in report.diagnostics] == [
+        ("B202", next(i for i, ln in enumerate(toml.read_text().splitlines(), 1) if "elsewhere" in ln))]

@@ -211,9 +211,15 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
                             f"[drive] shell_speed = {shell:g} m/s is not faster than top_speed = {top:g} m/s: "
                             "the tank would drive into its own shells"))
 
+    def missing_file(table: str, name: str | None, path: Path | None) -> None:
+        if name and (path is None or not path.is_file()) and not any(
+                d.code == "B202" and repr(name) in d.message for d in out):
+            out.append(diag("B202", mpath, man.lines.key(table, "file"), f"derived file {name!r} is missing"))
+
     hull = None
     hfile = man.string("hull", "file", out, default="hull.txt")
     hpath = safe_file(bundle, hfile) if hfile else None
+    missing_file("hull", hfile, hpath)
     if hpath is not None and hpath.is_file():
         pts, hd = scan_hull(hpath)
         out += hd
@@ -222,6 +228,7 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
     tree = None
     sfile = man.string("spheres", "file", out, default="spheres.txt")
     spath = safe_file(bundle, sfile) if sfile else None
+    missing_file("spheres", sfile, spath)
     if spath is not None and spath.is_file():
         tree, slines, sd = scan_spheres(spath)
         out += sd
