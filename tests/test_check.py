@@ -259,3 +259,14 @@ def test_vehicle_with_a_missing_hull_file_is_reported(tmp_path):
     report = run_check([tmp_path / "tank"])
     assert [(d.code, d.line) for d in report.diagnostics] == [
         ("B202", next(i for i, ln in enumerate(toml.read_text().splitlines(), 1) if "elsewhere" in ln))]
+
+
+def test_spawns_keep_their_manifest_index_when_one_is_malformed(tmp_path):
+    arena = tmp_path / "arenas" / "a"
+    shutil.copytree(BROKEN / "A302_spawn_in_block" / "arenas" / "spawn_in_block", arena)
+    toml = arena / "arena.toml"
+    text = toml.read_text()
+    head, rest = text.split("spawns = [\n", 1)
+    toml.write_text(head + 'spawns = [\n    "not a spawn",\n' + rest)
+    codes = sorted((d.code, d.message.split(" at ")[0]) for d in run_check([arena]).diagnostics)
+    assert codes == [("A302", "spawn 9"), ("B102", "spawn 0 must be [x, z, heading_rad] with 3 finite numbers, got 'not a spawn'")]

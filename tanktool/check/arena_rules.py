@@ -82,6 +82,7 @@ class ArenaInfo:
     spawns: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     good: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))  # spawns in free space
     faces: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    ids: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # index in the manifest
 
 
 # ----------------------------------------------------------------- bare walls.txt
@@ -93,16 +94,18 @@ def check_walls_file(path: Path) -> list[Diagnostic]:
 
 
 # ----------------------------------------------------------------- arena bundles
-def _spawns(man: Manifest, out: list[Diagnostic]) -> tuple[np.ndarray, list[int]]:
+def _spawns(man: Manifest, out: list[Diagnostic]) -> tuple[np.ndarray, list[int], np.ndarray]:
+    """The well-formed spawn points (k, 3), their manifest lines and their indices in
+    the manifest's list (messages name spawns by that index)."""
     raw = man.get("", "spawns")
     if raw is None:
         out.append(man.missing("", "spawns", "is missing (a list of [x, z, heading_rad])"))
-        return np.zeros((0, 3)), []
+        return np.zeros((0, 3)), [], np.zeros(0, np.int64)
     if not isinstance(raw, list):
         out.append(man.missing("", "spawns", f"must be a list of [x, z, heading_rad], got {raw!r}"))
-        return np.zeros((0, 3)), []
+        return np.zeros((0, 3)), [], np.zeros(0, np.int64)
     lines = man.lines.items("", "spawns", len(raw))
-    rows, keep = [], []
+    rows, keep, ids = [], [], []
     for i, s in enumerate(raw):
         ok = (isinstance(s, list) and len(s) == 3
               and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in s))
@@ -112,7 +115,8 @@ def _spawns(man: Manifest, out: list[Diagnostic]) -> tuple[np.ndarray, list[int]
             continue
         rows.append([float(v) for v in s])
         keep.append(lines[i])
-    return np.array(rows, dtype=np.float64).reshape(-1, 3), keep
+        ids.append(i)
+    return np.array(rows, dtype=np.float64).reshape(-1, 3), keep, np.array(ids, dtype=np.int64)
 
 
 def check_arena(bundle: Path, vehicles: list[VehicleSize], model_rules: bool = True) -> tuple[list[Diagnostic], ArenaInfo]:
@@ -127,7 +131,7 @@ def check_arena(bundle: Path, vehicles: list[VehicleSize], model_rules: bool = T
     info.name = name if isinstance(name, str) and name else bundle.name
     out += file_rules(man, bundle, ("walls.txt",))
 
-    spawns, spawn_lines = _spawns(man, out)
+    spawns, spawn_lines, info.ids = _spawns(man, out)
     info.spawns = spawns
     wname = man.string("walls", "file", out, default="walls.txt")
     wpath = safe_file(bundle, wname) if wname else None
@@ -167,6 +171,7 @@ def spawn_rules(fs: FreeSpace, spawns: np.ndarray, lines: list[int], man: Manife
     xz = spawns[:, :2]
     face = fs.face_of(xz)
     info.faces = face
+    n = info.ids if len(info.ids) == k else np.arange(k)
 
     good = np.zeros(k, dtype=bool)
     leaking = False
@@ -177,12 +182,12 @@ def spawn_rules(fs: FreeSpace, spawns: np.ndarray, lines: list[int], man: Manife
             leaking = True
             continue
         if f == UNBOUNDED:
-            out.append(diag("A302", mpath, lines[i], f"spawn {i} at {fmt_xz(xz[i])} is outside the arena's walls"))
+            out.append(diag("A302", mpath, lines[i], f"spawn {n[i]} at {fmt_xz(xz[i])} is outside the arena's walls"))
         elif not fs.free[f]:
-            out.append(diag("A302", mpath, lines[i], f"spawn {i} at {fmt_xz(xz[i])} is inside solid material"))
+            out.append(diag("A302", mpath, lines[i], f"spawn {n[i]} at {fmt_xz(xz[i])} is inside solid material"))
         elif dist[i] <= 4 * fs.grid:
             out.append(diag("A302", mpath, lines[i],
-                            f"spawn {i} at {fmt_xz(xz[i])} is on the wall at {wpath}:{_wl(walls, wall[i])}"))
+                            f"spawn {n[i]} at {fmt_xz(xz[i])} is on the wall at {wpath}:{_wl(walls, wall[i])}"))
         else:
             good[i] = True
     if leaking:
@@ -195,11 +200,11 @@ def spawn_rules(fs: FreeSpace, spawns: np.ndarray, lines: list[int], man: Manife
     if big:
         for i in blocked_spawns(fs, spawns, good, big):
             out.append(diag("A303", mpath, lines[i],
-                            f"spawn {i} at {fmt_xz(xz[i])}: vehicle {big.name!r} placed there touches the wall at "
+                            f"spawn {n[i]} at {fmt_xz(xz[i])}: vehicle {big.name!r} placed there touches the wall at "
                             f"{wpath}:{_wl(walls, wall[i])} ({dist[i]:.2f} m from the spawn point)"))
             placed[i] = False
 
-    out += reachability(fs, xz, face, placed, lines, mpath, half, big)
+    out += reachability(fs, xz, face, placed, lines, mpath, half, big, n)
     if big:
         out += passage_diagnostics(fs, np.unique(face[good]), big, wpath)
     out += islands(fs, set(int(f) for f in face[good]), wpath)
@@ -274,7 +279,7 @@ def reachable_groups(fs: FreeSpace, xz: np.ndarray, face: np.ndarray, placed: np
 
 
 def reachability(fs: FreeSpace, xz: np.ndarray, face: np.ndarray, placed: np.ndarray, lines: list[int],
-                 mpath: str, radius: float, big: VehicleSize | None) -> list[Diagnostic]:
+                 mpath: str, radius: float, big: VehicleSize | None, n: np.ndarray) -> list[Diagnostic]:
     label = reachable_groups(fs, xz, face, placed, radius)
     idx = np.flatnonzero(placed)
     if len(idx) < 2:
@@ -290,7 +295,7 @@ def reachability(fs: FreeSpace, xz: np.ndarray, face: np.ndarray, placed: np.nda
         else:
             why = f"a passage on the way is too narrow for vehicle {big.name!r}" if big else "walls close it off"
         out.append(diag("A304", mpath, lines[i],
-                        f"spawn {i} at {fmt_xz(xz[i])} cannot be reached from spawn {first}: {why}"))
+                        f"spawn {n[i]} at {fmt_xz(xz[i])} cannot be reached from spawn {n[first]}: {why}"))
     return out
 
 

@@ -295,7 +295,7 @@ def vehicle_fit(size: VehicleSize, arena: ArenaInfo) -> list[Diagnostic]:
         i = blocked[0]
         more = f" and {len(blocked) - 1} more" if len(blocked) > 1 else ""
         out.append(diag("V401", size.path, size.line,
-                        f"vehicle {size.name!r} placed at spawn {i} {fmt_xz(arena.spawns[i, :2])}{more} of {where} "
+                        f"vehicle {size.name!r} placed at spawn {arena.ids[i] if i < len(arena.ids) else i} {fmt_xz(arena.spawns[i, :2])}{more} of {where} "
                         "touches a wall"))
     passages = narrow_passages(fs, np.unique(arena.faces[arena.good]), size)
     if passages:
