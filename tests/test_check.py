@@ -270,3 +270,20 @@ def test_spawns_keep_their_manifest_index_when_one_is_malformed(tmp_path):
     toml.write_text(head + 'spawns = [\n    "not a spawn",\n' + rest)
     codes = sorted((d.code, d.message.split(" at ")[0]) for d in run_check([arena]).diagnostics)
     assert codes == [("A302", "spawn 9"), ("B102", "spawn 0 must be [x, z, heading_rad] with 3 finite numbers, got 'not a spawn'")]
+
+
+def test_a_spawn_behind_a_narrow_door_is_unreachable(tmp_path):
+    import tomli_w
+
+    from tanktool.check.manifest import tomllib
+
+    case = tmp_path / "case"
+    shutil.copytree(BROKEN / "A306_narrow_door", case)
+    toml = case / "arenas" / "narrow_door" / "arena.toml"
+    doc = tomllib.loads(toml.read_text())
+    doc["spawns"].append([35.0, 35.0, 0.0])  # in the corner room behind the 2 m door
+    toml.write_text(tomli_w.dumps(doc))
+    report = run_check([case / "arenas" / "narrow_door"])
+    got = {(d.code, d.message.split(":")[-1].strip()) for d in report.diagnostics if d.code == "A304"}
+    assert got == {("A304", "a passage on the way is too narrow for vehicle 'tank'")}
+    assert {d.code for d in report.diagnostics} == {"A304", "A306"}
