@@ -100,7 +100,7 @@ def _ends_inside(C: np.ndarray, HD: np.ndarray, spec: TankSpec, seg: np.ndarray)
     return float(max(inside.max(), 0.0))
 
 
-def _push_runs(walls, steps: int, which=None, spec: TankSpec | None = None):
+def _push_runs(walls, steps: int, which=None, spec: TankSpec | None = None, end_on: bool = True):
     spec = spec or TankSpec.box("pusher", restitution=0.2)
     seg = walls.all_segments()
     bounds = walls.bounds
@@ -121,7 +121,7 @@ def _push_runs(walls, steps: int, which=None, spec: TankSpec | None = None):
             skipped += 1
         # end-on: drive at each end along the wall's own line, slightly off-centre, so a
         # free end meets the nose between two hull points
-        for end, other in ((seg[k, 0], seg[k, 1]), (seg[k, 1], seg[k, 0])):
+        for end, other in ((seg[k, 0], seg[k, 1]), (seg[k, 1], seg[k, 0])) if end_on else ():
             u = (end - other) / np.hypot(*(end - other))
             off = np.array((-u[1], u[0])) * 0.3
             p = end + u * (R + 2.0) + off
@@ -164,16 +164,16 @@ def _run_one(walls, spec, seg, k, px, pz, heading, steps, world_box):
 
 @pytest.mark.parametrize("name,walls", _arenas(), ids=[n for n, _ in _arenas()])
 def test_push_into_every_wall(name, walls):
-    tested, skipped = _push_runs(walls, steps=1200)
+    tested, skipped = _push_runs(walls, steps=600)
     # a wall no tank can stand beside (a sliver between two others) cannot be pushed
     assert tested >= 0.9 * (tested + skipped) and tested > 0
 
 
 @pytest.mark.parametrize("name,walls", _arenas(), ids=[n for n, _ in _arenas()])
 def test_push_10000_steps(name, walls):
-    """The issue's full 10,000 steps, on three walls per arena (every wall: -m slow)."""
+    """The issue's full 10,000 steps, on one wall per arena (every wall: -m slow)."""
     n = len(walls.all_segments())
-    tested, _ = _push_runs(walls, steps=10_000, which=sorted({0, n // 2, n - 1}))
+    tested, _ = _push_runs(walls, steps=10_000, which=[n // 2], end_on=False)
     assert tested >= 1
 
 
@@ -186,12 +186,9 @@ def test_push_10000_steps_every_wall(name, walls):
 
 @pytest.mark.parametrize("spec", bundled_vehicle_specs(), ids=lambda s: s.name)
 def test_bundled_vehicles_push_into_every_wall(spec):
-    """The bundled vehicles' own hull points (8..16, not a box) in the box fixture and
-    the first bundled arena."""
-    arenas = [box_arena()[0]] + [read_walls(p / "walls.txt") for p in bundled_arenas()[:1]]
-    for walls in arenas:
-        tested, skipped = _push_runs(walls, steps=600, spec=spec)
-        assert tested > 0
+    """The bundled vehicles' own hull points (8..16, not a box) in the box fixture."""
+    tested, skipped = _push_runs(box_arena()[0], steps=480, spec=spec)
+    assert tested == len(box_arena()[0].all_segments())
 
 
 @pytest.mark.parametrize("deg", [8, 20, 45, 90, 150])
@@ -209,7 +206,7 @@ def test_driving_into_a_wedge_corner(deg):
         world = World(walls, [spec], [(45.0, 40.0, 0.0)], seed=0)
         t = world.tanks[0]
         t.place(45.0, 40.0, 0.0)
-        n = 2400
+        n = 1500
         C, H, HD = np.empty((n, 2)), np.empty((n, len(spec.hull_local), 2)), np.empty((n, 2))
         for i in range(n):
             world.step(None, [Command(advance=1.0, rotate=0.3 * math.sin(i * 0.01))])

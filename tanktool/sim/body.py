@@ -81,6 +81,7 @@ class TankSpec:
     spheres: list[tuple[float, float, float, float]] = field(init=False, repr=False)
     sphere_children: list[list[int]] = field(init=False, repr=False)
     radius: float = field(init=False)
+    box: tuple[float, float, float, float] = field(init=False, repr=False)   # footprint's (xmin, zmin, xmax, zmax)
     muzzle_local: tuple[float, float, float] = field(init=False, repr=False)
     height: float = field(init=False)
 
@@ -103,7 +104,8 @@ class TankSpec:
         if not 0.0 <= self.restitution <= 1.0:
             raise VehicleError(f"vehicle {self.name!r}: restitution must lie in [0, 1], got {self.restitution}")
         cx, _, cz = (float(c) for c in self.centre_of_mass)
-        self.hull_local = [(x - cx, z - cz) for x, _, z in hull]
+        # seen from above the top and bottom rings of a hull coincide: keep each (x, z) once
+        self.hull_local = list(dict.fromkeys((x - cx, z - cz) for x, _, z in hull))
         self.height = max(p[1] for p in hull)
         self.footprint = _convex_hull(self.hull_local)
         if len(self.footprint) < 3:
@@ -117,6 +119,9 @@ class TankSpec:
             ln = math.hypot(dx, dz)
             self.footprint_normals.append((dz / ln, -dx / ln))
         self.radius = max(math.hypot(x, z) for x, z in self.hull_local)
+        xs = [x for x, _ in self.hull_local]
+        zs = [z for _, z in self.hull_local]
+        self.box = (min(xs), min(zs), max(xs), max(zs))
         centers = [tuple(float(c) for c in p) for p in self.sphere_centers]
         radii = [float(r) for r in self.sphere_radii]
         parent = [int(p) for p in self.sphere_parent]

@@ -271,59 +271,70 @@ class WallSet:
 def wall_contacts(tank: Tank, walls: WallSet, candidates: Sequence[int]) -> list[tuple[Contact, int]]:
     """Contacts of a tank with the candidate walls: ``[((px, pz, nx, nz, depth), wall)]``.
 
-    n points away from the wall towards the tank's centre side; depth >= 0.
+    n points away from the wall towards the tank's centre side; depth >= 0.  The work
+    is done in the tank's own frame, where hull points are constants: a wall is first
+    clipped against the footprint's bounding box (almost every wall near a tank misses
+    it), and only then are the hull points tested.
     """
-    cx, cz = tank.x, tank.z
+    cx, cz, c, s = tank.x, tank.z, tank.c, tank.s
     spec = tank.spec
-    R = spec.radius
-    R2 = R * R
+    bx0, bz0, bx1, bz1 = spec.box
     out: list[tuple[Contact, int]] = []
-    hull: list[tuple[float, float]] | None = None
     for k in candidates:
-        w = walls.walls[k]
-        ax, az, ex, ez, l2, ln = w  # type: ignore[misc]
-        acx, acz = cx - ax, cz - az
-        t = (acx * ex + acz * ez) / l2
-        t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
-        qx, qz = acx - t * ex, acz - t * ez
-        if qx * qx + qz * qz > R2:
-            continue          # the wall is outside the tank's bounding circle
-        if hull is None:
-            hull = tank.hull_world()
-        sc = ex * acz - ez * acx          # which side of the wall the centre is on
+        ax, az, ex, ez, l2, ln = walls.walls[k]  # type: ignore[misc]
+        dx, dz = ax - cx, az - cz
+        lax, laz = dx * c + dz * s, -dx * s + dz * c        # wall start, tank frame
+        lex, lez = ex * c + ez * s, -ex * s + ez * c        # wall direction, tank frame
+        # slab test: does the wall cross the footprint's bounding box?
+        t0, t1 = 0.0, 1.0
+        if lex != 0.0:
+            ta, tb = (bx0 - lax) / lex, (bx1 - lax) / lex
+            if ta > tb:
+                ta, tb = tb, ta
+            t0 = ta if ta > t0 else t0
+            t1 = tb if tb < t1 else t1
+        elif lax < bx0 or lax > bx1:
+            continue
+        if lez != 0.0:
+            ta, tb = (bz0 - laz) / lez, (bz1 - laz) / lez
+            if ta > tb:
+                ta, tb = tb, ta
+            t0 = ta if ta > t0 else t0
+            t1 = tb if tb < t1 else t1
+        elif laz < bz0 or laz > bz1:
+            continue
+        if t0 > t1:
+            continue
+        # the normal points to the side of the wall the centre of mass is on
+        num_s = lax * lez - laz * lex
         nx, nz = -ez / ln, ex / ln
-        if sc < 0.0:
+        if ex * -dz - ez * -dx < 0.0:
             nx, nz = -nx, -nz
-        for px, pz in hull:
-            dx, dz = px - cx, pz - cz
-            denom = dx * ez - dz * ex
+        for px, pz in spec.hull_local:
+            denom = px * lez - pz * lex
             if denom == 0.0:
                 continue
-            # C + s·d meets A + u·e
-            s = -(acx * ez - acz * ex) / denom
-            if s < 0.0 or s > 1.0:
+            # the segment centre → P meets the wall at fraction s of it, u of the wall
+            s_ = num_s / denom
+            if s_ < 0.0 or s_ > 1.0:
                 continue
-            u = -(acx * dz - acz * dx) / denom
+            u = (lax * pz - laz * px) / denom
             if u < 0.0 or u > 1.0:
                 continue
-            depth = abs(ex * (pz - az) - ez * (px - ax)) / ln
-            out.append(((px, pz, nx, nz, depth), k))
+            depth = abs(lex * (pz - laz) - lez * (px - lax)) / ln
+            out.append(((cx + px * c - pz * s, cz + px * s + pz * c, nx, nz, depth), k))
         # the wall's end points inside the footprint (a wall end poking into the hull)
-        for qx_, qz_ in ((ax, az), (ax + ex, az + ez)):
-            ddx, ddz = qx_ - cx, qz_ - cz
-            if ddx * ddx + ddz * ddz >= R2:
-                continue
-            c = _endpoint_contact(tank, qx_, qz_)
-            if c is not None:
-                out.append((c, k))
+        for qx, qz, wx, wz in ((lax, laz, ax, az), (lax + lex, laz + lez, ax + ex, az + ez)):
+            if bx0 < qx < bx1 and bz0 < qz < bz1:
+                hit = _endpoint_contact(tank, qx, qz, wx, wz)
+                if hit is not None:
+                    out.append((hit, k))
     return out
 
 
-def _endpoint_contact(tank: Tank, ex: float, ez: float) -> Contact | None:
-    """A wall end point at world (ex, ez) strictly inside the tank's footprint."""
-    c, s = tank.c, tank.s
-    dx, dz = ex - tank.x, ez - tank.z
-    lx, lz = dx * c + dz * s, -dx * s + dz * c
+def _endpoint_contact(tank: Tank, lx: float, lz: float, ex: float, ez: float) -> Contact | None:
+    """A wall end point at (lx, lz) in the tank's frame, (ex, ez) in the world,
+    strictly inside the tank's footprint polygon."""
     spec = tank.spec
     best = math.inf
     best_n = (0.0, 0.0)
@@ -334,6 +345,7 @@ def _endpoint_contact(tank: Tank, ex: float, ez: float) -> Contact | None:
         if d < best:
             best, best_n = d, (nx, nz)
     nx, nz = best_n
+    c, s = tank.c, tank.s
     wx, wz = nx * c - nz * s, nx * s + nz * c     # edge normal in the world
     # the point pushes the tank away: the tank moves against the edge's outward normal
     return (ex, ez, -wx, -wz, best)

@@ -10,7 +10,6 @@ depends on the machine's speed.  The same seed gives the same report apart from
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import time
 from dataclasses import dataclass, field
@@ -77,34 +76,13 @@ def default_vehicle() -> str | None:
 
 
 def load_match_arena(ref: str | Path) -> ArenaInfo:
-    """Walls and spawn points of an arena bundle (name or folder)."""
+    """Walls, spawn points and bounds of an arena bundle (name or folder)."""
+    from ..arena import load_arena
+
     path = _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
-    if importlib.util.find_spec("tanktool.arena") is not None:
-        from ..arena import load_arena  # the arena engineer's loader, when present
-
-        bundle = load_arena(path)
-        spawns = np.asarray(bundle.spawns, dtype=np.float64).reshape(-1, 3)
-        return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path), np.asarray(bundle.bounds, float))
-    from ..formats.bundle import read_toml
-    from ..formats.walls_txt import read_walls
-
-    walls = read_walls(path / "walls.txt")
-    manifest = path / "arena.toml"
-    doc = read_toml(manifest)
-    raw = doc.get("spawns", doc.get("arena", {}).get("spawns"))
-    try:
-        spawns = np.asarray(raw, dtype=np.float64).reshape(-1, 3)
-    except (TypeError, ValueError):
-        raise ArenaError(f"{manifest}: 'spawns' must be a list of [x, z, heading] triples") from None
-    if not np.isfinite(spawns).all():
-        raise ArenaError(f"{manifest}: spawns must be finite numbers")
-    bounds = None
-    if doc.get("bounds") is not None:
-        try:
-            bounds = np.asarray(doc["bounds"], dtype=np.float64).reshape(2, 2)
-        except (TypeError, ValueError):
-            raise ArenaError(f"{manifest}: 'bounds' must be [[xmin, zmin], [xmax, zmax]]") from None
-    return ArenaInfo(str(doc.get("name", path.name)), walls, spawns, path, bounds)
+    bundle = load_arena(path)
+    spawns = np.asarray(bundle.spawns, dtype=np.float64).reshape(-1, 3)
+    return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path), np.asarray(bundle.bounds, float))
 
 
 def load_tank_spec(ref: str | Path | None) -> TankSpec:
