@@ -157,8 +157,10 @@ def test_spawns_spread_and_face_the_centre():
     wall_dist = np.min(np.abs(np.concatenate([sp[:, :2] - 1, 59 - sp[:, :2]], axis=1)), axis=1)
     assert wall_dist.min() >= 2.5 - 1e-9
     to_c = np.array([30, 30]) - sp[:, :2]
+    far = np.hypot(*to_c.T) >= 1.0  # one on the centre itself faces +x
+    assert np.allclose(sp[~far, 2], 0.0)
     f = np.stack([np.cos(sp[:, 2]), np.sin(sp[:, 2])], axis=1)
-    assert ((f * to_c).sum(axis=1) / np.hypot(*to_c.T)).min() > 0.999
+    assert ((f * to_c).sum(axis=1)[far] / np.hypot(*to_c[far].T)).min() > 0.999
 
 
 @pytest.mark.skipif(not (DATA / "arenas_obj" / "dungeon.obj").exists(), reason="test model missing")

@@ -6,7 +6,7 @@ could never meet) that keep at least ``clearance`` metres from every wall.  The
 spawns are then picked by farthest-point sampling -- the first is the candidate
 nearest the region's centre, each next one the candidate farthest from all chosen
 so far -- so they are spread out and deterministic.  Each faces the arena centre
-(the centre of the auxiliary rectangle).
+(the centre of the auxiliary rectangle); one within 1 m of it faces +x.
 """
 
 from __future__ import annotations
@@ -76,6 +76,6 @@ def place_spawns(free, bounds: np.ndarray, count: int = SPAWN_COUNT, clearance: 
     p = pts[chosen]
     centre = np.asarray(bounds, dtype=np.float64).mean(axis=0)
     heading = np.arctan2(centre[1] - p[:, 1], centre[0] - p[:, 0])
-    # a spawn at the very centre has no direction to face: keep +x
-    heading = np.where(np.hypot(*(centre - p).T) < 1e-9, 0.0, heading)
+    # a spawn on the centre itself has no direction to face: it faces +x
+    heading = np.where(np.hypot(*(centre - p).T) < 1.0, 0.0, heading)
     return np.column_stack([p, heading])

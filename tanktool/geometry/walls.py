@@ -68,6 +68,8 @@ class FloorLevel:
     area: float
     faces: np.ndarray  # (k,) indices of the floor level's upward faces
     levels: list[tuple[float, float]] = field(default_factory=list)  # (height, area) per level
+    up: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))  # every upward face
+    up_height: np.ndarray = field(default_factory=lambda: np.zeros(0))  # their centroid heights
 
 
 @dataclass
@@ -90,25 +92,48 @@ class WallExtraction:
 # 1. the floor
 
 
+def _upward_faces(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+    """Faces whose normal is within ~25 degrees of +y.
+
+    Returns (indices, centroid heights, areas, any_downward).  The cross product is
+    written out per component: on a million faces this is several times faster
+    than gathering (m, 3, 3) triangles and calling ``np.cross``.
+    """
+    # contiguous coordinate and index columns gather much faster than (m, 3) rows
+    X, Y, Z = (np.ascontiguousarray(vertices[:, k]) for k in range(3))
+    f0, f1, f2 = (np.ascontiguousarray(faces[:, k]) for k in range(3))
+    x0, z0 = X[f0], Z[f0]
+    e1x, e1z, e2x, e2z = X[f1] - x0, Z[f1] - z0, X[f2] - x0, Z[f2] - z0
+    ny = e1z * e2x - e1x * e2z
+    # only faces leaning up or down can be steep: the rest is computed on those alone
+    cand = np.flatnonzero(ny != 0)
+    y0 = Y[f0[cand]]
+    e1y = Y[f1[cand]] - y0
+    e2y = Y[f2[cand]] - y0
+    e1x, e1z, e2x, e2z, nyc = e1x[cand], e1z[cand], e2x[cand], e2z[cand], ny[cand]
+    nx = e1y * e2z - e1z * e2y
+    nz = e1x * e2y - e1y * e2x
+    n2 = nx * nx + nyc * nyc + nz * nz
+    steep = nyc * nyc >= UP_NORMAL_MIN ** 2 * n2
+    is_up = steep & (nyc > 0)
+    up = cand[is_up]
+    down = bool(np.any(steep & (nyc < 0)))
+    height = (Y[f0[up]] + Y[f1[up]] + Y[f2[up]]) / 3
+    return up, height, np.sqrt(n2[is_up]) / 2, down
+
+
 def find_floor(vertices: np.ndarray, faces: np.ndarray) -> FloorLevel:
     """The lowest large horizontal upward surface (rule in the module docstring).
 
     vertices (n, 3) world frame (Y up), faces (m, 3) int.  Raises ArenaError when
     the model has no upward-facing faces at all.
     """
-    tri = vertices[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    area2 = np.linalg.norm(normal, axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ny = np.where(area2 > 0, normal[:, 1] / area2, 0.0)
-    up = np.flatnonzero(ny >= UP_NORMAL_MIN)
+    up, height, area, down = _upward_faces(vertices, faces)
     if len(up) == 0:
-        if np.any(ny <= -UP_NORMAL_MIN):
+        if down:
             raise ArenaError("no upward-facing floor: the model's faces seem wound inside out "
                              "(or its up axis is wrong: try --up)")
         raise ArenaError("no horizontal surface to stand on (no face has a vertical normal; try --up)")
-    height = tri[up, :, 1].mean(axis=1)
-    area = area2[up] / 2
     order = np.argsort(height, kind="stable")
     h = height[order]
     split = np.flatnonzero(np.diff(h) > LEVEL_GAP) + 1
@@ -119,17 +144,12 @@ def find_floor(vertices: np.ndarray, faces: np.ndarray) -> FloorLevel:
     k = int(large[0])
     stop = starts[k + 1] if k + 1 < len(starts) else len(h)
     levels = [(float(a), float(b)) for a, b in zip(level_h, level_area)]
-    return FloorLevel(float(level_h[k]), float(level_area[k]), up[order[starts[k]:stop]], levels)
+    return FloorLevel(float(level_h[k]), float(level_area[k]), up[order[starts[k]:stop]], levels, up, height)
 
 
-def floor_faces(vertices: np.ndarray, faces: np.ndarray, floor_y: float, cut_y: float) -> np.ndarray:
+def floor_faces(floor: FloorLevel, cut_y: float) -> np.ndarray:
     """Indices of the upward faces from the floor level up to the cut height."""
-    tri = vertices[faces]
-    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    area2 = np.linalg.norm(normal, axis=1)
-    h = tri[:, :, 1].mean(axis=1)
-    up = normal[:, 1] >= UP_NORMAL_MIN * area2
-    return np.flatnonzero(up & (area2 > 0) & (h >= floor_y - LEVEL_GAP) & (h < cut_y))
+    return floor.up[(floor.up_height >= floor.y - LEVEL_GAP) & (floor.up_height < cut_y)]
 
 
 # ---------------------------------------------------------------------------
@@ -146,12 +166,12 @@ def slice_mesh(vertices: np.ndarray, faces: np.ndarray, y: float) -> tuple[np.nd
     i.e. for outward normals the solid is on the left.
     """
     d = vertices[:, 1] - y
-    above = d >= 0.0  # on the plane counts as above: shared edges cut identically
-    fa = above[faces]
-    count = fa.sum(axis=1)
-    crossing = (count == 1) | (count == 2)
+    above = (d >= 0.0).view(np.uint8)  # on the plane counts as above: shared edges cut identically
+    # per-column gathers: several times faster than above[faces].sum(axis=1)
+    count = above[faces[:, 0]] + above[faces[:, 1]] + above[faces[:, 2]]
+    crossing = np.flatnonzero((count == 1) | (count == 2))
     f = faces[crossing]
-    fa = fa[crossing]
+    fa = above[f].astype(bool)
     if len(f) == 0:
         return np.zeros((0, 2, 2)), np.zeros((0, 2)), np.zeros((0, 2), dtype=np.int64)
     # the lone vertex (the one on its own side) goes first; the cyclic order is kept
@@ -462,7 +482,7 @@ def extract_walls(vertices: np.ndarray, faces: np.ndarray, height: float = 1.0, 
     t0 = time.perf_counter()
     # everything horizontal from the floor level up to the cut is ground a tank
     # stands on (kerbs, low platforms); higher surfaces are tops of walls
-    ground = floor_faces(vertices, faces, floor.y, cut_y)
+    ground = floor_faces(floor, cut_y)
     floor_poly = floor_region(vertices, faces[ground], tolerance)
     solid, chains, nrings = cross_sections(seg, nrm, nodes, tolerance, floor_poly)
     t["sections"] = time.perf_counter() - t0
