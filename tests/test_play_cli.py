@@ -69,3 +69,24 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path):
                                  str(tmp_path / "no" / "such" / "r.json")])
     assert r.exit_code == 2 and "does not exist" in r.output
     assert not (tmp_path / "no").exists()
+
+
+def test_reports_match_across_processes(tmp_path):
+    """No hash-order or clock dependence: two interpreters with different hash seeds
+    write the same report (apart from timing)."""
+    import os
+    import subprocess
+    import sys
+
+    arena = _arena(tmp_path, maze=True)
+    reports = []
+    for hashseed in ("1", "2"):
+        out = tmp_path / f"r{hashseed}.json"
+        env = dict(os.environ, PYTHONHASHSEED=hashseed)
+        subprocess.run([sys.executable, "-m", "tanktool", "-q", "play", "--headless", "--arena", str(arena),
+                        "--bots", "5", "--seconds", "4", "--seed", "9", "--report", str(out)],
+                       check=True, env=env, capture_output=True)
+        rep = json.loads(out.read_text())
+        rep.pop("timing")
+        reports.append(rep)
+    assert reports[0] == reports[1]
