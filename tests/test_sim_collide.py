@@ -208,3 +208,20 @@ def test_kinetic_energy_never_grows_in_a_melee():
         assert w.kinetic_energy() <= ke0 * (1 + 1e-12) + 1e-9
         collisions += w.iterations_used > 0
     assert collisions > 20
+
+
+@pytest.mark.parametrize("e", [0.0, 0.3, 1.0])
+def test_restitution_law_in_a_world_step(e):
+    """Head-on along x: after the impact step the closing speed is -e times what it was."""
+    w = _two_tank_world(e, 0.0, 0.0)
+    a, b = w.tanks
+    b.vz = 0.0
+    closing = a.vx - b.vx
+    for _ in range(240):
+        w.step()
+        if w.iterations_used:
+            break
+    else:
+        pytest.fail("no impact")
+    assert a.vx - b.vx == pytest.approx(-e * closing, abs=1e-6)
+    assert abs(a.omega) < 1e-12 and abs(b.omega) < 1e-12
