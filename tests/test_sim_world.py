@@ -260,3 +260,24 @@ def test_bounds_become_walls_when_the_list_has_no_auxiliary_rectangle():
         w.step(None, [Command(advance=1.0)])
     assert len(w.walls) == 5
     assert max(z for _, z in t.hull_world()) <= 30.0 + 1e-3 and t.wall_bumps >= 1
+
+
+def test_snapshot_and_restore_continue_identically():
+    walls, spawns = box_arena()
+    w = World(walls, [TankSpec.box("t")] * 6, spawns, seed=8, respawn_delay=1.0)
+    w.tanks[0].place(30.0, 30.0, 0.0)
+    w.tanks[1].place(55.0, 30.0, math.pi)
+    cmds = [Command(fire=True), Command(fire=True)] + [Command(advance=1.0, rotate=0.3 * i) for i in range(4)]
+    for _ in range(200):
+        w.step(None, cmds)
+    snap = w.snapshot()
+    later = []
+    for _ in range(700):
+        later += [e.to_dict() for e in w.step(None, cmds)]
+    end = w.state()
+    w.restore(snap)
+    again = []
+    for _ in range(700):
+        again += [e.to_dict() for e in w.step(None, cmds)]
+    assert w.state() == end and again == later
+    assert {"hit", "kill", "respawn"} <= {e["kind"] for e in later}

@@ -176,6 +176,36 @@ class World:
                 tuple((t.x, t.z, t.heading, t.vx, t.vz, t.omega, t.hp, t.alive, t.reload) for t in self.tanks),
                 tuple((s.owner, s.x, s.y, s.z, s.vx, s.vy, s.vz) for s in self.shells))
 
+    _TANK_FIELDS = ("x", "z", "heading", "vx", "vz", "omega", "hp", "alive", "respawn_at", "reload",
+                    "kills", "deaths", "shots", "hits", "wall_bumps", "distance", "touching_wall")
+
+    def snapshot(self) -> dict[str, Any]:
+        """Everything needed to continue this world exactly (plain data: for network
+        peers taking over a session, replays, tests)."""
+        return {
+            "t": self.t, "steps": self.steps, "rng": self.rng.getstate(),
+            "tanks": [{f: getattr(t, f) for f in self._TANK_FIELDS} for t in self.tanks],
+            "shells": [{f: getattr(s, f) for f in Shell.__slots__} for s in self.shells],
+        }
+
+    def restore(self, snap: dict[str, Any]) -> None:
+        """Return to a :meth:`snapshot` of a world with the same walls and tanks."""
+        if len(snap["tanks"]) != len(self.tanks):
+            raise ValueError(f"snapshot has {len(snap['tanks'])} tanks, this world {len(self.tanks)}")
+        self.t, self.steps = snap["t"], snap["steps"]
+        self.rng.setstate(snap["rng"])
+        for t, d in zip(self.tanks, snap["tanks"]):
+            for f in self._TANK_FIELDS:
+                setattr(t, f, d[f])
+            t.c, t.s = math.cos(t.heading), math.sin(t.heading)
+            t.wall_cache = None
+        self.shells = []
+        for d in snap["shells"]:
+            sh = Shell.__new__(Shell)
+            for f in Shell.__slots__:
+                setattr(sh, f, d[f])
+            self.shells.append(sh)
+
     def momentum(self) -> tuple[float, float]:
         """Total linear momentum of the live tanks [kg m/s]."""
         return (sum(t.spec.mass * t.vx for t in self.tanks if t.alive),
