@@ -287,3 +287,27 @@ def test_a_spawn_behind_a_narrow_door_is_unreachable(tmp_path):
     got = {(d.code, d.message.split(":")[-1].strip()) for d in report.diagnostics if d.code == "A304"}
     assert got == {("A304", "a passage on the way is too narrow for vehicle 'tank'")}
     assert {d.code for d in report.diagnostics} == {"A304", "A306"}
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_synthetic_arenas_lint_clean(seed):
+    """Mazes of touching square blocks (shared edges, solids walled in by solids) and
+    rooms with random obstacles and courtyards are valid wall lists."""
+    from tanktool.check.walls_rules import bare_walls_leaks, check_walls
+    from tanktool.nav.synthetic import block_maze, random_arena
+
+    for walls in (block_maze(seed, n=6), random_arena(seed)):
+        fs = analyse(walls)
+        assert [d.format() for d in check_walls(walls, fs, "w") + bare_walls_leaks(fs, "w")] == []
+
+
+def test_a_long_wall_votes_for_every_face_along_it():
+    # the bottom and top walls run along two rooms split by a one-sided partition:
+    # each of their pieces votes for its own room, so both rooms come out free
+    from tanktool.check.walls_rules import check_walls
+
+    walls = _room([[[5, 0], [5, 10]]], [1])
+    fs = analyse(walls)
+    assert len(fs.faces) == 2 and fs.free.all()
+    assert (fs.piece_wall == 0).sum() == 2  # the bottom wall is two pieces, one per room
+    assert check_walls(walls, fs, "w") == []

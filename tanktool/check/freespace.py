@@ -49,6 +49,12 @@ class FreeSpace:
     grid: float                      # snapping grid, metres
     lines: object                    # (n,) shapely LineStrings of the walls (None for zero-length)
     noded: object                    # the walls as one noded geometry
+    # the noded pieces of the walls: the wall each lies along, its sides, length, line
+    piece_wall: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64), repr=False)
+    piece_front: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64), repr=False)
+    piece_back: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64), repr=False)
+    piece_length: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    piece_lines: object = field(default=None, repr=False)
     _wall_tree: STRtree | None = field(default=None, repr=False)
     _wall_ids: np.ndarray | None = field(default=None, repr=False)
 
@@ -116,19 +122,21 @@ class FreeSpace:
         # faster than buffering every wall; only walls lying inside a face (both sides
         # in it, e.g. a fence or a loose end) need their own buffer
         clear = shapely.buffer(region, -float(radius), quad_segs=8)
-        inner = np.flatnonzero((self.front == self.back) & np.isin(self.front, ids))
+        inner = np.flatnonzero((self.piece_front == self.piece_back) & np.isin(self.piece_front, ids))
         if len(inner):
-            clear = shapely.difference(clear, shapely.buffer(shapely.union_all(self.lines[inner]),
+            clear = shapely.difference(clear, shapely.buffer(shapely.union_all(self.piece_lines[inner]),
                                                              float(radius), quad_segs=8))
         return clear
 
     def flipped(self) -> np.ndarray:
-        """(n,) bool: walls whose normal points into solid while their back faces free space."""
+        """(n,) bool: walls with a piece whose normal points into solid (or the outside)
+        while its back faces free space."""
         free = np.append(self.free, False)  # index -1 (unbounded) is never free
-        ok = self.front >= UNBOUNDED
-        f = np.where(ok, self.front, UNBOUNDED)
-        b = np.where(ok, self.back, UNBOUNDED)
-        return ok & (f != b) & ~free[f] & free[b]
+        f, b = self.piece_front, self.piece_back
+        bad = (f != b) & ~free[f] & free[b]
+        out = np.zeros(len(self.front), dtype=bool)
+        out[self.piece_wall[bad]] = True
+        return out
 
 
 def snap_grid(segments: np.ndarray) -> float:
@@ -163,23 +171,48 @@ def analyse(walls: WallList) -> FreeSpace:
     fs._wall_tree = STRtree(lines[live])
     fs._wall_ids = live
 
-    # a point a hair in front of and behind each wall, a little off its middle so
-    # that it does not land on a T junction placed exactly at the middle
-    p, q = snapped[live, 0], snapped[live, 1]
-    d = q - p
-    L = length[live]
-    normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / L[:, None] * walls.direction[live, None]
-    eps = np.minimum(100.0 * g, 0.05 * L)
-    mid = p + (0.5 + 1.0 / 128.0) * d
-    sides = fs.face_of(np.concatenate([mid + eps[:, None] * normal, mid - eps[:, None] * normal]))
-    front[live] = sides[: len(live)]
-    back[live] = sides[len(live):]
+    # Sides are sampled per noded piece, not per wall: a long wall split by T
+    # junctions borders a different face along each piece, and each piece must vote
+    # for its own faces.  A piece maps back to every wall lying along it (duplicates
+    # and the two coincident walls of touching solids give several).
+    pieces = parts[shapely.get_type_id(parts) == 1] if len(parts) else np.zeros(0, object)
+    # every segment of every noded linestring (GEOS may chain segments through
+    # vertices where nothing else meets)
+    xy, owner = shapely.get_coordinates(pieces, return_index=True)
+    same = owner[1:] == owner[:-1]
+    pa, pb = xy[:-1][same], xy[1:][same]
+    pl = np.hypot(*(pb - pa).T)
+    ok = pl > 0
+    pa, pb, pl = pa[ok], pb[ok], pl[ok]
+    # a point a little off the piece's middle, so it does not land on a T junction
+    # placed exactly at the middle of a wall
+    pmid = pa + (0.5 + 1.0 / 128.0) * (pb - pa)
+    pi, ti = fs._wall_tree.query(shapely.points(pmid), predicate="dwithin", distance=2.0 * g)
+    w = live[ti]
+    d = snapped[w, 1] - snapped[w, 0]
+    normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / length[w, None] * walls.direction[w, None]
+    eps = np.minimum(100.0 * g, 0.05 * pl[pi])
+    m = pmid[pi]
+    sides = fs.face_of(np.concatenate([m + eps[:, None] * normal, m - eps[:, None] * normal]))
+    pf, pbk = sides[: len(pi)], sides[len(pi):]
+    fs.piece_wall, fs.piece_front, fs.piece_back, fs.piece_length = w, pf, pbk, pl[pi]
+    fs.piece_lines = shapely.linestrings(np.stack([pa[pi], pb[pi]], axis=1)) if len(pi) else np.zeros(0, object)
 
     vote = np.zeros(len(faces) + 1)
-    np.add.at(vote, front[live], L)   # index -1 lands in the extra last slot
-    np.add.at(vote, back[live], -L)
-    fs.free = vote[: len(faces)] > 0
+    weight = np.zeros(len(faces) + 1)
+    np.add.at(vote, pf, pl[pi])   # index -1 (unbounded) lands in the extra last slot
+    np.add.at(vote, pbk, -pl[pi])
+    np.add.at(weight, pf, pl[pi])
+    np.add.at(weight, pbk, pl[pi])
+    # a tie is no claim of free space: a solid walled in by other solids (every edge a
+    # cancelling pair) sums to zero up to rounding, and must stay solid
+    fs.free = vote[: len(faces)] > 1e-9 * (1.0 + weight[: len(faces)])
 
+    # each wall's own sides: those of its longest piece
+    order = np.lexsort((-pl[pi], w))
+    first = order[np.r_[True, w[order][1:] != w[order][:-1]]] if len(order) else order
+    front[w[first]] = pf[first]
+    back[w[first]] = pbk[first]
     fs.dangling, fs.dangling_wall = _dangling_ends(snapped, live, lines, g)
     return fs
 
