@@ -342,7 +342,7 @@ def islands(fs: FreeSpace, spawn_faces: set[int], wpath: str) -> list[Diagnostic
     for f in np.flatnonzero(fs.free):
         if int(f) in spawn_faces or fs.faces[f].area < ISLAND_MIN_AREA:
             continue
-        walls_of = np.flatnonzero(fs.front == f)
+        walls_of = np.sort(fs.piece_wall[fs.piece_front == f])
         line = _wl(fs.walls, int(walls_of[0])) if len(walls_of) else 0
         p = shapely.point_on_surface(fs.faces[f])
         out.append(diag("A307", wpath, line,

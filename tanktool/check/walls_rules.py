@@ -90,8 +90,12 @@ def pair_rules(walls: WallList, grid: float) -> list[Diagnostic]:
 def flipped_normals(fs: FreeSpace, path: str) -> list[Diagnostic]:
     walls = fs.walls
     out = []
+    free = np.append(fs.free, False)
     for k in np.flatnonzero(fs.flipped()):
-        where = "the outside of the arena" if fs.front[k] == UNBOUNDED else "solid material"
+        mine = fs.piece_wall == k
+        bad = mine & (fs.piece_front != fs.piece_back) & ~free[fs.piece_front] & free[fs.piece_back]
+        into = fs.piece_front[np.flatnonzero(bad)[0]] if bad.any() else fs.front[k]
+        where = "the outside of the arena" if into == UNBOUNDED else "solid material"
         out.append(diag("A205", path, _line(walls, k),
                         f"the normal of this wall points into {where}; free space is behind it"))
     return out
@@ -121,7 +125,7 @@ def bare_walls_leaks(fs: FreeSpace, path: str) -> list[Diagnostic]:
     when a wall's normal points into the unbounded outside and wall ends are loose."""
     if not len(fs.dangling):
         return []
-    if not (fs.front == UNBOUNDED).any():
+    if not (fs.piece_front == UNBOUNDED).any():
         return []
     return leak_diagnostics(fs, path, "the free space")
 
