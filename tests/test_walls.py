@@ -115,6 +115,20 @@ def test_inverted_winding_and_duplicate_vertices():
     assert shapely.contains_xy(ex.free, 10.0, 10.0)
 
 
+def test_round_off_between_split_vertices_is_merged():
+    # every face with its own vertices, each jittered by up to 1e-6 m (float32
+    # round-off of a 3DS file): loops must still close and the pillar stay solid
+    m = trimesh.util.concatenate(room() + [slab(18, 18, 22, 22, 0, 3)])
+    v = m.vertices[m.faces.reshape(-1)]
+    v = v + np.random.default_rng(1).uniform(-1e-6, 1e-6, v.shape)
+    ex = extract_walls(v, np.arange(len(v)).reshape(-1, 3))
+    assert len(ex.walls) == 8 and ex.thin_walls == 0
+    assert not shapely.contains_xy(ex.free, 20.0, 20.0)
+    # a wall whose top is exactly at the cut height is a wall (the plane moves down)
+    ex = extract_walls(*join(room() + [slab(18, 18, 22, 22, 0, 1.0)]))
+    assert len(ex.walls) == 8
+
+
 def test_pieces_shorter_than_tolerance_are_dropped():
     # a 4 mm bump on the east wall
     parts = room() + [slab(38.996, 10, 39.0, 30, 0, 4)]
@@ -175,3 +189,33 @@ def test_dungeon_main_level():
     assert shapely.contains_xy(ex.free, into_free[:, 0], into_free[:, 1]).mean() > 0.95
     sp = place_spawns(ex.free, w.bounds)
     assert shapely.contains_xy(ex.free, sp[:, 0], sp[:, 1]).all()
+
+
+@pytest.mark.skipif(not (DATA / "arenas_obj" / "house.obj").exists(), reason="test model missing")
+def test_house_ground_floor():
+    m = trimesh.load(DATA / "arenas_obj" / "house.obj", force="mesh", process=False)
+    ex = extract_walls(m.vertices, m.faces)
+    # the ground floor at y ~ 0.3 (not the upper storey at ~ 4.5 or the roof)
+    assert ex.floor_y == pytest.approx(0.3, abs=0.05)
+    assert 150 < ex.free.area < 260  # a ~15 x 15 m ground floor minus its walls
+    w = ex.walls
+    into_free = w.segments.mean(axis=1) + 0.005 * w.normals
+    assert shapely.contains_xy(ex.free, into_free[:, 0], into_free[:, 1]).mean() > 0.95
+
+
+def test_single_sided_room_shell_gives_its_outline_once():
+    # a level built of single faces: a floor quad and four inward-facing wall quads
+    s = 20.0
+    v = [[0, 0, 0], [s, 0, 0], [s, 0, s], [0, 0, s], [0, 3, 0], [s, 3, 0], [s, 3, s], [0, 3, s]]
+    floor = [[0, 2, 1], [0, 3, 2]]  # wound to face +y
+    walls = []
+    for a, b in ((0, 1), (1, 2), (2, 3), (3, 0)):
+        walls += [[a, b, b + 4], [a, b + 4, a + 4]]
+    mesh = trimesh.Trimesh(v, floor + walls, process=False)
+    mesh.fix_normals()  # whatever the winding, the result must be the same
+    ex = extract_walls(mesh.vertices, mesh.faces)
+    assert ex.floor_y == pytest.approx(0.0)
+    assert len(ex.walls) == 4 and ex.thin_walls == 0
+    assert shapely.area(ex.free) == pytest.approx(s * s)
+    mid = ex.walls.segments.mean(axis=1)
+    assert ((np.array([s / 2, s / 2]) - mid) * ex.walls.normals).sum(axis=1).min() > 0

@@ -11,8 +11,9 @@ The pipeline, each step a function below:
    a multi-storey model the ground storey wins over a bigger upper one only when it
    is at least a quarter of its size.
 2. :func:`slice_mesh` -- cut every triangle with the plane ``y = floor + height``
-   (numpy, all crossing triangles at once).  A vertex exactly on the plane counts as
-   above it, so a shared edge always yields the same cut point and loops close.
+   (numpy, all crossing triangles at once).  Vertices closer than
+   :func:`merge_distance` are merged and the plane is moved off every vertex, so a
+   shared edge always yields the same cut point and loops close.
    Each cut segment keeps the horizontal part of its face normal: it says which
    side is solid.
 3. :func:`cross_sections` -- join the segments into closed rings and open chains
@@ -156,8 +157,38 @@ def floor_faces(floor: FloorLevel, cut_y: float) -> np.ndarray:
 # 2. the cut
 
 
-def slice_mesh(vertices: np.ndarray, faces: np.ndarray, y: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def merge_distance(vertices: np.ndarray) -> float:
+    """Vertices closer than this are one vertex: a few float32 ulps of the model's
+    largest coordinate (5e-5 m on a 100 m arena), far below any wall tolerance."""
+    return 5e-7 * max(1.0, float(np.abs(vertices).max()) if len(vertices) else 1.0)
+
+
+def _cluster_points(pos: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Group points closer than ``eps`` (transitively).
+
+    Returns (label per point, index of one representative point per label).
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(pos).query_pairs(eps, output_type="ndarray")
+    n = len(pos)
+    if len(pairs) == 0:
+        return np.arange(n), np.arange(n)
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    _, rep = np.unique(label, return_index=True)
+    return label, rep
+
+
+def slice_mesh(vertices: np.ndarray, faces: np.ndarray, y: float,
+               merge: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cut triangles with the plane ``Y = y``.
+
+    ``merge``: vertices closer than this are joined (default :func:`merge_distance`);
+    the plane must keep more than twice that from every vertex
+    (:func:`extract_walls` moves it so).
 
     Returns ``segments`` (s, 2, 2) in (x, z), ``normals`` (s, 2) the horizontal part
     of each face normal (not normalised) and ``nodes`` (s, 2) int, an id per cut
@@ -178,12 +209,13 @@ def slice_mesh(vertices: np.ndarray, faces: np.ndarray, y: float) -> tuple[np.nd
     lone = np.where(count[crossing] == 1, np.argmax(fa, axis=1), np.argmin(fa, axis=1))
     rows = np.arange(len(f))[:, None]
     f = f[rows, (lone[:, None] + np.arange(3)) % 3]
-    # merge vertices at the same position (split seams of .3ds/.obj files) so that
-    # neighbouring triangles share edge ids; only the crossing triangles' vertices
+    # merge vertices within ``merge`` of each other (split seams of .3ds/.obj files,
+    # float32 round-off between objects) so that neighbouring triangles share edge
+    # ids; only the crossing triangles' vertices, so this stays cheap
     used, inv = np.unique(f, return_inverse=True)
-    pos = np.ascontiguousarray(vertices[used])
-    _, merged = np.unique(pos.view(np.dtype((np.void, 24))).reshape(-1), return_inverse=True)
-    g = merged.reshape(-1)[inv.reshape(f.shape)]
+    merged, rep = _cluster_points(vertices[used], merge if merge is not None else merge_distance(vertices))
+    g = merged[inv.reshape(f.shape)]
+    P = vertices[used][rep]  # one representative position per merged vertex
     # edges (lone, next) and (lone, prev): canonical (low id, high id) order so the
     # arithmetic, and hence the cut point, is identical in both adjacent triangles
     ends = []
@@ -191,17 +223,14 @@ def slice_mesh(vertices: np.ndarray, faces: np.ndarray, y: float) -> tuple[np.nd
     for other in (1, 2):
         a = np.minimum(g[:, 0], g[:, other])
         b = np.maximum(g[:, 0], g[:, other])
-        swap = g[:, 0] > g[:, other]
-        ia = np.where(swap, f[:, other], f[:, 0])
-        ib = np.where(swap, f[:, 0], f[:, other])
-        pa = vertices[ia]
-        pb = vertices[ib]
+        pa = P[a]
+        pb = P[b]
         da = pa[:, 1] - y
         db = pb[:, 1] - y
         t = da / (da - db)
         p = pa + t[:, None] * (pb - pa)
         ends.append(p[:, [0, 2]])
-        keys.append(a.astype(np.int64) * (len(used) + 1) + b)
+        keys.append(a.astype(np.int64) * (len(P) + 1) + b)
     p0, p1 = ends
     tri = vertices[f]
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])[:, [0, 2]]
@@ -404,7 +433,6 @@ def _ring_walls(ring: np.ndarray) -> np.ndarray:
 def outline_walls(free, tolerance: float) -> np.ndarray:
     """Walls along the boundary of ``free`` with free space on their left, so that
     Direction +1 gives normals into free space.  (n, 2, 2)."""
-    free = shapely.simplify(free, tolerance, preserve_topology=True)
     free = shapely.orient_polygons(free, exterior_cw=False)  # exterior CCW, holes CW
     out = []
     for poly in shapely.get_parts(free):
@@ -440,11 +468,13 @@ def thin_walls(chains: list, free, tolerance: float) -> np.ndarray:
 AUX_MARGIN = 1.0
 
 
-def _plane_clear_of_vertices(vertices: np.ndarray, y: float) -> float:
-    """Nudge the cut plane off any vertex lying on it (no on-plane special cases)."""
-    step = 1e-6 * max(1.0, abs(y))
-    for _ in range(8):
-        if not np.any(np.abs(vertices[:, 1] - y) < step / 4):
+def _plane_clear_of_vertices(vertices: np.ndarray, y: float, merge: float) -> float:
+    """Nudge the cut plane down until no vertex lies within 2 x ``merge`` of it:
+    no on-plane special cases, and no merged vertex straddles the plane."""
+    step = 4 * merge
+    ys = vertices[:, 1]
+    for _ in range(64):
+        if np.abs(ys - y).min() > 2 * merge:
             return y
         y -= step
     return y
@@ -472,11 +502,12 @@ def extract_walls(vertices: np.ndarray, faces: np.ndarray, height: float = 1.0, 
     t = {}
     t0 = time.perf_counter()
     floor = find_floor(vertices, faces)
-    cut_y = _plane_clear_of_vertices(vertices, floor.y + height)
+    merge = merge_distance(vertices)
+    cut_y = _plane_clear_of_vertices(vertices, floor.y + height, merge)
     t["floor"] = time.perf_counter() - t0
     step("floor")
     t0 = time.perf_counter()
-    seg, nrm, nodes = slice_mesh(vertices, faces, cut_y)
+    seg, nrm, nodes = slice_mesh(vertices, faces, cut_y, merge)
     t["cut"] = time.perf_counter() - t0
     step("cut")
     t0 = time.perf_counter()
@@ -498,6 +529,8 @@ def extract_walls(vertices: np.ndarray, faces: np.ndarray, height: float = 1.0, 
             f"no free space at {height:g} m above the floor (floor at y={floor.y:.3f}): "
             "the cut lies inside solid material everywhere there is floor"
         )
+    # merge collinear pieces; the free space kept is exactly what the walls outline
+    free = shapely.simplify(free, tolerance, preserve_topology=True)
     outline = outline_walls(free, tolerance)
     thin = thin_walls(chains, free, tolerance)
     t["free"] = time.perf_counter() - t0
