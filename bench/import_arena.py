@@ -76,7 +76,7 @@ def run(repeat: int, quick: bool) -> list[dict]:
         rows.append({
             "model": name, "faces": int(len(f)), "bare_cut_ms": round(t_bare * 1000, 1),
             "extraction_ms": round(t_ours * 1000, 1), "ratio": round(t_ours / t_bare, 2),
-            "bare_segments": int(len(sec.entities)) if sec is not None else 0,
+            "bare_polylines": int(len(sec.entities)) if sec is not None else 0,
             "walls": int(len(ex.walls)), "stages_ms": {k: round(s * 1000, 1) for k, s in ex.timings.items()},
         })
     return rows
