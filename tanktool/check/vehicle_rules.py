@@ -24,6 +24,8 @@ from .manifest import Manifest, file_rules, safe_file
 #: hull.txt and spheres.txt hold 4 decimals; the tools round so the written shapes still
 #: enclose, float32 storage in model.glb adds ~1e-7 relative: 0.2 mm covers both
 GEOM_TOL = 2e-4
+#: m: hull points and spheres farther out than this are typos, not vehicles
+MAX_SIZE = 1000.0
 
 
 def scan_hull(path: Path) -> tuple[np.ndarray, list[Diagnostic]]:
@@ -44,6 +46,10 @@ def scan_hull(path: Path) -> tuple[np.ndarray, list[Diagnostic]]:
             continue
         if not all(math.isfinite(c) for c in xyz):
             out.append(diag("V101", str(path), no, f"coordinates must be finite numbers, got {line!r}"))
+            continue
+        if max(abs(c) for c in xyz) > MAX_SIZE:
+            out.append(diag("V101", str(path), no, f"a point beyond +-{MAX_SIZE:g} m: {line!r}",
+                            "check the number: hull points are in metres, vehicle frame"))
             continue
         rows.append(xyz)
     if not HULL_MIN <= len(rows) <= HULL_MAX and not out:
@@ -82,6 +88,8 @@ def scan_spheres(path: Path) -> tuple[SphereTree | None, np.ndarray, list[Diagno
             problem = "centre and radius must be finite numbers"
         elif r < 0:
             problem = f"radius must not be negative, got {r:g}"
+        elif max(abs(cx), abs(cy), abs(cz), r) > MAX_SIZE:
+            problem = f"centre or radius beyond {MAX_SIZE:g} m: a vehicle is not that big"
         elif sid != n:
             problem = f"expected sphere id {n} (ids count up from 0), got {sid}"
         elif n == 0 and (par != -1 or lev != 1):
@@ -241,8 +249,10 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
                             f"centre of mass ({com[0]:g}, {com[1]:g}, {com[2]:g}) is outside the hull"))
         else:
             # no body has more inertia than with all its mass on the hull's farthest rim
-            r2 = float(np.max((hull[:, 0] - com[0]) ** 2 + (hull[:, 2] - com[2]) ** 2))
-            if inertia > mass * r2 * (1 + 1e-6):
+            with np.errstate(all="ignore"):  # absurd figures overflow to inf, and are then reported
+                r2 = float(np.max((hull[:, 0] - com[0]) ** 2 + (hull[:, 2] - com[2]) ** 2))
+                too_much = inertia > mass * r2 * (1 + 1e-6)
+            if too_much:
                 out.append(diag("V302", mpath, man.lines.key("mass", "inertia"),
                                 f"[mass] inertia = {inertia:g} kg m^2 is more than the {mass * r2:.4g} kg m^2 "
                                 "of all the mass on the hull's rim: impossible"))
