@@ -1,0 +1,492 @@
+"""The one message layout of network play (paper §3.3: "the same data structure for
+every message type, each field treated differently").
+
+Every message, on TCP or UDP, is a 22-byte header followed by its payload, all
+big-endian (network order)::
+
+    offset size field      type   meaning
+    0      4    magic      4s     b"TKNP"
+    4      1    version    u8     VERSION
+    5      1    type       u8     one of the MessageType values
+    6      1    sender     u8     the sender's player number 1..8 (0: not assigned yet)
+    7      1    flags      u8     0 (reserved)
+    8      4    sequence   u32    per sender and type, grows by one each message
+    12     8    timestamp  f64    the sender's clock (Unix seconds) when sent
+    20     2    length     u16    payload bytes that follow (<= MAX_PAYLOAD)
+    22     n    payload           type-specific, below
+
+:func:`decode` checks every field (magic, version, known type, sender range, the exact
+length each type needs, finite numbers within range, valid names) and returns None for
+anything that fails, counting the reason in a :class:`Counter`: garbage never raises.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import struct
+from collections import Counter
+from dataclasses import dataclass
+from typing import Union
+
+MAGIC = b"TKNP"
+VERSION = 1
+MAX_PLAYERS = 8
+MAX_NAME = 24                      # bytes of UTF-8
+MAX_PAYLOAD = 512
+MAC_SIZE = 32                      # HMAC-SHA256
+NONCE_SIZE = 16
+HEADER = struct.Struct("!4sBBBBIdH")
+#: positions, velocities: generous bounds that still reject absurd values [m, m/s]
+MAX_COORD = 1.0e6
+MAX_SPEED = 1.0e4
+MAX_HP = 1.0e6
+MAX_TIME = 1.0e10
+
+
+class MessageType(enum.IntEnum):
+    CHALLENGE = 1    # listener -> connector: a nonce (and whether a password is needed)
+    JOIN = 2         # joiner -> host: join request (name, ports, HMAC)
+    HELLO = 3        # peer -> peer: open a mesh link for my number (HMAC)
+    NUMBER = 4       # host -> joiner: your player number, the session clock, the table
+    NEW_PLAYER = 5   # host -> everyone: a new player, and the whole table
+    STATE = 6        # UDP: one tank's state
+    SHOT = 7         # a tank fired
+    HIT = 8          # the victim's peer: a shell hit my tank
+    EXIT = 9         # I am leaving
+    REFUSE = 10      # a join or link refused, with a reason
+
+
+class RefuseCode(enum.IntEnum):
+    FULL = 1
+    PASSWORD = 2
+    NOT_HOST = 3
+    BAD_REQUEST = 4
+
+
+@dataclass(frozen=True, slots=True)
+class Entry:
+    """One row of the player table: who, and where to reach them."""
+
+    number: int
+    epoch: int          # the host's join counter: tells a reused number from its old owner
+    ip: str             # dotted IPv4
+    tcp_port: int
+    udp_port: int
+    name: str
+
+
+@dataclass(frozen=True, slots=True)
+class Table:
+    host: int
+    entries: tuple[Entry, ...]
+
+    def numbers(self) -> list[int]:
+        return [e.number for e in self.entries]
+
+    def get(self, number: int) -> Entry | None:
+        for e in self.entries:
+            if e.number == number:
+                return e
+        return None
+
+
+@dataclass(frozen=True, slots=True)
+class Challenge:
+    nonce: bytes
+    password: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Join:
+    name: str
+    tcp_port: int
+    udp_port: int
+    mac: bytes
+
+
+@dataclass(frozen=True, slots=True)
+class Hello:
+    epoch: int
+    mac: bytes
+
+
+@dataclass(frozen=True, slots=True)
+class Assign:
+    """NUMBER (to the joiner) and NEW_PLAYER (to everyone else) share this payload."""
+
+    number: int
+    session_t: float
+    table: Table
+
+
+@dataclass(frozen=True, slots=True)
+class State:
+    tank: int
+    t: float            # the sender's session time of this state [s]
+    x: float
+    z: float
+    heading: float
+    vx: float
+    vz: float
+    omega: float
+    hp: float
+    alive: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Shot:
+    tank: int
+    t: float
+    x: float
+    z: float
+    heading: float
+    vx: float
+    vz: float
+
+
+@dataclass(frozen=True, slots=True)
+class Hit:
+    shooter: int
+    victim: int
+    t: float
+    damage: float
+    hp: float           # the victim's hit points after the hit
+    killed: bool
+    x: float
+    z: float
+
+
+@dataclass(frozen=True, slots=True)
+class Exit:
+    pass
+
+
+@dataclass(frozen=True, slots=True)
+class Refuse:
+    code: int
+    text: str
+
+
+Body = Union[Challenge, Join, Hello, Assign, State, Shot, Hit, Exit, Refuse]
+
+
+@dataclass(frozen=True, slots=True)
+class Message:
+    type: MessageType
+    sender: int
+    seq: int
+    timestamp: float
+    body: Body
+
+
+class BadMessage(Exception):
+    """Raised inside decoding only; :func:`decode` turns it into None + a counted reason."""
+
+    def __init__(self, reason: str) -> None:
+        super().__init__(reason)
+        self.reason = reason
+
+
+# ---------------------------------------------------------------------- payloads
+_CHALLENGE = struct.Struct(f"!{NONCE_SIZE}sB")
+_JOIN = struct.Struct(f"!{MAC_SIZE}sHHB")
+_HELLO = struct.Struct(f"!{MAC_SIZE}sI")
+_ASSIGN = struct.Struct("!BdBB")          # number, session t, table host, entry count
+_ENTRY = struct.Struct("!BI4sHHB")        # number, epoch, ip, tcp, udp, name length
+_STATE = struct.Struct("!Bd7fB")
+_SHOT = struct.Struct("!Bd5f")
+_HIT = struct.Struct("!BBdffBff")
+_REFUSE = struct.Struct("!BB")
+
+
+def _name_bytes(name: str) -> bytes:
+    b = name.encode("utf-8")
+    if not b or len(b) > MAX_NAME:
+        raise ValueError(f"a player name must be 1 to {MAX_NAME} bytes of UTF-8, got {name!r}")
+    return b
+
+
+def _read_name(raw: bytes) -> str:
+    try:
+        s = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise BadMessage("name") from None
+    if not s or not s.isprintable():
+        raise BadMessage("name")
+    return s
+
+
+def _ip_bytes(ip: str) -> bytes:
+    parts = ip.split(".")
+    if len(parts) != 4:
+        raise ValueError(f"not an IPv4 address: {ip!r}")
+    return bytes(int(p) for p in parts)
+
+
+def _finite(*values: float) -> None:
+    for v in values:
+        if not math.isfinite(v):
+            raise BadMessage("nan")
+
+
+def _in(v: float, lo: float, hi: float) -> None:
+    if not lo <= v <= hi:
+        raise BadMessage("range")
+
+
+def _player(n: int) -> None:
+    if not 1 <= n <= MAX_PLAYERS:
+        raise BadMessage("range")
+
+
+def _encode_table(number: int, session_t: float, table: Table) -> bytes:
+    out = [_ASSIGN.pack(number, session_t, table.host, len(table.entries))]
+    for e in table.entries:
+        name = _name_bytes(e.name)
+        out.append(_ENTRY.pack(e.number, e.epoch, _ip_bytes(e.ip), e.tcp_port, e.udp_port, len(name)) + name)
+    return b"".join(out)
+
+
+def _decode_table(p: bytes) -> Assign:
+    if len(p) < _ASSIGN.size:
+        raise BadMessage("length")
+    number, session_t, host, count = _ASSIGN.unpack_from(p)
+    _player(number)
+    _finite(session_t)
+    _in(session_t, 0.0, MAX_TIME)
+    _player(host)
+    if not 1 <= count <= MAX_PLAYERS:
+        raise BadMessage("range")
+    off = _ASSIGN.size
+    entries = []
+    seen = set()
+    for _ in range(count):
+        if off + _ENTRY.size > len(p):
+            raise BadMessage("length")
+        n, epoch, ip, tcp, udp, nlen = _ENTRY.unpack_from(p, off)
+        off += _ENTRY.size
+        if off + nlen > len(p) or not 1 <= nlen <= MAX_NAME:
+            raise BadMessage("length")
+        name = _read_name(p[off:off + nlen])
+        off += nlen
+        _player(n)
+        if n in seen or tcp == 0 or udp == 0:
+            raise BadMessage("range")
+        seen.add(n)
+        entries.append(Entry(n, epoch, ".".join(str(b) for b in ip), tcp, udp, name))
+    if off != len(p):
+        raise BadMessage("length")
+    if host not in seen or number not in seen:
+        raise BadMessage("range")
+    return Assign(number, session_t, Table(host, tuple(entries)))
+
+
+def encode_body(body: Body) -> tuple[MessageType, bytes]:
+    """The message type and payload bytes of a body."""
+    if isinstance(body, Challenge):
+        return MessageType.CHALLENGE, _CHALLENGE.pack(body.nonce, int(body.password))
+    if isinstance(body, Join):
+        name = _name_bytes(body.name)
+        return MessageType.JOIN, _JOIN.pack(body.mac, body.tcp_port, body.udp_port, len(name)) + name
+    if isinstance(body, Hello):
+        return MessageType.HELLO, _HELLO.pack(body.mac, body.epoch)
+    if isinstance(body, Assign):
+        raise TypeError("Assign is sent as NUMBER or NEW_PLAYER: use encode(..., kind=...)")
+    if isinstance(body, State):
+        return MessageType.STATE, _STATE.pack(body.tank, body.t, body.x, body.z, body.heading, body.vx, body.vz,
+                                              body.omega, body.hp, int(body.alive))
+    if isinstance(body, Shot):
+        return MessageType.SHOT, _SHOT.pack(body.tank, body.t, body.x, body.z, body.heading, body.vx, body.vz)
+    if isinstance(body, Hit):
+        return MessageType.HIT, _HIT.pack(body.shooter, body.victim, body.t, body.damage, body.hp,
+                                          int(body.killed), body.x, body.z)
+    if isinstance(body, Exit):
+        return MessageType.EXIT, b""
+    if isinstance(body, Refuse):
+        text = body.text.encode("utf-8")[:200]
+        return MessageType.REFUSE, _REFUSE.pack(body.code, len(text)) + text
+    raise TypeError(f"not a message body: {body!r}")
+
+
+def encode(body: Body, sender: int, seq: int, timestamp: float, kind: MessageType | None = None) -> bytes:
+    """One whole message.  ``kind`` picks NUMBER or NEW_PLAYER for an :class:`Assign`."""
+    if isinstance(body, Assign):
+        if kind not in (MessageType.NUMBER, MessageType.NEW_PLAYER):
+            raise TypeError("an Assign needs kind=NUMBER or NEW_PLAYER")
+        mtype, payload = kind, _encode_table(body.number, body.session_t, body.table)
+    else:
+        mtype, payload = encode_body(body)
+    if len(payload) > MAX_PAYLOAD:
+        raise ValueError(f"payload of {len(payload)} bytes is over {MAX_PAYLOAD}")
+    return HEADER.pack(MAGIC, VERSION, mtype, sender, 0, seq & 0xFFFFFFFF, timestamp, len(payload)) + payload
+
+
+def _decode_payload(mtype: MessageType, p: bytes) -> Body:
+    def exact(s: struct.Struct) -> tuple:
+        if len(p) != s.size:
+            raise BadMessage("length")
+        return s.unpack(p)
+
+    if mtype == MessageType.CHALLENGE:
+        nonce, pw = exact(_CHALLENGE)
+        if pw > 1:
+            raise BadMessage("range")
+        return Challenge(nonce, bool(pw))
+    if mtype == MessageType.JOIN:
+        if len(p) < _JOIN.size:
+            raise BadMessage("length")
+        mac, tcp, udp, nlen = _JOIN.unpack_from(p)
+        if len(p) != _JOIN.size + nlen or not 1 <= nlen <= MAX_NAME:
+            raise BadMessage("length")
+        if tcp == 0 or udp == 0:
+            raise BadMessage("range")
+        return Join(_read_name(p[_JOIN.size:]), tcp, udp, mac)
+    if mtype == MessageType.HELLO:
+        mac, epoch = exact(_HELLO)
+        return Hello(epoch, mac)
+    if mtype in (MessageType.NUMBER, MessageType.NEW_PLAYER):
+        return _decode_table(p)
+    if mtype == MessageType.STATE:
+        tank, t, x, z, h, vx, vz, om, hp, alive = exact(_STATE)
+        _player(tank)
+        _finite(t, x, z, h, vx, vz, om, hp)
+        _in(t, 0.0, MAX_TIME)
+        for c in (x, z):
+            _in(c, -MAX_COORD, MAX_COORD)
+        for v in (vx, vz, om):
+            _in(v, -MAX_SPEED, MAX_SPEED)
+        _in(h, -4 * math.pi, 4 * math.pi)
+        _in(hp, -MAX_HP, MAX_HP)
+        if alive > 1:
+            raise BadMessage("range")
+        return State(tank, t, x, z, h, vx, vz, om, hp, bool(alive))
+    if mtype == MessageType.SHOT:
+        tank, t, x, z, h, vx, vz = exact(_SHOT)
+        _player(tank)
+        _finite(t, x, z, h, vx, vz)
+        _in(t, 0.0, MAX_TIME)
+        for c in (x, z):
+            _in(c, -MAX_COORD, MAX_COORD)
+        for v in (vx, vz):
+            _in(v, -MAX_SPEED, MAX_SPEED)
+        _in(h, -4 * math.pi, 4 * math.pi)
+        return Shot(tank, t, x, z, h, vx, vz)
+    if mtype == MessageType.HIT:
+        shooter, victim, t, dmg, hp, killed, x, z = exact(_HIT)
+        _player(shooter)
+        _player(victim)
+        _finite(t, dmg, hp, x, z)
+        _in(t, 0.0, MAX_TIME)
+        _in(dmg, 0.0, MAX_HP)
+        _in(hp, -MAX_HP, MAX_HP)
+        for c in (x, z):
+            _in(c, -MAX_COORD, MAX_COORD)
+        if killed > 1 or shooter == victim:
+            raise BadMessage("range")
+        return Hit(shooter, victim, t, dmg, hp, bool(killed), x, z)
+    if mtype == MessageType.EXIT:
+        if p:
+            raise BadMessage("length")
+        return Exit()
+    if mtype == MessageType.REFUSE:
+        if len(p) < _REFUSE.size:
+            raise BadMessage("length")
+        code, tlen = _REFUSE.unpack_from(p)
+        if len(p) != _REFUSE.size + tlen:
+            raise BadMessage("length")
+        if code not in {c.value for c in RefuseCode}:
+            raise BadMessage("range")
+        try:
+            text = p[_REFUSE.size:].decode("utf-8")
+        except UnicodeDecodeError:
+            raise BadMessage("name") from None
+        return Refuse(code, text)
+    raise BadMessage("type")      # pragma: no cover - the caller checked the type
+
+
+def parse_header(data: bytes) -> tuple[MessageType, int, int, float, int]:
+    """(type, sender, seq, timestamp, payload length) of a header, or BadMessage."""
+    if len(data) < HEADER.size:
+        raise BadMessage("short")
+    magic, version, mtype, sender, flags, seq, ts, length = HEADER.unpack_from(data)
+    if magic != MAGIC:
+        raise BadMessage("magic")
+    if version != VERSION:
+        raise BadMessage("version")
+    try:
+        mt = MessageType(mtype)
+    except ValueError:
+        raise BadMessage("type") from None
+    if flags != 0:
+        raise BadMessage("flags")
+    if sender > MAX_PLAYERS:
+        raise BadMessage("sender")
+    if not math.isfinite(ts) or not 0.0 <= ts <= MAX_TIME:
+        raise BadMessage("nan" if not math.isfinite(ts) else "range")
+    if length > MAX_PAYLOAD:
+        raise BadMessage("length")
+    return mt, sender, seq, ts, length
+
+
+def decode(data: bytes, counter: Counter | None = None) -> Message | None:
+    """A whole message (one datagram), or None with ``counter[reason] += 1``."""
+    try:
+        mt, sender, seq, ts, length = parse_header(data)
+        if len(data) != HEADER.size + length:
+            raise BadMessage("length")
+        body = _decode_payload(mt, bytes(data[HEADER.size:]))
+        # only a joiner (and a listener answering one) may not have a number yet
+        if sender == 0 and mt not in (MessageType.JOIN, MessageType.CHALLENGE, MessageType.REFUSE):
+            raise BadMessage("sender")
+        return Message(mt, sender, seq, ts, body)
+    except BadMessage as e:
+        if counter is not None:
+            counter[e.reason] += 1
+        return None
+    except (struct.error, ValueError, TypeError):   # belt and braces: never raise on input
+        if counter is not None:
+            counter["payload"] += 1
+        return None
+
+
+class StreamReader:
+    """Frames messages out of a TCP byte stream.
+
+    A stream cannot resynchronise after a bad header (where would the next message
+    start?), so the first malformed header marks the stream ``broken`` and its owner
+    closes the connection; a bad payload inside a well-framed message is only dropped.
+    """
+
+    def __init__(self, counter: Counter, max_buffer: int = 16 * (HEADER.size + MAX_PAYLOAD)) -> None:
+        self.buffer = bytearray()
+        self.counter = counter
+        self.broken = False
+        self.max_buffer = max_buffer
+
+    def feed(self, data: bytes) -> list[Message]:
+        """Messages completed by ``data`` (bad ones counted and dropped)."""
+        if self.broken:
+            return []
+        self.buffer += data
+        out: list[Message] = []
+        while len(self.buffer) >= HEADER.size:
+            try:
+                _, _, _, _, length = parse_header(self.buffer)
+            except BadMessage as e:
+                self.counter[e.reason] += 1
+                self.broken = True
+                self.buffer.clear()
+                return out
+            end = HEADER.size + length
+            if len(self.buffer) < end:
+                break
+            msg = decode(bytes(self.buffer[:end]), self.counter)
+            del self.buffer[:end]
+            if msg is not None:
+                out.append(msg)
+        if len(self.buffer) > self.max_buffer:      # cannot happen with valid headers; be safe
+            self.counter["overflow"] += 1
+            self.broken = True
+            self.buffer.clear()
+        return out
