@@ -1,0 +1,252 @@
+"""The input layer: keyboard, mouse and joystick events become game actions and
+:class:`~tanktool.sim.commands.Command` values; game code never sees a key code.
+
+Every physical input has a name:
+
+- ``key:<pygame key name>`` (``key:w``, ``key:up``, ``key:space``)
+- ``mouse:<button>`` (``mouse:1`` is the left button)
+- ``joybutton:<n>``, and ``joyaxis:<n>+`` / ``joyaxis:<n>-`` for one half of an axis
+
+and :class:`Bindings` maps each action to a list of names.  Driving actions are
+analogue: an action's strength is the largest of its inputs (keys and buttons 1, an
+axis half its deflection beyond the dead zone), and ``advance = advance − reverse``
+etc.  Menu actions (pause, camera, view, overlays) fire once on press.
+
+Bindings live in ``$XDG_CONFIG_HOME/tanktool/bindings.toml`` (``~/.config/...`` when
+the variable is unset), written atomically; a missing file means the defaults.
+Joysticks are opened as they are plugged in (``JOYDEVICEADDED``) and forgotten when
+pulled out, so hot-plugging needs nothing from the player.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Iterable
+
+from ..errors import FormatError
+from ..sim.commands import Command
+
+DRIVE_ACTIONS = ("advance", "reverse", "turn_left", "turn_right", "strafe_left", "strafe_right", "fire")
+MENU_ACTIONS = ("pause", "camera", "view", "overlay_quadtree", "overlay_navgrid", "overlay_agents", "quit")
+ACTIONS = DRIVE_ACTIONS + MENU_ACTIONS
+
+DEFAULTS: dict[str, list[str]] = {
+    "advance": ["key:w", "key:up", "joyaxis:1-"],
+    "reverse": ["key:s", "key:down", "joyaxis:1+"],
+    "turn_left": ["key:a", "key:left", "joyaxis:0-"],
+    "turn_right": ["key:d", "key:right", "joyaxis:0+"],
+    "strafe_left": ["key:q", "joybutton:4"],
+    "strafe_right": ["key:e", "joybutton:5"],
+    "fire": ["key:space", "joybutton:0", "mouse:1"],
+    "pause": ["key:p", "key:escape", "joybutton:7"],
+    "camera": ["key:c", "joybutton:3"],
+    "view": ["key:v"],
+    "overlay_quadtree": ["key:f1"],
+    "overlay_navgrid": ["key:f2"],
+    "overlay_agents": ["key:f3"],
+    "quit": ["key:f10"],
+}
+INPUT_NAME = re.compile(r"^(key:.+|mouse:\d+|joybutton:\d+|joyaxis:\d+[+-])$")
+DEADZONE = 0.15
+#: an axis pushed this far counts as a press when remapping or for menu actions
+AXIS_PRESS = 0.6
+
+
+def config_dir() -> Path:
+    """The user's tanktool config folder (XDG base directory spec)."""
+    base = os.environ.get("XDG_CONFIG_HOME") or str(Path.home() / ".config")
+    return Path(base) / "tanktool"
+
+
+def bindings_path() -> Path:
+    return config_dir() / "bindings.toml"
+
+
+@dataclass
+class Bindings:
+    """Action -> input names, plus the joystick dead zone."""
+
+    actions: dict[str, list[str]] = field(default_factory=lambda: {a: list(v) for a, v in DEFAULTS.items()})
+    deadzone: float = DEADZONE
+
+    def inputs(self, action: str) -> list[str]:
+        return self.actions.get(action, [])
+
+    def remap(self, action: str, name: str) -> None:
+        """Make ``name`` the only input of ``action``, and take it away from any other
+        action so one button never does two things."""
+        if action not in ACTIONS:
+            raise ValueError(f"unknown action {action!r}")
+        for other, names in self.actions.items():
+            if other != action and name in names:
+                names.remove(name)
+        self.actions[action] = [name]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"deadzone": self.deadzone, "actions": {a: list(self.actions.get(a, [])) for a in ACTIONS}}
+
+
+def load_bindings(path: str | os.PathLike | None = None) -> Bindings:
+    """Read the bindings file; defaults when it does not exist.  Actions the file does
+    not name keep their defaults, so a file from an older version still works."""
+    from ..formats.bundle import read_toml
+
+    path = Path(path) if path is not None else bindings_path()
+    if not path.is_file():
+        return Bindings()
+    doc = read_toml(path)
+    b = Bindings()
+    dz = doc.get("deadzone", DEADZONE)
+    if not isinstance(dz, (int, float)) or isinstance(dz, bool) or not 0.0 <= dz < 1.0:
+        raise FormatError(f"{path}: deadzone must be a number in [0, 1), got {dz!r}")
+    b.deadzone = float(dz)
+    table = doc.get("actions", {})
+    if not isinstance(table, dict):
+        raise FormatError(f"{path}: [actions] must be a table of action = [input names]")
+    for action, names in table.items():
+        if action not in ACTIONS:
+            raise FormatError(f"{path}: [actions] {action}: unknown action (one of {', '.join(ACTIONS)})")
+        if not isinstance(names, list) or not all(isinstance(n, str) and INPUT_NAME.match(n) for n in names):
+            raise FormatError(f"{path}: [actions] {action}: expected a list of input names like "
+                              f"\"key:w\", \"mouse:1\", \"joybutton:0\", \"joyaxis:1-\", got {names!r}")
+        b.actions[action] = list(names)
+    return b
+
+
+def save_bindings(bindings: Bindings, path: str | os.PathLike | None = None) -> Path:
+    """Write the bindings atomically (creating the config folder); returns the path."""
+    from ..formats.bundle import write_toml
+
+    path = Path(path) if path is not None else bindings_path()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    write_toml(path, bindings.to_dict())
+    return path
+
+
+def input_name(event: Any) -> str | None:
+    """The input name a *press* event stands for (for the remap screen), or None."""
+    import pygame
+
+    if event.type == pygame.KEYDOWN:
+        return f"key:{pygame.key.name(event.key)}"
+    if event.type == pygame.MOUSEBUTTONDOWN:
+        return f"mouse:{event.button}"
+    if event.type == pygame.JOYBUTTONDOWN:
+        return f"joybutton:{event.button}"
+    if event.type == pygame.JOYAXISMOTION and abs(event.value) >= AXIS_PRESS:
+        return f"joyaxis:{event.axis}{'+' if event.value > 0 else '-'}"
+    return None
+
+
+class InputState:
+    """Pressed keys and buttons, joystick axes, and the joysticks plugged in.
+
+    Feed it every pygame event with :meth:`handle` (which returns the menu actions
+    pressed by that event) and read :meth:`command` once per simulation step.
+    """
+
+    def __init__(self, bindings: Bindings | None = None) -> None:
+        self.bindings = bindings or Bindings()
+        self.pressed: set[str] = set()                 # key:, mouse:, joybutton: names held
+        self.axes: dict[tuple[int, int], float] = {}   # (joystick instance, axis) -> value
+        self.joy_buttons: dict[int, set[str]] = {}     # instance -> buttons held
+        self.joysticks: dict[int, Any] = {}            # instance -> pygame Joystick
+
+    # ------------------------------------------------------------------ events
+    def handle(self, event: Any) -> list[str]:
+        """Update the state from one event; return the menu actions it triggered."""
+        import pygame
+
+        t = event.type
+        name: str | None = None
+        if t == pygame.KEYDOWN:
+            name = f"key:{pygame.key.name(event.key)}"
+            self.pressed.add(name)
+        elif t == pygame.KEYUP:
+            self.pressed.discard(f"key:{pygame.key.name(event.key)}")
+        elif t == pygame.MOUSEBUTTONDOWN:
+            name = f"mouse:{event.button}"
+            self.pressed.add(name)
+        elif t == pygame.MOUSEBUTTONUP:
+            self.pressed.discard(f"mouse:{event.button}")
+        elif t == pygame.JOYBUTTONDOWN:
+            name = f"joybutton:{event.button}"
+            self.joy_buttons.setdefault(self._joy(event), set()).add(name)
+        elif t == pygame.JOYBUTTONUP:
+            self.joy_buttons.get(self._joy(event), set()).discard(f"joybutton:{event.button}")
+        elif t == pygame.JOYAXISMOTION:
+            key = (self._joy(event), int(event.axis))
+            old = self.axes.get(key, 0.0)
+            self.axes[key] = float(event.value)
+            # an axis crossing the press threshold acts like a button for menu actions
+            if abs(event.value) >= AXIS_PRESS > abs(old) or (old * event.value < 0 and abs(event.value) >= AXIS_PRESS):
+                name = f"joyaxis:{event.axis}{'+' if event.value > 0 else '-'}"
+        elif t == getattr(pygame, "JOYDEVICEADDED", -1):
+            self._plug(event.device_index)
+        elif t == getattr(pygame, "JOYDEVICEREMOVED", -1):
+            self._unplug(event.instance_id)
+        if name is None:
+            return []
+        return [a for a in MENU_ACTIONS if name in self.bindings.inputs(a)]
+
+    @staticmethod
+    def _joy(event: Any) -> int:
+        return int(getattr(event, "instance_id", getattr(event, "joy", 0)))
+
+    def _plug(self, device_index: int) -> None:
+        import pygame
+
+        try:
+            js = pygame.joystick.Joystick(device_index)
+            js.init()
+        except pygame.error:
+            return                  # gone again before we could open it
+        self.joysticks[js.get_instance_id()] = js
+
+    def _unplug(self, instance_id: int) -> None:
+        self.joysticks.pop(instance_id, None)
+        self.joy_buttons.pop(instance_id, None)
+        for key in [k for k in self.axes if k[0] == instance_id]:
+            del self.axes[key]
+
+    def release_all(self) -> None:
+        """Forget held inputs (the window lost focus: keys released elsewhere never arrive)."""
+        self.pressed.clear()
+        self.joy_buttons.clear()
+        self.axes.clear()
+
+    # ------------------------------------------------------------------ reading
+    def strength(self, action: str) -> float:
+        """How hard an action is pressed, in [0, 1]."""
+        best = 0.0
+        held = self.pressed.union(*self.joy_buttons.values()) if self.joy_buttons else self.pressed
+        dz = self.bindings.deadzone
+        for name in self.bindings.inputs(action):
+            if name.startswith("joyaxis:"):
+                axis, sign = int(name[8:-1]), (1.0 if name[-1] == "+" else -1.0)
+                for (_, a), v in self.axes.items():
+                    if a == axis:
+                        v = v * sign
+                        if v > dz:
+                            best = max(best, min((v - dz) / (1.0 - dz), 1.0))
+            elif name in held:
+                return 1.0
+        return best
+
+    def command(self) -> Command:
+        s = self.strength
+        return Command(advance=s("advance") - s("reverse"), rotate=s("turn_right") - s("turn_left"),
+                       strafe=s("strafe_right") - s("strafe_left"), fire=s("fire") >= 0.5)
+
+
+def describe(names: Iterable[str]) -> str:
+    """Input names for people: ``key:space`` -> ``SPACE``, ``joyaxis:1-`` -> ``axis 1-``."""
+    out = []
+    for n in names:
+        kind, _, what = n.partition(":")
+        out.append({"key": what.upper(), "mouse": f"mouse {what}", "joybutton": f"button {what}",
+                    "joyaxis": f"axis {what}"}.get(kind, n))
+    return ", ".join(out) or "(none)"
