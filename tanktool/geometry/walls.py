@@ -311,7 +311,8 @@ def cross_sections(segments: np.ndarray, normals: np.ndarray, nodes: np.ndarray,
         near = shapely.dwithin(solid, shapely.points(mid), tolerance)
         votes = np.bincount(comp[seg_neg], weights=near, minlength=ncomp)
         total = np.bincount(comp[seg_neg], minlength=ncomp)
-        hole = negative & (votes > 0.5 * np.maximum(total, 1))
+        # all of it (but round-off): an inverted box overlapping a solid one is no hole
+        hole = negative & (votes >= 0.95 * np.maximum(total, 1))
         if hole.any():
             solid = _winding_region(segments[(positive | hole)[comp]], tolerance)
     lone = negative & ~hole
