@@ -16,26 +16,29 @@ The pipeline, each step a function below:
    shared edge always yields the same cut point and loops close.
    Each cut segment keeps the horizontal part of its face normal: it says which
    side is solid.
-3. :func:`cross_sections` -- join the segments into closed rings and open chains
-   (shapely ``line_merge`` per connected component), simplify within the tolerance,
-   and decide for each ring whether its inside is solid (the face normals point
-   out of it) or free (a room's inner wall face: normals point into it).  When a
-   ring's normals disagree (badly wound models), nesting parity decides instead.
-   The solid cross-section is then the set of points of positive winding number
-   over all rings, so overlapping or nested boxes are one solid and no wall is
-   left buried inside solid material.
-4. Free space is the part of the floor's bounding rectangle not covered by solid
-   that holds floor (area-weighted sample points of the floor level fall in it).
-   Regions that touch the rectangle's border lie outside the outer walls and are
-   dropped whenever at least one enclosed region exists; an open arena (no outer
-   walls) keeps them, bounded by the floor's rectangle.  Slivers thinner than the
-   tolerance vanish (coordinates are snapped to the tolerance grid).
-5. The walls are the boundary of the free space, oriented so that each normal
-   points into free space, collinear pieces merged, pieces shorter than the
-   tolerance dropped.  Open chains (single-quad walls, zero-thickness fences,
-   non-watertight pieces that do not close) are *thin walls*: where they cross free
-   space they become two walls on the same segment with opposite Direction, so a
-   vehicle meets a wall from either side.
+3. :func:`cross_sections` -- group the segments into components (connected
+   through shared cut points).  Segments are ordered "face normal on the right", so
+   a closed component with consistent normals that point out of it runs
+   counter-clockwise and bounds solid; the solid cross-section is the set of points
+   of positive winding number over all such components (:func:`_winding_region`),
+   so overlapping or nested boxes are one solid and no wall is left buried inside
+   solid material.  A closed component whose normals point into it is a hole when
+   it lies wholly in solid (a room inside a thick wall ring), a box wound inside
+   out when floor surrounds it, and otherwise a one-sided shell seen from inside.
+4. :func:`floor_region` + :func:`free_space` -- the free space is the floor's
+   outline (the upward faces from the floor level up to the cut, from their
+   boundary edges and winding numbers) minus the solid.  If the largest region is
+   walled in, regions touching the floor's bounding rectangle (strips outside the
+   outer walls) are dropped; regions narrower than MIN_FREE_WIDTH everywhere
+   (ledges, sills) too.  Coordinates are snapped to the tolerance grid.
+5. :func:`outline_walls` -- the walls are the boundary of the free space, free
+   space on their left so that Direction +1 makes each normal point into it,
+   collinear pieces merged, pieces shorter than the tolerance dropped.
+   :func:`thin_walls` -- open chains (single-quad walls, zero-thickness fences,
+   non-watertight pieces), one-sided shells and loops with inconsistent normals do
+   not say which side is solid: where they cross free space they become *thin
+   walls*, two walls on the same segment with opposite normals, so a vehicle meets
+   them from either side.
 """
 
 from __future__ import annotations
