@@ -112,6 +112,7 @@ class ImportResult:
     faces: int
     thin_walls: int
     seconds: float
+    warnings: list[str] = field(default_factory=list)   # non-fatal remarks (a .bzw's unknown objects)
 
 
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
@@ -146,18 +147,20 @@ def import_arena(
     force: bool = False,
     navgrid: dict[str, Any] | None = None,
     progress: Callable[[str], None] | None = None,
+    warn: Callable[[str], None] | None = None,
 ) -> ImportResult:
     """Read ``model``, extract walls and spawns and write the arena bundle ``out``.
 
     ``out`` defaults to ``./<name>``; ``name`` to the model's file stem.  ``navgrid``
     overrides the [navgrid] defaults (used when rebuilding a bundled arena).
+    ``warn`` also receives the non-fatal remarks collected in ``ImportResult.warnings``.
     Everything is written into a temporary folder renamed into place at the end,
     so a failure leaves nothing behind.
     """
     import trimesh
 
     from .formats.bundle import sha256_file, staged_dir, write_toml
-    from .formats.models import detect_format, load_scene
+    from .formats.models import default_up, detect_format, load_scene
     from .formats.walls_txt import write_walls
     from .geometry.spawns import place_spawns
     from .geometry.walls import extract_walls
@@ -179,7 +182,14 @@ def import_arena(
     if not (math.isfinite(tolerance) and 0 < tolerance < height):
         raise ArenaError(f"--tolerance must be positive and below --height, got {tolerance}")
 
-    scene = load_scene(model, up=up, scale=scale)
+    warnings: list[str] = []
+
+    def remark(message: str) -> None:
+        warnings.append(message)
+        if warn is not None:
+            warn(message)
+
+    scene = load_scene(model, up=up, scale=scale, warn=remark)
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
     try:
@@ -193,7 +203,7 @@ def import_arena(
     if progress:
         progress("spawns")
 
-    src_up = up or ("z" if fmt == "3ds" else "y")
+    src_up = up or default_up(fmt)
     nav = dict(NAVGRID_DEFAULTS)
     nav.update(navgrid or {})
     bounds = ex.walls.bounds
@@ -226,7 +236,7 @@ def import_arena(
         }
         write_toml(tmp / MANIFEST, doc)
     return ImportResult(target, name, ex.walls, spawns, ex.floor_y, len(mesh.faces), ex.thin_walls,
-                        time.perf_counter() - t0)
+                        time.perf_counter() - t0, warnings)
 
 
 def _r(v: float, nd: int = 4) -> float:

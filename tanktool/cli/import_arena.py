@@ -38,7 +38,7 @@ def _face_count_guess(model: Path) -> int:
 @force_option
 def import_arena(model: Path, out: Path | None, name: str | None, up: str | None, scale: float,
                  height: float, tolerance: float, force: bool) -> None:
-    """Turn an arena MODEL (.3ds .obj .glb .stl .ply .off) into an arena bundle.
+    """Turn an arena MODEL (.3ds .obj .glb .stl .ply .off, BZFlag .bzw) into an arena bundle.
 
     \b
     Writes arena.toml, the model, model.glb, walls.txt, preview.png:
@@ -47,11 +47,16 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
     from ..arena import import_arena as run
     from .main import echo
 
+    def warn(message: str) -> None:
+        # non-fatal remarks (a .bzw's unknown objects) go to stderr, even under -q
+        click.echo(f"warning: {message}", err=True)
+
     if _face_count_guess(model) > PROGRESS_FACES:
         with progress(length=len(STAGES), label=f"importing {model.name}") as bar:
-            result = run(model, out, name, up, scale, height, tolerance, force, progress=lambda _s: bar.update(1))
+            result = run(model, out, name, up, scale, height, tolerance, force, progress=lambda _s: bar.update(1),
+                         warn=warn)
     else:
-        result = run(model, out, name, up, scale, height, tolerance, force)
+        result = run(model, out, name, up, scale, height, tolerance, force, warn=warn)
     (x0, z0), (x1, z1) = result.walls.bounds
     thin = f" ({result.thin_walls} from thin walls)" if result.thin_walls else ""
     echo(f"arena {result.name!r}: {len(result.walls)} walls{thin} + 4 auxiliary, {len(result.spawns)} spawns")

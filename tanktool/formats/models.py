@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -17,6 +18,9 @@ from ..errors import FormatError
 
 #: extensions trimesh (plus our .3ds reader) loads as meshes
 MESH_EXTENSIONS = {".3ds", ".obj", ".glb", ".gltf", ".stl", ".ply", ".off"}
+#: files that are not meshes but are turned into one (a Z-up scene) before the usual
+#: pipeline: BZFlag worlds (formats/bzw.py) and 2D floor plans (formats/floorplan.py)
+BUILT_EXTENSIONS = {".bzw"}
 
 #: rotation taking a Z-up frame to our Y-up frame: (x, y, z) -> (x, z, -y)
 Z_UP_TO_Y_UP = np.array(
@@ -36,7 +40,7 @@ def detect_format(path: str | os.PathLike) -> str:
     if path.is_dir():
         raise FormatError(f"{path}: is a folder, expected a model file")
     ext = path.suffix.lower()
-    if ext in MESH_EXTENSIONS:
+    if ext in MESH_EXTENSIONS or ext in BUILT_EXTENSIONS:
         return ext[1:]
     with open(path, "rb") as f:
         head = f.read(16)
@@ -47,7 +51,7 @@ def detect_format(path: str | os.PathLike) -> str:
     if head[:5].lower() == b"solid" or path.suffix == "":
         # ascii STL or unknown text; let the caller's message say what we accept
         pass
-    kinds = ", ".join(sorted(MESH_EXTENSIONS))
+    kinds = ", ".join(sorted(MESH_EXTENSIONS | BUILT_EXTENSIONS))
     raise FormatError(f"{path}: not a model file this tool reads (expected one of {kinds})")
 
 
@@ -75,14 +79,17 @@ def _check_binary_stl(path: Path) -> None:
 
 
 def default_up(fmt: str) -> str:
-    return "z" if fmt == "3ds" else "y"
+    # .bzw worlds are Z-up, like .3ds (built scenes come out in their source's frame)
+    return "z" if fmt in ("3ds", "bzw") else "y"
 
 
-def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.0):
+def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.0,
+               warn: Callable[[str], None] | None = None):
     """Load ``path`` as a ``trimesh.Scene`` in the world frame (Y up, metres).
 
-    Raises FormatError for unreadable files, models without triangles and
-    non-finite vertices.
+    ``warn`` receives the non-fatal remarks of built formats (a .bzw file's
+    unknown objects).  Raises FormatError for unreadable files, models without
+    triangles and non-finite vertices.
     """
     import trimesh
 
@@ -99,6 +106,10 @@ def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.
     try:
         if fmt == "3ds":
             scene = threeds.load_scene(path)
+        elif fmt == "bzw":
+            from . import bzw
+
+            scene = bzw.load_scene(path, warn=warn)
         else:
             if fmt == "stl":
                 _check_binary_stl(path)
