@@ -11,7 +11,7 @@ from click.testing import CliRunner
 
 from tanktool.arena import load_arena
 from tanktool.cli.main import cli
-from tanktool.errors import ArenaError
+from tanktool.errors import ArenaError, FormatError
 from tanktool.formats.bundle import read_toml, sha256_file
 from tanktool.formats.walls_txt import read_walls
 
@@ -164,3 +164,19 @@ def test_dungeon_imports(tmp_path):
     a = load_arena(out)
     assert a.floor_y == pytest.approx(10.0, abs=0.05)
     assert len(a.walls) > 100 and len(a.spawns) == 8
+
+
+def test_load_arena_rejects_broken_manifests(tmp_path):
+    model = write_room(tmp_path / "room.obj")
+    out = tmp_path / "room"
+    assert run("-q", "import-arena", str(model), "-o", str(out)).exit_code == 0
+    toml = (out / "arena.toml").read_text()
+    (out / "arena.toml").write_text(toml.replace("spawns = [", "spawns = [[1, 2], ", 1))
+    with pytest.raises(ArenaError, match="spawns"):
+        load_arena(out)
+    (out / "arena.toml").write_text(toml.replace('file = "walls.txt"', 'file = "../walls.txt"'))
+    with pytest.raises(ArenaError, match="walls"):
+        load_arena(out)
+    (out / "arena.toml").write_text("name = \n")
+    with pytest.raises(FormatError, match="invalid TOML"):
+        load_arena(out)
