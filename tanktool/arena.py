@@ -169,7 +169,8 @@ def import_arena(
     t0 = time.perf_counter()
     model = Path(model)
     fmt = detect_format(model)
-    name = name or model.stem
+    if name is None:  # from the file stem, made a safe folder name ("my arena" -> "my_arena")
+        name = re.sub(r"[^A-Za-z0-9._-]+", "_", model.stem).strip("._-") or "arena"
     if not _NAME_RE.match(name):
         raise ArenaError(f"arena name {name!r}: use letters, digits, '.', '_' or '-'")
     target = Path(out) if out is not None else Path.cwd() / name

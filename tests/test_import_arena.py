@@ -180,3 +180,13 @@ def test_load_arena_rejects_broken_manifests(tmp_path):
     (out / "arena.toml").write_text("name = \n")
     with pytest.raises(FormatError, match="invalid TOML"):
         load_arena(out)
+
+
+def test_default_name_from_an_awkward_file_stem(tmp_path, monkeypatch):
+    model = write_room(tmp_path / "my arena (v2).obj")
+    monkeypatch.chdir(tmp_path)
+    r = run("import-arena", str(model))
+    assert r.exit_code == 0, r.output
+    assert load_arena(tmp_path / "my_arena_v2").name == "my_arena_v2"
+    r = CliRunner().invoke(cli, ["import-arena", str(model), "--name", "bad/name"])
+    assert r.exit_code == 2 and "arena name" in r.output
