@@ -14,6 +14,7 @@ import click
 
 from ..errors import ArenaError, TanktoolError
 from .main import echo
+from .net_play import network_options
 from .options import progress
 
 
@@ -42,8 +43,11 @@ def _arena_ref(arena: str | None) -> str:
               help="Write the match report (JSON) here.")
 @click.option("--picture", "picture", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Save a top view of the final state (PNG).  Default without --headless: match.png.")
+@network_options
 def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | None, seconds: float | None,
-         seed: int, integrator: str, report_path: Path | None, picture: Path | None) -> None:
+         seed: int, integrator: str, report_path: Path | None, picture: Path | None,
+         host: str | None = None, join: str | None = None, player_name: str | None = None,
+         password: str | None = None) -> None:
     """Play a match: bots on an arena.
 
     \b
@@ -51,6 +55,11 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --headless --arena box --bots 8 --seconds 60 --seed 1 --report match.json
       tanktool play --headless --arena arenas/maze --vehicle heavy --seconds 600
     """
+    if host is not None or join is not None:
+        from .net_play import run_network
+
+        run_network(host, join, player_name, password, arena, vehicle, seconds, seed, report_path, echo)
+        return
     from ..sim.match import default_vehicle, format_report, load_match_arena, load_tank_spec, run_match, scoreboard
 
     if not headless:

@@ -200,7 +200,7 @@ _HIT = struct.Struct("!BBdffBff")
 _REFUSE = struct.Struct("!BB")
 
 
-def _name_bytes(name: str) -> bytes:
+def name_bytes(name: str) -> bytes:
     b = name.encode("utf-8")
     if not b or len(b) > MAX_NAME:
         raise ValueError(f"a player name must be 1 to {MAX_NAME} bytes of UTF-8, got {name!r}")
@@ -243,7 +243,7 @@ def _player(n: int) -> None:
 def _encode_table(number: int, session_t: float, table: Table) -> bytes:
     out = [_ASSIGN.pack(number, session_t, table.host, len(table.entries))]
     for e in table.entries:
-        name = _name_bytes(e.name)
+        name = name_bytes(e.name)
         out.append(_ENTRY.pack(e.number, e.epoch, _ip_bytes(e.ip), e.tcp_port, e.udp_port, len(name)) + name)
     return b"".join(out)
 
@@ -287,7 +287,7 @@ def encode_body(body: Body) -> tuple[MessageType, bytes]:
     if isinstance(body, Challenge):
         return MessageType.CHALLENGE, _CHALLENGE.pack(body.nonce, int(body.password))
     if isinstance(body, Join):
-        name = _name_bytes(body.name)
+        name = name_bytes(body.name)
         return MessageType.JOIN, _JOIN.pack(body.mac, body.tcp_port, body.udp_port, len(name)) + name
     if isinstance(body, Hello):
         return MessageType.HELLO, _HELLO.pack(body.mac, body.epoch)

@@ -1,0 +1,101 @@
+"""``tanktool play --host [ADDR:]PORT`` / ``--join ADDR:PORT``: network play.
+
+The options are defined here once and stacked on ``play`` (``network_options``); the
+command hands over to :func:`run_network` when either is given.  A network match runs
+headless for now (the window issue adds menus for it): the local tank is driven by the
+scripted bot, for ``--seconds`` of real time, and ``--report`` writes the match report
+with ``peers``, ``host_changes`` and ``network`` counters.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+from pathlib import Path
+from typing import Any, Callable
+
+import click
+
+from ..errors import NetError, TanktoolError
+
+DEFAULT_NET_SECONDS = 60.0
+
+
+def network_options(f: Callable) -> Callable:
+    """``--host``, ``--join``, ``--name``, ``--password`` for ``tanktool play``."""
+    f = click.option("--password", default=None, metavar="TEXT",
+                     help="Session password (checked with an HMAC challenge; never sent).")(f)
+    f = click.option("--name", "player_name", default=None, metavar="NAME",
+                     help="Your player name in a network session (1-24 characters).")(f)
+    f = click.option("--join", "join", default=None, metavar="ADDR:PORT",
+                     help="Join the network session whose host (or any member) is at ADDR:PORT.")(f)
+    f = click.option("--host", "host", default=None, metavar="[ADDR:]PORT",
+                     help="Host a network session, listening on ADDR:PORT (ADDR defaults to 127.0.0.1).")(f)
+    return f
+
+
+def run_network(host: str | None, join: str | None, player_name: str | None, password: str | None,
+                arena: str | None, vehicle: str | None, seconds: float | None, seed: int,
+                report_path: Path | None, echo: Callable[[str], None]) -> dict[str, Any]:
+    """Host or join a session, play it, print a summary, write the report."""
+    from ..formats.bundle import atomic_write_text
+    from ..net.peer import Peer, parse_address
+    from ..net.protocol import name_bytes
+    from ..net.session import NetMatch
+    from ..sim.match import default_arena, default_vehicle, load_match_arena, load_tank_spec
+
+    if host is not None and join is not None:
+        raise click.UsageError("--host and --join exclude each other")
+    if report_path is not None and not report_path.parent.exists():
+        raise TanktoolError(f"{report_path}: folder {report_path.parent} does not exist")
+    name = player_name or ("host" if host is not None else "player")
+    try:
+        name_bytes(name)
+    except ValueError as e:
+        raise NetError(str(e)) from None
+    ref = arena or default_arena()
+    if ref is None:
+        raise TanktoolError("no arena given and none bundled under arenas/ (use --arena PATH)")
+    info = load_match_arena(ref)
+    spec = load_tank_spec(vehicle or default_vehicle())
+    seconds = DEFAULT_NET_SECONDS if seconds is None else seconds
+
+    if host is not None:
+        peer = Peer.host(parse_address(host), name, password)
+        ip, port = peer.tcp_address
+        echo(f"hosting on {ip}:{port} as player 1 ({name})")
+    else:
+        assert join is not None
+        peer = Peer.join(parse_address(join, need_host=True), name, password)
+        h = peer.table[peer.host_number]
+        me_ip, me_port = peer.tcp_address
+        echo(f"joined {h.ip}:{h.tcp_port} as player {peer.number} ({name}), listening on {me_ip}:{me_port} "
+             f"(udp {peer.udp_address[1]}); host is player {peer.host_number}")
+    match = None
+
+    def stop(signum: int, frame: Any) -> None:
+        # Ctrl-C or SIGTERM ends the match cleanly: EXIT to everyone, and the report
+        if match is not None:
+            match.stop = True
+
+    old = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        match = NetMatch(peer, info, spec, seed=seed, log=echo)
+        report = match.run(seconds)
+    finally:
+        peer.close()
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+    net = report["network"]
+    lat = report["latency_ms"]
+    echo(f"{report['seconds']:.1f} s as player {report['me']}; host at the end: player {report['host']}; "
+         f"{len(report['peers'])} players")
+    for p in report["peers"]:
+        echo(f"  p{p['number']} {p['name']:<12} kills {p['kills']:>2} deaths {p['deaths']:>2} "
+             f"position ({p['position'][0]:.1f}, {p['position'][1]:.1f})")
+    echo(f"network: sent {net['sent']}, received {net['received']}, dropped {net['dropped']}; "
+         f"state latency p50 {lat['p50']} ms, p99 {lat['p99']} ms")
+    if report_path is not None:
+        atomic_write_text(report_path, json.dumps(report, indent=1) + "\n")
+        echo(f"report: {report_path}")
+    return report

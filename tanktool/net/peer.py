@@ -1,0 +1,766 @@
+"""A peer of a network session (paper §3.3): the player table, joins, the full mesh,
+and host migration.
+
+The first peer hosts.  A joiner opens TCP to the host and answers its challenge with a
+join request; the host checks room (8 players), assigns the lowest free number and sends
+the joiner its number and the whole table (number, name, address), and every other
+peer the new table.  The joiner then opens a TCP link to every other peer (full mesh),
+so any of them can take over.  TCP carries what must arrive (join, table, shots, hits,
+exits); UDP carries tank states, latest sequence wins.
+
+Host migration: a peer whose TCP link closes, or who is silent for ``silence`` seconds
+(3 s), leaves every table on its own.  When the host leaves, the remaining peer with
+the lowest number becomes host; all tables hold the same numbers, so all agree without
+a vote.  The host's only duty is answering joins, so nothing else has to move.
+
+Safety: a number is bound to a TCP link (the host's, or one the joiner opened to the
+address in the host's table, or a HELLO whose number, epoch and IP match the table) and to
+the UDP address in the table; anything a link or address sends for another number is
+dropped and counted.  With a password, every link answers an HMAC-SHA256 challenge.
+Messages are size-checked by the protocol and rate-limited per link and per address.
+"""
+
+from __future__ import annotations
+
+import errno
+import hmac
+import math
+import os
+import selectors
+import socket
+import time
+from collections import Counter, deque
+from dataclasses import dataclass, field
+from hashlib import sha256
+from typing import Any, Callable
+
+from ..errors import NetError
+from . import protocol as P
+
+#: a peer silent this long has left (and if it hosted, the host migrates) [s]
+SILENCE = 3.0
+#: an accepted TCP connection must say JOIN or HELLO within this time [s]
+PENDING_TIMEOUT = 5.0
+MAX_PENDING = 16
+#: per link / address message rates: a tank state at 30 Hz, a few events
+TCP_RATE, TCP_BURST = 100.0, 200.0
+UDP_RATE, UDP_BURST = 90.0, 45.0
+MAX_OUTBUF = 256 * 1024
+LATENCY_SAMPLES = 200_000
+
+
+def parse_address(text: str, default_host: str = "127.0.0.1", need_host: bool = False) -> tuple[str, int]:
+    """``[ADDR:]PORT`` -> (dotted IPv4, port); NetError (one line) if malformed."""
+    text = text.strip()
+    host, sep, port_s = text.rpartition(":")
+    if not sep:
+        if need_host:
+            raise NetError(f"{text!r}: expected ADDR:PORT, e.g. 127.0.0.1:5000")
+        host, port_s = default_host, text
+    host = host or default_host
+    if host == "localhost":
+        host = "127.0.0.1"
+    try:
+        port = int(port_s)
+    except ValueError:
+        raise NetError(f"{text!r}: the port must be a number from 0 to 65535") from None
+    if not 0 <= port <= 65535 or (need_host and port == 0):
+        raise NetError(f"{text!r}: the port must be a number from {1 if need_host else 0} to 65535")
+    try:
+        socket.inet_aton(host)
+        if host.count(".") != 3:
+            raise OSError
+    except OSError:
+        raise NetError(f"{text!r}: {host!r} is not an IPv4 address (e.g. 127.0.0.1)") from None
+    return host, port
+
+
+def join_mac(password: str, nonce: bytes, name: str) -> bytes:
+    return hmac.new(password.encode(), b"join" + nonce + name.encode(), sha256).digest()
+
+
+def hello_mac(password: str, nonce: bytes, number: int, epoch: int) -> bytes:
+    return hmac.new(password.encode(), b"hello" + nonce + bytes([number]) + epoch.to_bytes(4, "big"),
+                    sha256).digest()
+
+
+class Bucket:
+    """Token bucket: ``rate`` messages a second with bursts up to ``burst``."""
+
+    __slots__ = ("rate", "burst", "tokens", "last")
+
+    def __init__(self, rate: float, burst: float, now: float) -> None:
+        self.rate, self.burst, self.tokens, self.last = rate, burst, burst, now
+
+    def take(self, now: float) -> bool:
+        self.tokens = min(self.burst, self.tokens + (now - self.last) * self.rate)
+        self.last = now
+        if self.tokens >= 1.0:
+            self.tokens -= 1.0
+            return True
+        return False
+
+
+@dataclass
+class Link:
+    """A TCP connection: pending until it says who it is, then bound to one number."""
+
+    sock: socket.socket
+    reader: P.StreamReader
+    bucket: Bucket
+    opened: float
+    nonce: bytes = b""
+    number: int = 0                   # bound player number (0 while pending)
+    hello: P.Message | None = None    # a HELLO waiting for the table to know its number
+    out: bytearray = field(default_factory=bytearray)
+    closing: bool = False             # close once ``out`` is flushed (after a refusal)
+    outgoing: bool = False            # a mesh link we opened, waiting for its challenge
+
+
+@dataclass(frozen=True)
+class NetEvent:
+    """What a poll saw: ``kind`` is joined, left, host, state, shot or hit."""
+
+    kind: str
+    number: int
+    body: Any = None
+    reason: str = ""
+
+
+class Peer:
+    """One player's end of a session.  Build with :meth:`host` or :meth:`join`, then
+    call :meth:`poll` often (it never blocks longer than its timeout)."""
+
+    def __init__(self, name: str, password: str | None = None, clock: Callable[[], float] = time.time,
+                 silence: float = SILENCE) -> None:
+        P.name_bytes(name)      # validates the name early, with a clear message
+        self.name = name
+        self.password = password or None
+        self.clock = clock
+        self.silence = silence
+        self.number = 0
+        self.table: dict[int, P.Entry] = {}
+        self.host_number = 0
+        self.links: dict[int, Link] = {}            # bound links by number
+        self.pending: list[Link] = []
+        self.departed: set[tuple[int, int]] = set()  # (number, epoch) that left
+        self.last_heard: dict[int, float] = {}
+        self.last_state_seq: dict[int, int] = {}
+        self.udp_buckets: dict[int, Bucket] = {}
+        self.counters: Counter = Counter()          # sent, received, bytes_sent, bytes_received
+        self.dropped: Counter = Counter()           # reason -> count
+        self.latencies: deque[float] = deque(maxlen=LATENCY_SAMPLES)
+        self.host_changes: list[tuple[float, int]] = []
+        self.events: list[NetEvent] = []
+        self.seq = 0
+        self.session_offset = 0.0       # session time = clock() - session_offset
+        self.sel = selectors.DefaultSelector()
+        self.tcp: socket.socket | None = None
+        self.udp: socket.socket | None = None
+        self.closed = False
+        self._backlog: list[P.Message] = []
+
+    # ------------------------------------------------------------------ set-up
+    def _listen(self, ip: str, port: int) -> None:
+        """A TCP listener and a UDP socket on ip (TCP on ``port``, UDP on the same
+        number when free)."""
+        tcp = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        tcp.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            tcp.bind((ip, port))
+            tcp.listen(16)
+            try:
+                udp.bind((ip, tcp.getsockname()[1]))
+            except OSError:
+                if port:       # the user asked for this port: UDP must have it too
+                    raise
+                udp.bind((ip, 0))
+        except OSError as e:
+            tcp.close()
+            udp.close()
+            what = "in use" if e.errno in (98, 48, 10048) else f"not available ({e.strerror})"
+            raise NetError(f"cannot listen on {ip}:{port}: address {what}") from None
+        tcp.setblocking(False)
+        udp.setblocking(False)
+        udp.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+        self.tcp, self.udp = tcp, udp
+        self.sel.register(tcp, selectors.EVENT_READ, "accept")
+        self.sel.register(udp, selectors.EVENT_READ, "udp")
+
+    @property
+    def tcp_address(self) -> tuple[str, int]:
+        assert self.tcp is not None
+        return self.tcp.getsockname()
+
+    @property
+    def udp_address(self) -> tuple[str, int]:
+        assert self.udp is not None
+        return self.udp.getsockname()
+
+    @classmethod
+    def host(cls, bind: tuple[str, int], name: str, password: str | None = None, **kw: Any) -> "Peer":
+        """Start a session: listen on ``bind`` and become player 1, the host."""
+        peer = cls(name, password, **kw)
+        peer._listen(*bind)
+        ip, tcp_port = peer.tcp_address
+        peer.number = peer.host_number = 1
+        peer.table = {1: P.Entry(1, 1, ip, tcp_port, peer.udp_address[1], name)}
+        peer.session_offset = peer.clock()
+        return peer
+
+    @classmethod
+    def join(cls, address: tuple[str, int], name: str, password: str | None = None, timeout: float = 5.0,
+             port: int = 0, **kw: Any) -> "Peer":
+        """Join the session whose host (or any member, which redirects) is at ``address``.
+
+        Listens on the interface that reaches the host, on ``port`` (0: any free one).
+        Raises NetError with one clear line if the host cannot be reached or refuses.
+        """
+        peer = cls(name, password, **kw)
+        try:
+            for _ in range(3):        # a member that is not the host names it: follow
+                redirect = peer._join_once(address, timeout, port)
+                if redirect is None:
+                    return peer
+                address = redirect
+            raise NetError(f"cannot join: redirected too many times (last {address[0]}:{address[1]})")
+        except BaseException:
+            peer.close(send_exit=False)
+            raise
+
+    def _join_once(self, address: tuple[str, int], timeout: float, port: int) -> tuple[str, int] | None:
+        where = f"{address[0]}:{address[1]}"
+        try:
+            sock = socket.create_connection(address, timeout=timeout)
+        except OSError as e:
+            raise NetError(f"cannot reach {where}: {e.strerror or e}") from None
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        reader = P.StreamReader(self.dropped)
+        deadline = time.monotonic() + timeout
+        try:
+            msg = self._read_blocking(sock, reader, deadline, where)
+            if not isinstance(msg.body, P.Challenge):
+                raise NetError(f"{where} did not answer like a tanktool peer")
+            if msg.body.password and not self.password:
+                raise NetError(f"{where} wants a password (--password)")
+            if self.tcp is None:
+                self._listen(sock.getsockname()[0], port)
+            mac = join_mac(self.password, msg.body.nonce, self.name) if self.password else bytes(P.MAC_SIZE)
+            sent_at = self.clock()
+            self._send_blocking(sock, P.Join(self.name, self.tcp_address[1], self.udp_address[1], mac))
+            msg = self._read_blocking(sock, reader, deadline, where)
+        except BaseException:
+            sock.close()
+            raise
+        if isinstance(msg.body, P.Refuse):
+            sock.close()
+            if msg.body.code == P.RefuseCode.NOT_HOST:
+                try:
+                    return parse_address(msg.body.text, need_host=True)
+                except NetError:
+                    raise NetError(f"{where} is not the host and did not say who is") from None
+            raise NetError(f"join refused by {where}: {msg.body.text}")
+        if msg.type != P.MessageType.NUMBER or msg.sender != msg.body.table.host:
+            sock.close()
+            raise NetError(f"{where} did not answer the join request")
+        body: P.Assign = msg.body
+        now = self.clock()
+        self.number = body.number
+        self.host_number = body.table.host
+        # the session clock: the host's, plus half the round trip
+        self.session_offset = now - (body.session_t + 0.5 * (now - sent_at))
+        for e in body.table.entries:
+            if e.number == self.host_number and e.ip == "0.0.0.0":
+                e = P.Entry(e.number, e.epoch, address[0], e.tcp_port, e.udp_port, e.name)   # reach it as dialled
+            self.table[e.number] = e
+        sock.setblocking(False)
+        link = Link(sock, reader, Bucket(TCP_RATE, TCP_BURST, now), now)
+        self._bind_link(link, self.host_number)
+        self._drain_backlog(link)
+        for n, e in sorted(self.table.items()):
+            if n not in (self.number, self.host_number):
+                self._link_to(e)
+        return None
+
+    def _link_to(self, e: P.Entry) -> None:
+        """Open the mesh link to a table member (the joiner opens them all).  Non-blocking:
+        two peers joining at once must not wait on each other.  The link is bound to
+        ``e.number`` at once (we dialled the address the host's table gives for it) and
+        answers the member's challenge with a HELLO when it comes."""
+        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock.setblocking(False)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        err = sock.connect_ex((e.ip, e.tcp_port))
+        if err not in (0, errno.EINPROGRESS, errno.EWOULDBLOCK):
+            sock.close()
+            self.dropped["link_failed"] += 1      # it will time out of the table if really gone
+            return
+        now = self.clock()
+        link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now, outgoing=True)
+        self._bind_link(link, e.number)
+
+    def _drain_backlog(self, link: Link) -> None:
+        backlog, self._backlog = self._backlog, []
+        for m in backlog:
+            self._on_tcp(link, m)
+
+    def _read_blocking(self, sock: socket.socket, reader: P.StreamReader, deadline: float,
+                       where: str) -> P.Message:
+        while True:
+            msgs = reader.feed(b"")
+            if msgs:
+                # a message that came in the same segment waits for the bound link
+                self._backlog.extend(msgs[1:])
+                return msgs[0]
+            if reader.broken:
+                raise NetError(f"{where} sent something that is not a tanktool message")
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise NetError(f"{where} did not answer in time")
+            sock.settimeout(left)
+            try:
+                data = sock.recv(4096)
+            except socket.timeout:
+                raise NetError(f"{where} did not answer in time") from None
+            except OSError as e:
+                raise NetError(f"{where}: {e.strerror or e}") from None
+            if not data:
+                raise NetError(f"{where} closed the connection")
+            self.counters["bytes_received"] += len(data)
+            reader.buffer += data
+
+    def _pack(self, body: P.Body, kind: P.MessageType | None = None) -> bytes:
+        self.seq += 1
+        return P.encode(body, self.number, self.seq, self.clock(), kind=kind)
+
+    def _send_blocking(self, sock: socket.socket, body: P.Body) -> None:
+        data = self._pack(body)
+        sock.sendall(data)
+        self.counters["sent"] += 1
+        self.counters["bytes_sent"] += len(data)
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def is_host(self) -> bool:
+        return self.number != 0 and self.number == self.host_number
+
+    def session_time(self) -> float:
+        return self.clock() - self.session_offset
+
+    def players(self) -> list[P.Entry]:
+        return [self.table[n] for n in sorted(self.table)]
+
+    # ------------------------------------------------------------------ sending
+    def send_state(self, state: P.State) -> None:
+        """A state of my tank to every peer, by UDP."""
+        if self.udp is None:
+            return
+        data = self._pack(state)
+        for n, e in self.table.items():
+            if n == self.number:
+                continue
+            try:
+                self.udp.sendto(data, (e.ip, e.udp_port))
+            except OSError:
+                self.dropped["send_failed"] += 1
+                continue
+            self.counters["sent"] += 1
+            self.counters["states_sent"] += 1
+            self.counters["bytes_sent"] += len(data)
+
+    def send_event(self, body: P.Body) -> None:
+        """A shot, hit or exit to every linked peer, by TCP."""
+        data = self._pack(body)
+        for link in list(self.links.values()):
+            self._queue(link, data)
+
+    def _queue(self, link: Link, data: bytes) -> None:
+        link.out += data
+        self.counters["sent"] += 1
+        self.counters["bytes_sent"] += len(data)
+        self._flush(link)
+
+    def _flush(self, link: Link) -> None:
+        if link.out:
+            try:
+                n = link.sock.send(link.out)
+                del link.out[:n]
+            except (BlockingIOError, InterruptedError):
+                pass
+            except OSError:
+                self._drop_link(link, "closed")
+                return
+        if len(link.out) > MAX_OUTBUF:
+            self._drop_link(link, "too slow")
+            return
+        want = selectors.EVENT_READ | (selectors.EVENT_WRITE if link.out else 0)
+        try:
+            if self.sel.get_key(link.sock).events != want:
+                self.sel.modify(link.sock, want, link)
+        except (KeyError, ValueError):
+            pass
+        if link.closing and not link.out:
+            self._close_link(link)
+
+    # ------------------------------------------------------------------ the loop
+    def poll(self, timeout: float = 0.0) -> list[NetEvent]:
+        """Handle everything that arrived (waiting at most ``timeout`` seconds for the
+        first thing), check silences and pending links; return what happened."""
+        if self.closed:
+            return []
+        for key, mask in self.sel.select(max(timeout, 0.0)):
+            if key.data == "accept":
+                self._accept()
+            elif key.data == "udp":
+                self._read_udp()
+            else:
+                link: Link = key.data
+                if link.sock.fileno() < 0:
+                    continue
+                if mask & selectors.EVENT_WRITE:
+                    self._flush(link)
+                if mask & selectors.EVENT_READ and link.sock.fileno() >= 0:
+                    self._read_tcp(link)
+        self._check_timeouts()
+        out, self.events = self.events, []
+        return out
+
+    def _accept(self) -> None:
+        assert self.tcp is not None
+        for _ in range(8):
+            try:
+                sock, _addr = self.tcp.accept()
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                self.dropped["accept_failed"] += 1
+                return
+            if len(self.pending) >= MAX_PENDING:
+                self.dropped["too_many_pending"] += 1
+                sock.close()
+                continue
+            sock.setblocking(False)
+            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            now = self.clock()
+            link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now,
+                        nonce=os.urandom(P.NONCE_SIZE))
+            self.pending.append(link)
+            self.sel.register(sock, selectors.EVENT_READ, link)
+            self._queue(link, self._pack(P.Challenge(link.nonce, self.password is not None)))
+
+    def _read_tcp(self, link: Link) -> None:
+        try:
+            data = link.sock.recv(65536)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            data = b""
+        if not data:
+            self._drop_link(link, "closed")
+            return
+        self.counters["bytes_received"] += len(data)
+        msgs = link.reader.feed(data)
+        now = self.clock()
+        for m in msgs:
+            if link.sock.fileno() < 0:
+                return
+            if not link.bucket.take(now):
+                self.dropped["rate"] += 1
+                continue
+            self._on_tcp(link, m)
+        if link.reader.broken:
+            self._drop_link(link, "garbage")
+
+    def _on_tcp(self, link: Link, m: P.Message) -> None:
+        now = self.clock()
+        if link.closing:
+            return
+        if link.number == 0:
+            self._on_pending(link, m)
+            return
+        if link.outgoing:
+            if not isinstance(m.body, P.Challenge) or m.sender != link.number:
+                self._drop_link(link, "garbage")
+                return
+            link.outgoing = False
+            epoch = self.table[self.number].epoch
+            mac = hello_mac(self.password, m.body.nonce, self.number, epoch) if self.password else bytes(P.MAC_SIZE)
+            self._queue(link, self._pack(P.Hello(epoch, mac)))
+            return
+        if m.sender != link.number:
+            self.dropped["impostor"] += 1      # a peer speaks only for its own number
+            return
+        self.counters["received"] += 1
+        self.last_heard[link.number] = now
+        body = m.body
+        if m.type == P.MessageType.NEW_PLAYER:
+            if m.sender != self.host_number:
+                self.dropped["not_host"] += 1
+                return
+            self._merge_table(body.table, body.number)
+        elif isinstance(body, P.Shot):
+            if body.tank != m.sender:
+                self.dropped["impostor"] += 1
+                return
+            self.events.append(NetEvent("shot", m.sender, body))
+        elif isinstance(body, P.Hit):
+            if body.victim != m.sender:        # only the victim's peer decides a hit
+                self.dropped["impostor"] += 1
+                return
+            self.events.append(NetEvent("hit", m.sender, body))
+        elif isinstance(body, P.Exit):
+            self._remove(link.number, "exit")
+        elif isinstance(body, P.State):
+            self._on_state(m, now)            # allowed on TCP too (e.g. through firewalls)
+        else:
+            self.dropped["unexpected"] += 1
+
+    def _on_pending(self, link: Link, m: P.Message) -> None:
+        body = m.body
+        if isinstance(body, P.Join):
+            if self.password and not hmac.compare_digest(body.mac, join_mac(self.password, link.nonce, body.name)):
+                self._refuse(link, P.RefuseCode.PASSWORD, "wrong password")
+                return
+            if not self.is_host:
+                h = self.table.get(self.host_number)
+                self._refuse(link, P.RefuseCode.NOT_HOST, f"{h.ip}:{h.tcp_port}" if h else "")
+                return
+            self._admit(link, body)
+        elif isinstance(body, P.Hello):
+            if self.password and not hmac.compare_digest(
+                    body.mac, hello_mac(self.password, link.nonce, m.sender, body.epoch)):
+                self._refuse(link, P.RefuseCode.PASSWORD, "wrong password")
+                return
+            link.hello = m
+            self._try_hello(link)
+        else:
+            self.dropped["unexpected"] += 1
+
+    def _try_hello(self, link: Link) -> bool:
+        """Bind a HELLO link when the table knows its number with that epoch and the
+        address matches; otherwise it waits (the host's NEW_PLAYER may still be on
+        its way) until PENDING_TIMEOUT."""
+        m = link.hello
+        assert m is not None
+        n = m.sender
+        e = self.table.get(n)
+        if e is None or e.epoch != m.body.epoch:
+            if (n, m.body.epoch) in self.departed:
+                self._refuse(link, P.RefuseCode.BAD_REQUEST, "you left the session")
+            return False
+        try:
+            ip = link.sock.getpeername()[0]
+        except OSError:
+            self._drop_link(link, "closed")
+            return False
+        if n == self.number or n in self.links or (ip != e.ip and e.ip != "0.0.0.0"):
+            self.dropped["impostor"] += 1
+            self._refuse(link, P.RefuseCode.BAD_REQUEST, f"player {n} is already linked")
+            return False
+        self.pending.remove(link)
+        self._bind_link(link, n, registered=True)
+        return True
+
+    def _admit(self, link: Link, join: P.Join) -> None:
+        free = [n for n in range(1, P.MAX_PLAYERS + 1) if n not in self.table]
+        if not free:
+            self._refuse(link, P.RefuseCode.FULL, f"session full: {P.MAX_PLAYERS} players already")
+            return
+        try:
+            ip = link.sock.getpeername()[0]
+        except OSError:
+            self._drop_link(link, "closed")
+            return
+        n = free[0]
+        epoch = max(e.epoch for e in self.table.values()) + 1
+        self.table[n] = P.Entry(n, epoch, ip, join.tcp_port, join.udp_port, join.name)
+        self.pending.remove(link)
+        self._bind_link(link, n, registered=True)
+        table = self._table()
+        t = self.session_time()
+        self._queue(link, self._pack(P.Assign(n, t, table), P.MessageType.NUMBER))
+        news = self._pack(P.Assign(n, t, table), P.MessageType.NEW_PLAYER)
+        for k, other in list(self.links.items()):
+            if k != n:
+                self._queue(other, news)
+        self.events.append(NetEvent("joined", n, self.table[n]))
+
+    def _refuse(self, link: Link, code: P.RefuseCode, text: str) -> None:
+        self.dropped[f"refused_{code.name.lower()}"] += 1
+        self._queue(link, self._pack(P.Refuse(code, text)))
+        link.closing = True
+        link.hello = None
+        self._flush(link)
+
+    def _table(self) -> P.Table:
+        return P.Table(self.host_number, tuple(self.table[n] for n in sorted(self.table)))
+
+    def _merge_table(self, table: P.Table, new: int) -> None:
+        """The host's table: add who we do not know (unless we saw them leave)."""
+        for e in table.entries:
+            if (e.number, e.epoch) in self.departed or e.number == self.number:
+                continue
+            old = self.table.get(e.number)
+            if old is None or old.epoch != e.epoch:
+                if old is not None:
+                    self._remove(e.number, "replaced")
+                self.table[e.number] = e
+                self.last_heard[e.number] = self.clock()
+                self.events.append(NetEvent("joined", e.number, e))
+        for link in list(self.pending):
+            if link.hello is not None:
+                self._try_hello(link)
+
+    def _bind_link(self, link: Link, number: int, registered: bool = False) -> None:
+        link.number = number
+        self.links[number] = link
+        self.last_heard[number] = self.clock()
+        if registered:
+            self._flush(link)
+        else:
+            self.sel.register(link.sock, selectors.EVENT_READ, link)
+            if link.out:
+                self._flush(link)
+
+    def _read_udp(self) -> None:
+        assert self.udp is not None
+        now = self.clock()
+        for _ in range(256):          # bounded: a flood cannot starve the game loop
+            try:
+                data, addr = self.udp.recvfrom(2048)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                self.dropped["udp_error"] += 1
+                return
+            self.counters["bytes_received"] += len(data)
+            m = P.decode(data, self.dropped)
+            if m is None:
+                continue
+            e = self.table.get(m.sender)
+            if e is None or m.sender == self.number or addr != (e.ip, e.udp_port):
+                self.dropped["impostor" if e is not None else "unknown"] += 1
+                continue
+            if not isinstance(m.body, P.State):
+                self.dropped["unexpected"] += 1
+                continue
+            b = self.udp_buckets.get(m.sender)
+            if b is None:
+                b = self.udp_buckets[m.sender] = Bucket(UDP_RATE, UDP_BURST, now)
+            if not b.take(now):
+                self.dropped["rate"] += 1
+                continue
+            self.counters["received"] += 1
+            self.last_heard[m.sender] = now
+            self._on_state(m, now)
+
+    def _on_state(self, m: P.Message, now: float) -> None:
+        if m.body.tank != m.sender:
+            self.dropped["impostor"] += 1
+            return
+        if m.seq <= self.last_state_seq.get(m.sender, -1):
+            self.dropped["stale"] += 1        # latest sequence wins
+            return
+        self.last_state_seq[m.sender] = m.seq
+        self.counters["states_received"] += 1
+        self.latencies.append(now - m.timestamp)
+        self.events.append(NetEvent("state", m.sender, m.body))
+
+    # ------------------------------------------------------------------ leaving
+    def _check_timeouts(self) -> None:
+        now = self.clock()
+        for link in list(self.pending):
+            if now - link.opened > PENDING_TIMEOUT:
+                self.dropped["pending_timeout"] += 1
+                self._close_link(link)
+        for n in list(self.table):
+            if n != self.number and now - self.last_heard.get(n, now) > self.silence:
+                self._remove(n, "silent")
+
+    def _drop_link(self, link: Link, reason: str) -> None:
+        if link.outgoing:
+            # a mesh link that never opened says nothing about its peer: silence will
+            self.dropped["link_failed"] += 1
+            self._close_link(link)
+        elif link.number and self.links.get(link.number) is link:
+            self._remove(link.number, reason)
+        else:
+            if reason == "garbage":
+                self.dropped["garbage_stream"] += 1
+            self._close_link(link)
+
+    def _close_link(self, link: Link) -> None:
+        try:
+            self.sel.unregister(link.sock)
+        except (KeyError, ValueError):
+            pass
+        link.sock.close()
+        if link in self.pending:
+            self.pending.remove(link)
+        if link.number and self.links.get(link.number) is link:
+            del self.links[link.number]
+
+    def _remove(self, n: int, reason: str) -> None:
+        """Player ``n`` left (exit, closed link, silence): out of the table; if it was
+        the host, the lowest remaining number hosts."""
+        e = self.table.pop(n, None)
+        link = self.links.get(n)
+        if link is not None:
+            self._close_link(link)
+        self.last_heard.pop(n, None)
+        self.last_state_seq.pop(n, None)
+        self.udp_buckets.pop(n, None)
+        if e is None:
+            return
+        self.departed.add((n, e.epoch))
+        self.events.append(NetEvent("left", n, e, reason))
+        if n == self.host_number and self.table:
+            self.host_number = min(self.table)
+            self.host_changes.append((self.session_time(), self.host_number))
+            self.events.append(NetEvent("host", self.host_number))
+
+    def close(self, send_exit: bool = True) -> None:
+        """Leave: tell everyone (TCP), close every socket."""
+        if self.closed:
+            return
+        if send_exit and self.links:
+            self.send_event(P.Exit())
+            for link in list(self.links.values()):
+                if link.out:
+                    try:
+                        link.sock.setblocking(True)
+                        link.sock.settimeout(0.5)
+                        link.sock.sendall(link.out)
+                    except OSError:
+                        pass
+        for link in list(self.links.values()) + list(self.pending):
+            self._close_link(link)
+        for s in (self.tcp, self.udp):
+            if s is not None:
+                try:
+                    self.sel.unregister(s)
+                except (KeyError, ValueError):
+                    pass
+                s.close()
+        self.sel.close()
+        self.closed = True
+
+    def network_report(self) -> dict[str, Any]:
+        """Counters for reports: messages sent / received / dropped, bytes, reasons."""
+        return {
+            "sent": self.counters["sent"], "received": self.counters["received"],
+            "dropped": sum(self.dropped.values()),
+            "bytes_sent": self.counters["bytes_sent"], "bytes_received": self.counters["bytes_received"],
+            "states_sent": self.counters["states_sent"], "states_received": self.counters["states_received"],
+            "dropped_reasons": dict(sorted(self.dropped.items())),
+        }
+
+
+def percentile(values: list[float], q: float) -> float:
+    """The q-th percentile (0..100) by nearest rank; NaN for no values."""
+    if not values:
+        return math.nan
+    s = sorted(values)
+    k = min(len(s) - 1, max(0, int(math.ceil(q / 100.0 * len(s))) - 1))
+    return s[k]

@@ -1,0 +1,250 @@
+"""A networked match: one :class:`~tanktool.net.peer.Peer` and a local World, in real time.
+
+Every peer runs a World with one tank slot per player number (tank ``n - 1`` is player
+``n``).  Authority, per tank:
+
+- **movement**: each peer simulates its own tank (driven by Commands, like any other
+  driver) and sends its state by UDP at ``state_hz``; remote tanks are placed from their
+  buffered states, ``INTERP_DELAY`` in the past (:mod:`.remote`).
+- **shots**: the shooter's peer fires and sends SHOT (TCP) with the pose it fired from;
+  every other peer launches the same shell from that pose in its own world.
+- **hits: the victim's peer decides.**  Its world flies every shell against its own
+  tank, which it knows exactly; when one hits, it takes the damage (and dies if it must)
+  and sends HIT to everyone.  A hit a peer's world sees on a *remote* tank is not
+  scored: that tank's own peer is the judge, and its next state carries its hit points.
+  So nobody can be killed by a peer that merely claims it, and no two peers ever score a
+  hit differently.
+
+Computer opponents are not part of network sessions yet (the host would run them).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from ..sim.body import TankSpec
+from ..sim.commands import IDLE, Command
+from ..sim.driver import ScriptedDriver
+from ..sim.weapons import fire
+from ..sim.world import World
+from . import protocol as P
+from .peer import Peer, percentile
+from .remote import INTERP_DELAY, RemoteTank
+
+STATE_HZ = 30.0
+#: a process that falls further behind than this skips steps rather than spiral [s]
+MAX_LAG = 0.25
+
+
+@dataclass
+class Score:
+    shots: int = 0
+    hits: int = 0
+    kills: int = 0
+    deaths: int = 0
+
+
+@dataclass
+class NetMatch:
+    """A peer's side of a networked match (build it, then :meth:`run`)."""
+
+    peer: Peer
+    arena: Any                       # sim.match.ArenaInfo
+    spec: TankSpec
+    seed: int = 0
+    driver: Callable[[World, Any], Command] | None = None
+    state_hz: float = STATE_HZ
+    log: Callable[[str], None] = lambda line: None
+    world: World = field(init=False)
+    remotes: dict[int, RemoteTank] = field(init=False, default_factory=dict)
+    scores: dict[int, Score] = field(init=False, default_factory=dict)
+    views: list[dict[str, Any]] = field(init=False, default_factory=list)
+    left: list[dict[str, Any]] = field(init=False, default_factory=list)
+    names: dict[int, str] = field(init=False, default_factory=dict)
+    #: set (e.g. from a signal handler) to end the match at the next loop turn
+    stop: bool = field(init=False, default=False)
+
+    def __post_init__(self) -> None:
+        names = [f"p{n}" for n in range(1, P.MAX_PLAYERS + 1)]
+        self.world = World(self.arena.walls, [self.spec] * P.MAX_PLAYERS, self.arena.spawns, seed=self.seed,
+                           names=names, bounds=self.arena.bounds)
+        self.me = self.world.tanks[self.peer.number - 1]
+        self.world.t = self.peer.session_time()
+        for t in self.world.tanks:
+            if t is not self.me:
+                self._absent(t)
+        if self.driver is None:
+            self.driver = ScriptedDriver(random.Random(self.seed * 1009 + self.peer.number))
+        for e in self.peer.players():
+            self.names[e.number] = e.name
+
+    # ------------------------------------------------------------------ pieces
+    @staticmethod
+    def _absent(t: Any) -> None:
+        t.alive = False
+        t.respawn_at = math.inf      # only its own peer brings it back
+
+    def _score(self, n: int) -> Score:
+        return self.scores.setdefault(n, Score())
+
+    def _place_remotes(self, t_view: float) -> None:
+        """Remote tanks where their buffered states put them at ``t_view``."""
+        for tank in self.world.tanks:
+            n = tank.index + 1
+            if tank is self.me:
+                continue
+            rt = self.remotes.get(n) if n in self.peer.table else None
+            s = rt.sample(t_view) if rt is not None else None
+            if s is None:
+                self._absent(tank)
+                continue
+            tank.x, tank.z, tank.heading = s.x, s.z, s.heading
+            tank.vx, tank.vz, tank.omega = s.vx, s.vz, s.omega
+            tank.c, tank.s = math.cos(s.heading), math.sin(s.heading)
+            tank.hp = s.hp
+            tank.alive = s.alive
+            tank.respawn_at = math.inf
+
+    def _remote_shot(self, shot: P.Shot) -> None:
+        """Launch a remote tank's shell from the pose it fired from."""
+        tank = self.world.tanks[shot.tank - 1]
+        saved = (tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s)
+        tank.x, tank.z, tank.heading, tank.vx, tank.vz = shot.x, shot.z, shot.heading, shot.vx, shot.vz
+        tank.c, tank.s = math.cos(shot.heading), math.sin(shot.heading)
+        self.world.shells.append(fire(tank, self.world.walls))
+        tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s = saved
+
+    def _on_net(self, events: list) -> None:
+        for ev in events:
+            if ev.kind == "state":
+                self.remotes.setdefault(ev.number, RemoteTank()).push(ev.body)
+            elif ev.kind == "shot":
+                self._score(ev.number).shots += 1
+                self._remote_shot(ev.body)
+            elif ev.kind == "hit":
+                h: P.Hit = ev.body
+                self._count_hit(h.shooter, h.victim, h.killed)
+            elif ev.kind == "joined":
+                self.names[ev.number] = ev.body.name
+                self.remotes.pop(ev.number, None)
+                self.log(f"player {ev.number} ({ev.body.name}) joined")
+            elif ev.kind == "left":
+                self.remotes.pop(ev.number, None)
+                self._absent(self.world.tanks[ev.number - 1])
+                self.left.append({"time": round(self.peer.session_time(), 3), "number": ev.number,
+                                  "name": ev.body.name, "reason": ev.reason})
+                self.log(f"player {ev.number} ({ev.body.name}) left ({ev.reason})")
+            elif ev.kind == "host":
+                self.log(f"host is now player {ev.number}" + (" (me)" if ev.number == self.peer.number else ""))
+
+    def _count_hit(self, shooter: int, victim: int, killed: bool) -> None:
+        self._score(shooter).hits += 1
+        if killed:
+            self._score(shooter).kills += 1
+            self._score(victim).deaths += 1
+
+    def _my_state(self) -> P.State:
+        m = self.me
+        return P.State(self.peer.number, max(self.world.t, 0.0), m.x, m.z, math.remainder(m.heading, 2 * math.pi),
+                       m.vx, m.vz, m.omega, m.hp, m.alive)
+
+    def _record_view(self, second: int) -> None:
+        tanks = {}
+        for n in sorted(self.peer.table):
+            t = self.world.tanks[n - 1]
+            tanks[str(n)] = [round(t.x, 3), round(t.z, 3), bool(t.alive)]
+        self.views.append({"t": second, "tanks": tanks})
+
+    def step(self) -> None:
+        """One fixed step of the local world, with the network around it."""
+        w, me, n = self.world, self.me, self.peer.number
+        self._place_remotes(w.t + w.dt - INTERP_DELAY)
+        cmd = self.driver(w, me) if me.alive else IDLE
+        pose = (me.x, me.z, me.heading, me.vx, me.vz)
+        commands: list[Command | None] = [None] * len(w.tanks)
+        commands[n - 1] = cmd
+        for ev in w.step(None, commands):
+            if ev.kind == "shot" and ev.tank == n - 1:
+                self._score(n).shots += 1
+                self.peer.send_event(P.Shot(n, w.t, *pose))
+            elif ev.kind == "hit" and ev.other == n - 1:
+                # the victim decides: this hit is real, tell everyone
+                killed = not me.alive
+                self._count_hit(ev.tank + 1, n, killed)
+                self.peer.send_event(P.Hit(ev.tank + 1, n, w.t, ev.value, max(me.hp, 0.0), killed, ev.x, ev.z))
+        for t in w.tanks:     # a remote tank "killed" in our world waits for its own peer
+            if t is not me and not t.alive:
+                t.respawn_at = math.inf
+
+    def run(self, seconds: float) -> dict[str, Any]:
+        """Play ``seconds`` of real time; return the report."""
+        w, peer = self.world, self.peer
+        start = time.monotonic()
+        end = start + seconds
+        next_step = start
+        next_state = start
+        state_period = 1.0 / self.state_hz
+        next_view = math.floor(w.t) + 1
+        skipped = 0
+        while not self.stop:
+            now = time.monotonic()
+            if now >= end:
+                break
+            self._on_net(peer.poll(max(0.0, min(next_step, next_state, end) - now)))
+            now = time.monotonic()
+            if now - next_step > MAX_LAG:          # starved of CPU: skip, keep real time
+                skipped += int((now - next_step) / w.dt)
+                next_step = now
+                w.t = peer.session_time()
+            while next_step <= now:
+                self.step()
+                next_step += w.dt
+                if w.t >= next_view:
+                    self._record_view(next_view)
+                    next_view = math.floor(w.t) + 1
+            if now >= next_state:
+                peer.send_state(self._my_state())
+                next_state += state_period
+                if now - next_state > MAX_LAG:
+                    next_state = now
+        wall = time.monotonic() - start
+        return self.report(wall, skipped)
+
+    # ------------------------------------------------------------------ report
+    def report(self, wall: float, skipped: int = 0) -> dict[str, Any]:
+        peer = self.peer
+        peers = []
+        for e in peer.players():
+            t = self.world.tanks[e.number - 1]
+            sc = self._score(e.number)
+            peers.append({"number": e.number, "name": e.name, "address": f"{e.ip}:{e.tcp_port}",
+                          "position": [round(t.x, 3), round(t.z, 3)], "alive": bool(t.alive),
+                          "hit_points": round(max(t.hp, 0.0), 2), "shots": sc.shots, "hits": sc.hits,
+                          "kills": sc.kills, "deaths": sc.deaths})
+        lat = list(peer.latencies)
+        return {
+            "mode": "network",
+            "arena": self.arena.name,
+            "vehicle": self.spec.name,
+            "seed": self.seed,
+            "me": peer.number,
+            "name": peer.name,
+            "host": peer.host_number,
+            "seconds": round(wall, 3),
+            "session_time": round(self.world.t, 3),
+            "peers": peers,
+            "left": self.left,
+            "host_changes": [{"time": round(t, 3), "host": h} for t, h in peer.host_changes],
+            "network": peer.network_report(),
+            "latency_ms": {"samples": len(lat), "p50": _ms(percentile(lat, 50)), "p99": _ms(percentile(lat, 99))},
+            "views": self.views,
+            "timing": {"wall_clock_s": round(wall, 3), "steps": self.world.steps, "skipped_steps": skipped},
+        }
+
+
+def _ms(v: float) -> float | None:
+    return None if math.isnan(v) else round(v * 1000.0, 3)

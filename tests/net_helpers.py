@@ -1,0 +1,57 @@
+"""Helpers for the network tests: in-process peers pumped together, loopback only."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from tanktool.net import protocol as P
+from tanktool.net.peer import Peer
+
+LOOPBACK = "127.0.0.1"
+
+
+def pump(peers, seconds: float = 0.2, states: bool = False) -> list:
+    """Poll every open peer for ``seconds`` (bounded); optionally send a state each round."""
+    events = []
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        for p in peers:
+            if p.closed:
+                continue
+            if states and p.number:
+                p.send_state(P.State(p.number, max(p.session_time(), 0.0), 1.0 * p.number, 2.0, 0.0,
+                                     0.0, 0.0, 0.0, 100.0, True))
+            events += [(p.number, e) for e in p.poll(0.002)]
+    return events
+
+
+def join(peers, address, name: str, password: str | None = None, timeout: float = 5.0, **kw) -> Peer:
+    """Peer.join blocks on its handshake, so run it in a thread while the others poll."""
+    out: dict = {}
+
+    def run() -> None:
+        try:
+            out["peer"] = Peer.join(address, name, password, timeout=timeout, **kw)
+        except Exception as e:          # handed to the test thread
+            out["error"] = e
+
+    th = threading.Thread(target=run, daemon=True)
+    th.start()
+    deadline = time.monotonic() + timeout + 5.0
+    while th.is_alive() and time.monotonic() < deadline:
+        for p in peers:
+            if not p.closed:
+                p.poll(0.002)
+    th.join(1.0)
+    if "error" in out:
+        raise out["error"]
+    peer = out["peer"]
+    peers.append(peer)
+    pump(peers, 0.1)
+    return peer
+
+
+def close_all(peers) -> None:
+    for p in peers:
+        p.close(send_exit=False)

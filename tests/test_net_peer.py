@@ -1,0 +1,203 @@
+"""Sessions in one process on loopback: joins, the mesh, refusals, host migration,
+impostors, garbage and passwords."""
+
+from __future__ import annotations
+
+import socket
+
+import pytest
+from net_helpers import LOOPBACK, close_all, join, pump
+
+from tanktool.errors import NetError
+from tanktool.net import protocol as P
+from tanktool.net.peer import Peer, parse_address
+
+
+@pytest.fixture
+def peers():
+    made: list[Peer] = []
+    yield made
+    close_all(made)
+
+
+def _session(peers, n: int, password: str | None = None) -> list[Peer]:
+    host = Peer.host((LOOPBACK, 0), "host", password)
+    peers.append(host)
+    for i in range(2, n + 1):
+        join(peers, host.tcp_address, f"peer{i}", password)
+    return peers
+
+
+def test_full_mesh_and_same_table(peers):
+    _session(peers, 4)
+    assert [p.number for p in peers] == [1, 2, 3, 4]
+    for p in peers:
+        assert sorted(p.table) == [1, 2, 3, 4]
+        assert sorted(p.links) == sorted({1, 2, 3, 4} - {p.number})     # full mesh
+        assert p.host_number == 1
+        assert {n: e.name for n, e in p.table.items()} == {1: "host", 2: "peer2", 3: "peer3", 4: "peer4"}
+    # the session clock is shared: every joiner is within a few ms of the host
+    times = [p.session_time() for p in peers]
+    assert max(times) - min(times) < 0.05
+
+
+def test_states_events_and_latest_sequence_wins(peers):
+    _session(peers, 3)
+    events = pump(peers, 0.3, states=True)
+    got = {(me, e.number) for me, e in events if e.kind == "state"}
+    assert got == {(a, b) for a in (1, 2, 3) for b in (1, 2, 3) if a != b}
+    # a shot by TCP reaches everyone else
+    peers[1].send_event(P.Shot(2, 1.0, 3.0, 4.0, 0.5, 0.0, 0.0))
+    events = pump(peers, 0.2)
+    shots = {me for me, e in events if e.kind == "shot" and e.body.tank == 2}
+    assert shots == {1, 3}
+    # a replayed (older) datagram is dropped as stale
+    s = P.State(2, 1.0, 0, 0, 0, 0, 0, 0, 100, True)
+    old = P.encode(s, 2, 1, 1.0)
+    sock = peers[1].udp
+    sock.sendto(old, peers[0].udp_address)
+    before = peers[0].dropped["stale"]
+    pump(peers, 0.1)
+    assert peers[0].dropped["stale"] == before + 1
+
+
+def test_ninth_refused(peers):
+    _session(peers, 8)
+    assert sorted(peers[0].table) == list(range(1, 9))
+    with pytest.raises(NetError, match="session full"):
+        join(peers, peers[0].tcp_address, "ninth")
+    assert len(peers) == 8 and all(len(p.table) == 8 for p in peers)
+
+
+def test_lowest_free_number_reused_but_host_stays(peers):
+    _session(peers, 4)
+    peers[1].close()                           # player 2 leaves cleanly (EXIT)
+    pump(peers, 0.2)
+    assert all(sorted(p.table) == [1, 3, 4] for p in peers if not p.closed)
+    newcomer = join(peers, peers[0].tcp_address, "again")
+    assert newcomer.number == 2 and newcomer.host_number == 1
+    pump(peers, 0.1)
+    assert all(sorted(p.table) == [1, 2, 3, 4] for p in peers if not p.closed)
+
+
+def test_host_crash_migrates_and_new_host_takes_joins(peers):
+    _session(peers, 4)
+    peers[0].close(send_exit=False)            # the host vanishes (its links close)
+    events = pump(peers, 0.3)
+    alive = [p for p in peers if not p.closed]
+    assert all(p.host_number == 2 for p in alive)
+    assert peers[1].is_host and not peers[2].is_host
+    assert all(p.host_changes and p.host_changes[-1][1] == 2 for p in alive)
+    assert {me for me, e in events if e.kind == "host" and e.number == 2} == {2, 3, 4}
+    # a new player joins through the new host and gets the lowest free number
+    newcomer = join(peers, peers[1].tcp_address, "late")
+    assert newcomer.number == 1 and newcomer.host_number == 2
+    pump(peers, 0.1)
+    for p in peers:
+        if not p.closed:
+            assert sorted(p.table) == [1, 2, 3, 4] and p.host_number == 2
+            assert sorted(p.links) == sorted({1, 2, 3, 4} - {p.number})
+    # joining through a member that is not the host is redirected to the host
+    peers[2].close()
+    pump(peers, 0.1)
+    other = join(peers, peers[3].tcp_address, "redirected")
+    assert other.number == 3 and other.host_number == 2
+
+
+def test_silent_host_is_replaced(peers):
+    host = Peer.host((LOOPBACK, 0), "host", silence=0.5)
+    peers.append(host)
+    for i in (2, 3):
+        join(peers, host.tcp_address, f"p{i}", silence=0.5)
+    # the host stops polling and sending (a frozen process); 2 and 3 keep talking
+    pump(peers[1:], 1.0, states=True)
+    assert all(p.host_number == 2 for p in peers[1:])
+    assert 1 not in peers[1].table and 1 not in peers[2].table
+
+
+def test_impostor_state_and_events_ignored(peers):
+    _session(peers, 3)
+    pump(peers, 0.1, states=True)
+    rogue = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    try:
+        fake = P.encode(P.State(2, 5.0, 999.0, 999.0, 0, 0, 0, 0, 100, True), 2, 10**6, 1.0)
+        for p in peers:
+            rogue.sendto(fake, p.udp_address)
+        # player 3's own socket claiming to be player 2
+        peers[2].udp.sendto(fake, peers[0].udp_address)
+    finally:
+        rogue.close()
+    # player 3 claims, over its own TCP link, a hit on player 2 and a shot of player 1
+    peers[2].send_event(P.Hit(3, 2, 1.0, 25.0, 0.0, True, 0, 0))
+    peers[2].send_event(P.Shot(1, 1.0, 0, 0, 0, 0, 0))
+    events = pump(peers, 0.2)
+    assert not [e for _, e in events if e.kind == "state" and e.body.x == 999.0]
+    assert not [e for _, e in events if e.kind in ("hit", "shot")]
+    assert peers[0].dropped["impostor"] >= 3 and peers[1].dropped["impostor"] >= 1
+    # a forged HELLO for a number that is already linked is refused
+    s = socket.create_connection(peers[0].tcp_address, timeout=2)
+    try:
+        s.sendall(P.encode(P.Hello(peers[0].table[2].epoch, bytes(32)), 2, 1, 1.0))
+        pump(peers, 0.2)
+        data = s.recv(4096)
+        assert P.MessageType.REFUSE in [m.type for m in P.StreamReader(peers[0].dropped).feed(data)]
+    finally:
+        s.close()
+    assert all(sorted(p.table) == [1, 2, 3] for p in peers)
+
+
+def test_garbage_to_every_port_changes_nothing(peers):
+    _session(peers, 3)
+    pump(peers, 0.1, states=True)
+    tables = [dict(p.table) for p in peers]
+    udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+    good = P.encode(P.State(1, 1.0, 0, 0, 0, 0, 0, 0, 100, True), 1, 5, 1.0)
+    try:
+        for p in peers:
+            for k in range(len(good)):
+                udp.sendto(good[:k], p.udp_address)                 # truncations
+            udp.sendto(b"\xff" * 600, p.udp_address)
+            udp.sendto(good + b"x", p.udp_address)
+            for junk in (b"GET / HTTP/1.0\r\n\r\n", good[:30], b"\x00" * 5000):
+                t = socket.create_connection(p.tcp_address, timeout=2)
+                t.sendall(junk)
+                t.close()
+    finally:
+        udp.close()
+    pump(peers, 0.5, states=True)
+    for p, before in zip(peers, tables):
+        assert p.table == before and p.host_number == 1
+        assert sorted(p.links) == sorted({1, 2, 3} - {p.number})
+        assert sum(p.dropped.values()) >= len(good) + 2
+        assert not p.pending           # every junk connection was closed
+
+
+def test_password(peers):
+    host = Peer.host((LOOPBACK, 0), "host", "s3cret")
+    peers.append(host)
+    with pytest.raises(NetError, match="wants a password"):
+        join(peers, host.tcp_address, "nopw")
+    with pytest.raises(NetError, match="wrong password"):
+        join(peers, host.tcp_address, "badpw", "guess")
+    ok = join(peers, host.tcp_address, "good", "s3cret")
+    third = join(peers, host.tcp_address, "good2", "s3cret")
+    assert ok.number == 2 and third.number == 3 and 2 in third.links   # HELLO passed the HMAC too
+    assert host.dropped["refused_password"] == 1
+
+
+def test_bad_addresses_and_port_in_use(peers):
+    for text in ("nonsense", "1.2.3:80", "127.0.0.1:99999", "127.0.0.1:x"):
+        with pytest.raises(NetError):
+            parse_address(text, need_host=True)
+    assert parse_address("5000") == ("127.0.0.1", 5000)
+    assert parse_address("0.0.0.0:7") == ("0.0.0.0", 7)
+    host = Peer.host((LOOPBACK, 0), "host")
+    peers.append(host)
+    with pytest.raises(NetError, match="in use"):
+        Peer.host(host.tcp_address, "again")
+    free = socket.socket()
+    free.bind((LOOPBACK, 0))
+    port = free.getsockname()[1]
+    free.close()
+    with pytest.raises(NetError, match="cannot reach"):
+        Peer.join((LOOPBACK, port), "nobody", timeout=1.0)
