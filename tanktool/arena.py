@@ -148,12 +148,15 @@ def import_arena(
     navgrid: dict[str, Any] | None = None,
     progress: Callable[[str], None] | None = None,
     warn: Callable[[str], None] | None = None,
+    wall_height: float | None = None,
+    wall_thickness: float | None = None,
 ) -> ImportResult:
     """Read ``model``, extract walls and spawns and write the arena bundle ``out``.
 
     ``out`` defaults to ``./<name>``; ``name`` to the model's file stem.  ``navgrid``
     overrides the [navgrid] defaults (used when rebuilding a bundled arena).
     ``warn`` also receives the non-fatal remarks collected in ``ImportResult.warnings``.
+    ``wall_height`` / ``wall_thickness`` shape a .dxf/.svg floor plan's walls.
     Everything is written into a temporary folder renamed into place at the end,
     so a failure leaves nothing behind.
     """
@@ -190,7 +193,11 @@ def import_arena(
         if warn is not None:
             warn(message)
 
-    scene = load_scene(model, up=up, scale=scale, warn=remark)
+    if wall_height is not None and not wall_height > height:
+        raise ArenaError(f"--wall-height ({wall_height:g}) must be above the cut --height ({height:g}), "
+                         f"or the walls would not be cut")
+    scene = load_scene(model, up=up, scale=scale, warn=remark, wall_height=wall_height,
+                       wall_thickness=wall_thickness)
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
     try:
@@ -228,7 +235,8 @@ def import_arena(
             "bounds": [[_r(bounds[0, 0]), _r(bounds[0, 1])], [_r(bounds[1, 0]), _r(bounds[1, 1])]],
             "floor_y": _r(ex.floor_y),
             "spawns": [[_r(x), _r(z), _r(h, 6)] for x, z, h in spawns],
-            "source": {"file": model.name, "sha256": sha256_file(model), "up": src_up, "scale": float(scale)},
+            "source": {"file": model.name, "sha256": sha256_file(model), "up": src_up, "scale": float(scale),
+                       **_plan_source(fmt, wall_height, wall_thickness)},
             "model": {"file": "model.glb"},
             "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
                       "count": len(ex.walls)},
@@ -238,6 +246,18 @@ def import_arena(
         write_toml(tmp / MANIFEST, doc)
     return ImportResult(target, name, ex.walls, spawns, ex.floor_y, len(mesh.faces), ex.thin_walls,
                         time.perf_counter() - t0, warnings)
+
+
+def _plan_source(fmt: str, wall_height: float | None, wall_thickness: float | None) -> dict[str, float]:
+    """[source] keys of a floor plan: the wall height and thickness it was built with."""
+    from .formats.models import PLAN_FORMATS
+
+    if fmt not in PLAN_FORMATS:
+        return {}
+    from .formats.floorplan import DEFAULT_WALL_HEIGHT, DEFAULT_WALL_THICKNESS
+
+    return {"wall_height": float(DEFAULT_WALL_HEIGHT if wall_height is None else wall_height),
+            "wall_thickness": float(DEFAULT_WALL_THICKNESS if wall_thickness is None else wall_thickness)}
 
 
 def _r(v: float, nd: int = 4) -> float:

@@ -35,14 +35,21 @@ def _face_count_guess(model: Path) -> int:
               help="Cut height above the floor, in metres: what crosses it is a wall.")
 @click.option("--tolerance", type=float, default=0.01, show_default=True,
               help="Shortest wall kept and snapping grid, in metres.")
+@click.option("--wall-height", type=float, default=None, metavar="H",
+              help="Floor plans (.dxf .svg): wall height in metres (default 3).")
+@click.option("--wall-thickness", type=float, default=None, metavar="T",
+              help="Floor plans (.dxf .svg): wall thickness in metres (default 0.5).")
 @force_option
 def import_arena(model: Path, out: Path | None, name: str | None, up: str | None, scale: float,
-                 height: float, tolerance: float, force: bool) -> None:
-    """Turn an arena MODEL (.3ds .obj .glb .stl .ply .off, BZFlag .bzw) into an arena bundle.
+                 height: float, tolerance: float, wall_height: float | None, wall_thickness: float | None,
+                 force: bool) -> None:
+    """Turn an arena MODEL (.3ds .obj .glb .stl .ply .off, BZFlag .bzw, floor plan
+    .dxf .svg) into an arena bundle.
 
     \b
     Writes arena.toml, the model, model.glb, walls.txt, preview.png:
       tanktool import-arena castle.3ds -o arenas/castle --height 1.2
+      tanktool import-arena plan.dxf --wall-height 3 --wall-thickness 0.4
     """
     from ..arena import import_arena as run
     from .main import echo
@@ -54,9 +61,10 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
     if _face_count_guess(model) > PROGRESS_FACES:
         with progress(length=len(STAGES), label=f"importing {model.name}") as bar:
             result = run(model, out, name, up, scale, height, tolerance, force, progress=lambda _s: bar.update(1),
-                         warn=warn)
+                         warn=warn, wall_height=wall_height, wall_thickness=wall_thickness)
     else:
-        result = run(model, out, name, up, scale, height, tolerance, force, warn=warn)
+        result = run(model, out, name, up, scale, height, tolerance, force, warn=warn,
+                     wall_height=wall_height, wall_thickness=wall_thickness)
     (x0, z0), (x1, z1) = result.walls.bounds
     thin = f" ({result.thin_walls} from thin walls)" if result.thin_walls else ""
     echo(f"arena {result.name!r}: {len(result.walls)} walls{thin} + 4 auxiliary, {len(result.spawns)} spawns")

@@ -20,7 +20,9 @@ from ..errors import FormatError
 MESH_EXTENSIONS = {".3ds", ".obj", ".glb", ".gltf", ".stl", ".ply", ".off"}
 #: files that are not meshes but are turned into one (a Z-up scene) before the usual
 #: pipeline: BZFlag worlds (formats/bzw.py) and 2D floor plans (formats/floorplan.py)
-BUILT_EXTENSIONS = {".bzw"}
+BUILT_EXTENSIONS = {".bzw", ".dxf", ".svg"}
+#: built formats that take --wall-height / --wall-thickness
+PLAN_FORMATS = ("dxf", "svg")
 
 #: rotation taking a Z-up frame to our Y-up frame: (x, y, z) -> (x, z, -y)
 Z_UP_TO_Y_UP = np.array(
@@ -79,17 +81,19 @@ def _check_binary_stl(path: Path) -> None:
 
 
 def default_up(fmt: str) -> str:
-    # .bzw worlds are Z-up, like .3ds (built scenes come out in their source's frame)
-    return "z" if fmt in ("3ds", "bzw") else "y"
+    # .bzw worlds are Z-up, like .3ds; floor plans are built Z-up (plan y stored as -y)
+    return "z" if fmt in ("3ds", "bzw", *PLAN_FORMATS) else "y"
 
 
 def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.0,
-               warn: Callable[[str], None] | None = None):
+               warn: Callable[[str], None] | None = None, wall_height: float | None = None,
+               wall_thickness: float | None = None):
     """Load ``path`` as a ``trimesh.Scene`` in the world frame (Y up, metres).
 
     ``warn`` receives the non-fatal remarks of built formats (a .bzw file's
-    unknown objects).  Raises FormatError for unreadable files, models without
-    triangles and non-finite vertices.
+    unknown objects); ``wall_height`` / ``wall_thickness`` shape the walls of a
+    .dxf/.svg floor plan (defaults in formats/floorplan.py).  Raises FormatError for
+    unreadable files, models without triangles and non-finite vertices.
     """
     import trimesh
 
@@ -97,6 +101,10 @@ def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.
 
     path = Path(path)
     fmt = detect_format(path)
+    if fmt in PLAN_FORMATS and up not in (None, "z"):
+        raise FormatError(f"{path}: --up does not apply to a floor plan (its x, y are the arena's x, z)")
+    if fmt not in PLAN_FORMATS and (wall_height is not None or wall_thickness is not None):
+        raise FormatError(f"{path}: --wall-height / --wall-thickness apply only to .dxf/.svg floor plans")
     if up is None:
         up = default_up(fmt)
     if up not in ("y", "z"):
@@ -110,6 +118,13 @@ def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.
             from . import bzw
 
             scene = bzw.load_scene(path, warn=warn)
+        elif fmt in PLAN_FORMATS:
+            from . import floorplan
+
+            scene = floorplan.load_scene(
+                path,
+                floorplan.DEFAULT_WALL_HEIGHT if wall_height is None else wall_height,
+                floorplan.DEFAULT_WALL_THICKNESS if wall_thickness is None else wall_thickness)
         else:
             if fmt == "stl":
                 _check_binary_stl(path)

@@ -1,0 +1,256 @@
+"""2D floor plans (``.dxf``, ``.svg``) as arena models.
+
+Every line, polyline (open or closed), arc, circle and curve of the drawing is the
+centre line of a wall ``thickness`` thick and ``height`` high: the lines are noded
+and merged where they meet end to end (so corners are mitred, not notched), buffered
+by half the thickness with flat ends, and the union is extruded.  A floor
+rectangle covers the walls' bounding box.  DXF text, points and hatches are not
+lines and are ignored.
+
+Coordinates: the drawing's (x, y) become the arena's (x, z), in drawing units (use
+``--scale`` for millimetres, pixels, ...), so ``walls.txt`` holds the drawing's own
+numbers.  The scene is returned Z-up (plan y stored as -y) and
+:func:`tanktool.formats.models.load_scene` turns it upright like any Z-up model.
+
+trimesh reads both formats into 2D paths: DXF with its own reader (ASCII DXF;
+LINE, LWPOLYLINE, POLYLINE, ARC, CIRCLE, SPLINE, ...), SVG through ``svg.path`` and
+``lxml``.  Before trimesh sees a file it is checked here so that a malformed one is
+refused with its line: DXF group codes and numbers, SVG's XML and the numbers of
+``line``/``rect``/``circle``/``polyline``/``polygon`` elements.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FormatError
+
+#: extensions handled here
+PLAN_EXTENSIONS = {".dxf", ".svg"}
+DEFAULT_WALL_HEIGHT = 3.0
+DEFAULT_WALL_THICKNESS = 0.5
+#: longest a mitred corner may stick out, in wall half-thicknesses (sharper corners are bevelled)
+MITRE_LIMIT = 4.0
+
+WALL_RGBA = (170, 165, 150, 255)
+FLOOR_RGBA = (110, 130, 100, 255)
+
+_NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+
+
+# ---------------------------------------------------------------- checks with line numbers
+
+def check_dxf(path: Path, data: bytes) -> None:
+    """Refuse a malformed ASCII DXF with the line of the first bad group.
+
+    A DXF file is pairs of lines: an integer group code, then its value.  Codes
+    10-59 and 140-147 carry numbers (coordinates, radii, angles)."""
+    if data.startswith(b"AutoCAD Binary DXF"):
+        raise FormatError(f"{path}: byte 0: binary DXF is not supported; save the drawing as ASCII DXF")
+    text = data.decode("utf-8", "replace")
+    lines = text.splitlines()
+    if not any(line.strip() for line in lines):
+        raise FormatError(f"{path}: empty file, expected an ASCII DXF drawing")
+    for i in range(0, len(lines), 2):
+        code_s = lines[i].strip()
+        try:
+            code = int(code_s)
+        except ValueError:
+            raise FormatError(f"{path}:{i + 1}: expected a DXF group code (an integer), got {code_s[:40]!r}") from None
+        if i + 1 >= len(lines):
+            raise FormatError(f"{path}:{i + 1}: group code {code} has no value line (file cut short?)")
+        value = lines[i + 1].strip()
+        if (10 <= code <= 59 or 140 <= code <= 147) and not _NUMBER.match(value):
+            raise FormatError(f"{path}:{i + 2}: group code {code} expects a number, got {value[:40]!r}")
+        if code == 0 and value == "EOF":
+            return
+
+
+_SVG_NUMBERS = {
+    "line": ("x1", "y1", "x2", "y2"),
+    "rect": ("x", "y", "width", "height"),
+    "circle": ("cx", "cy", "r"),
+    "ellipse": ("cx", "cy", "rx", "ry"),
+}
+_SVG_LENGTH = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?(px|mm|cm|in|pt|pc|%)?$")
+
+
+def check_svg(path: Path, data: bytes) -> None:
+    """Refuse malformed SVG (XML errors, non-numeric coordinates) with the line."""
+    from lxml import etree
+
+    try:
+        root = etree.fromstring(data, parser=etree.XMLParser(resolve_entities=False, no_network=True))
+    except etree.XMLSyntaxError as e:
+        line = e.position[0] if e.position else getattr(e, "lineno", 0)
+        raise FormatError(f"{path}:{line}: not well-formed SVG/XML: {e.msg}") from None
+    if not isinstance(root.tag, str) or etree.QName(root).localname != "svg":
+        raise FormatError(f"{path}:{root.sourceline}: expected an <svg> document")
+    for el in root.iter():
+        if not isinstance(el.tag, str):
+            continue
+        tag = etree.QName(el).localname
+        for attr in _SVG_NUMBERS.get(tag, ()):
+            v = el.get(attr)
+            if v is not None and not _SVG_LENGTH.match(v.strip()):
+                raise FormatError(f"{path}:{el.sourceline}: <{tag}> {attr} expects a number, got {v[:40]!r}")
+        if tag in ("polyline", "polygon"):
+            pts = el.get("points", "")
+            nums = [p for p in re.split(r"[\s,]+", pts.strip()) if p]
+            bad = next((p for p in nums if not _NUMBER.match(p)), None)
+            if bad is not None:
+                raise FormatError(f"{path}:{el.sourceline}: <{tag}> points expects numbers, got {bad[:40]!r}")
+            if len(nums) % 2:
+                raise FormatError(f"{path}:{el.sourceline}: <{tag}> points has an odd count of numbers ({len(nums)})")
+
+
+# ---------------------------------------------------------------- reading
+
+def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
+    """The drawing's lines as a list of (k, 2) polylines in its own (x, y), k >= 2
+    (closed ones end where they start).  Raises FormatError for unreadable files and
+    drawings without lines."""
+    import trimesh
+
+    path = Path(path)
+    fmt = path.suffix.lower()[1:]
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise FormatError(f"{path}: no such file") from None
+    except OSError as e:
+        raise FormatError(f"{path}: cannot read: {e.strerror}") from None
+    if fmt == "dxf":
+        check_dxf(path, data)
+    elif fmt == "svg":
+        check_svg(path, data)
+    else:
+        raise FormatError(f"{path}: not a floor plan (expected .dxf or .svg)")
+    try:
+        drawing = trimesh.load(str(path), file_type=fmt)
+    except FormatError:
+        raise
+    except ImportError as e:
+        raise FormatError(f"{path}: reading .{fmt} needs a missing package ({e.name}); "
+                          f"reinstall tanktool with its dependencies") from None
+    except Exception as e:  # trimesh raises many kinds for bad drawings
+        raise FormatError(f"{path}: cannot read as .{fmt}: {e}") from None
+    lines: list[np.ndarray] = []
+    for entity in getattr(drawing, "entities", ()):
+        if type(entity).__name__ == "Text":
+            continue
+        try:
+            pts = np.asarray(entity.discrete(drawing.vertices), dtype=np.float64)
+        except Exception:  # an entity trimesh cannot sample (degenerate arc, ...)
+            continue
+        if pts.ndim != 2 or pts.shape[0] < 2 or pts.shape[1] < 2:
+            continue
+        pts = pts[:, :2]
+        if not np.isfinite(pts).all():
+            raise FormatError(f"{path}: a {type(entity).__name__.lower()} has non-finite coordinates")
+        if np.ptp(pts, axis=0).max() > 0:
+            lines.append(pts)
+    if not lines:
+        raise FormatError(f"{path}: the drawing has no lines or polylines to make walls of")
+    return lines
+
+
+# ---------------------------------------------------------------- geometry
+
+def plan_walls(lines: list[np.ndarray], thickness: float):
+    """The walls' footprint: a shapely (Multi)Polygon, the union of every line
+    buffered by ``thickness / 2`` with flat ends and mitred corners."""
+    import shapely
+
+    if not (math.isfinite(thickness) and thickness > 0):
+        raise FormatError(f"--wall-thickness must be a positive number, got {thickness}")
+    geoms = [shapely.LineString(ln) for ln in lines]
+    # noding splits lines where they cross; merging joins pieces that meet end to end,
+    # so separate LINE entities around a corner are mitred like one polyline
+    merged = shapely.line_merge(shapely.union_all(geoms))
+    # trimesh samples a circle into ~250 points; a sagitta of 1/20 of the thickness is
+    # invisible in the wall and keeps the wall list short
+    merged = shapely.simplify(merged, thickness / 20.0, preserve_topology=True)
+    walls = shapely.buffer(merged, thickness / 2.0, cap_style="flat", join_style="mitre", mitre_limit=MITRE_LIMIT)
+    walls = shapely.make_valid(walls)
+    polys = [p for p in shapely.get_parts(walls) if p.geom_type == "Polygon" and p.area > 0]
+    if not polys:
+        raise FormatError("the drawing's lines make no wall area")
+    return shapely.multipolygons(polys) if len(polys) > 1 else polys[0]
+
+
+def extrude(footprint, height: float) -> tuple[np.ndarray, np.ndarray]:
+    """(n, 3) vertices and (m, 3) outward faces of ``footprint`` (a shapely polygon or
+    multipolygon in (x, y)) extruded from z = 0 to ``height``: a closed solid whose
+    side quads follow every ring (holes included)."""
+    import shapely
+
+    verts: list[np.ndarray] = []
+    faces: list[np.ndarray] = []
+    n = 0
+    for poly in shapely.get_parts(footprint):
+        poly = shapely.orient_polygons(poly) if hasattr(shapely, "orient_polygons") else \
+            shapely.geometry.polygon.orient(poly, 1.0)
+        tris = [t for t in shapely.get_parts(shapely.constrained_delaunay_triangles(poly)) if t.area > 0]
+        for tri in tris:
+            c = np.asarray(tri.exterior.coords)[:3]
+            if (c[1, 0] - c[0, 0]) * (c[2, 1] - c[0, 1]) - (c[1, 1] - c[0, 1]) * (c[2, 0] - c[0, 0]) < 0:
+                c = c[::-1]                       # counter-clockwise from above: the top faces up
+            top = np.column_stack([c, np.full(3, height)])
+            bottom = np.column_stack([c[::-1], np.zeros(3)])
+            verts += [top, bottom]
+            faces += [np.array([[n, n + 1, n + 2]]), np.array([[n + 3, n + 4, n + 5]])]
+            n += 6
+        # exterior counter-clockwise, holes clockwise: the solid is on the left of each
+        # ring, so (p0, q0, q1) with the ring's direction faces outwards
+        for ring in (poly.exterior, *poly.interiors):
+            c = np.asarray(ring.coords)[:, :2]
+            p, q = c[:-1], c[1:]
+            k = len(p)
+            quad = np.concatenate([
+                np.column_stack([p, np.zeros(k)]), np.column_stack([q, np.zeros(k)]),
+                np.column_stack([q, np.full(k, height)]), np.column_stack([p, np.full(k, height)])])
+            idx = n + np.arange(k)
+            verts.append(quad)
+            faces.append(np.column_stack([idx, idx + k, idx + 2 * k]))
+            faces.append(np.column_stack([idx, idx + 2 * k, idx + 3 * k]))
+            n += 4 * k
+    if not verts:
+        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
+    return np.concatenate(verts), np.concatenate(faces).astype(np.int64)
+
+
+def load_scene(path: str | os.PathLike, wall_height: float = DEFAULT_WALL_HEIGHT,
+               wall_thickness: float = DEFAULT_WALL_THICKNESS):
+    """Read a .dxf/.svg floor plan as a Z-up ``trimesh.Scene``: ``walls`` (the
+    extruded lines) and ``floor`` (their bounding rectangle at z = 0)."""
+    import trimesh
+
+    path = Path(path)
+    if not (math.isfinite(wall_height) and wall_height > 0):
+        raise FormatError(f"--wall-height must be a positive number of metres, got {wall_height}")
+    lines = read_plan(path)
+    try:
+        footprint = plan_walls(lines, wall_thickness)
+    except FormatError as e:
+        raise FormatError(f"{path}: {e}") from None
+    # plan (x, y) must end up as world (x, z); the Z-up conversion maps y to -z
+    v, f = extrude(footprint, wall_height)
+    v[:, 1] *= -1.0
+    f = f[:, ::-1].copy()                 # the mirror flips the winding back outwards
+    x0, y0, x1, y1 = footprint.bounds
+    floor_v = np.array([[x0, -y0, 0.0], [x1, -y0, 0.0], [x1, -y1, 0.0], [x0, -y1, 0.0]])
+    floor_f = np.array([[0, 1, 2], [0, 2, 3]], dtype=np.int64)
+    if np.cross(floor_v[1] - floor_v[0], floor_v[2] - floor_v[0])[2] < 0:
+        floor_f = floor_f[:, ::-1].copy()  # facing up (+z)
+    scene = trimesh.Scene()
+    for name, (vv, ff, rgba) in (("floor", (floor_v, floor_f, FLOOR_RGBA)), ("walls", (v, f, WALL_RGBA))):
+        mesh = trimesh.Trimesh(vertices=vv, faces=ff, process=False)
+        mesh.visual.face_colors = np.tile(np.array(rgba, dtype=np.uint8), (len(ff), 1))
+        scene.add_geometry(mesh, geom_name=name, node_name=name)
+    return scene
