@@ -223,6 +223,7 @@ class Voice:
     min_dist: float = 1.0
     max_dist: float = 100.0
     pitch: float = 1.0
+    gain: float = 1.0
     cursor: int = 0            # next sample of a looping voice
     started: bool = False
     channel: object = None
@@ -304,14 +305,21 @@ class Sound:
         if v is not None:
             v.pitch = min(max(float(pitch), 0.25), 4.0)
 
+    def set_gain(self, voice: int, gain: float) -> None:
+        """Volume factor on top of the distance rolloff (0 mutes a voice without stopping it)."""
+        v = self.voices.get(voice)
+        if v is not None:
+            v.gain = min(max(float(gain), 0.0), 4.0)
+
     def set_listener(self, position, facing, velocity=(0.0, 0.0, 0.0)) -> None:
         self.listener_pos, self.listener_facing, self.listener_vel = _vec(position), _vec(facing), _vec(velocity)
 
     def render(self, voice: Voice, samples: np.ndarray) -> np.ndarray:
         """A voice's samples as heard now: (n, 2) float."""
-        return spatialize(samples, self.rate, voice.position, voice.velocity, self.listener_pos,
-                          self.listener_facing, self.listener_vel, min_dist=voice.min_dist,
-                          max_dist=voice.max_dist, pitch=voice.pitch)
+        out = spatialize(samples, self.rate, voice.position, voice.velocity, self.listener_pos,
+                         self.listener_facing, self.listener_vel, min_dist=voice.min_dist,
+                         max_dist=voice.max_dist, pitch=voice.pitch)
+        return out * voice.gain if voice.gain != 1.0 else out
 
     def update(self) -> None:
         """Apply every change since the last call: start new voices, feed looping ones

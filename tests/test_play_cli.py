@@ -45,7 +45,7 @@ def test_play_without_headless_runs_a_match_and_draws_it(tmp_path, monkeypatch):
     arena = _arena(tmp_path, maze=True)
     r = CliRunner().invoke(cli, ["play", "--arena", str(arena), "--seconds", "3"])
     assert r.exit_code == 0, r.output
-    assert "window is not built yet" in r.output
+    assert "no display to open the game window" in r.output
     assert "picture: match.png" in r.output
     png = (tmp_path / "match.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000

@@ -1,9 +1,11 @@
 """``tanktool play``: a match.
 
 ``--headless`` runs scripted bots without window or sound as fast as the machine allows
-and can write a JSON report.  Without it, the windowed game would start; it is not built
-yet, so the command says so and does the best thing that exists: a short headless match
-on the default arena, a scoreboard, and a top-view picture of the final state.
+and can write a JSON report; with ``--frames``/``--screenshot`` it renders one picture
+of the 3D or top view instead (``tanktool.game.headless``).  Without ``--headless`` the
+game window opens (``tanktool.game.app``); when there is no display to open it on, the
+command says so and does the best thing that exists: a short headless match on the
+default arena, a scoreboard, and a top-view picture of the final state.
 """
 
 from __future__ import annotations
@@ -27,6 +29,16 @@ def _arena_ref(arena: str | None) -> str:
     return ref
 
 
+def _size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise click.BadParameter(f"expected WIDTHxHEIGHT like 1280x720, got {text!r}", param_hint="--size") from None
+    if not (64 <= w <= 8192 and 64 <= h <= 8192):
+        raise click.BadParameter(f"{w}x{h}: each side must be 64..8192 pixels", param_hint="--size")
+    return w, h
+
+
 @click.command("play")
 @click.option("--headless", is_flag=True, help="No window or sound: run scripted bots as fast as possible.")
 @click.option("--arena", "arena", default=None, metavar="A",
@@ -43,9 +55,18 @@ def _arena_ref(arena: str | None) -> str:
               help="Write the match report (JSON) here.")
 @click.option("--picture", "picture", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Save a top view of the final state (PNG).  Default without --headless: match.png.")
+@click.option("--view", type=click.Choice(["3d", "top"]), default="3d", show_default=True,
+              help="3D view (OpenGL) or the 2D top-down view: the window's first view, or what --screenshot renders.")
+@click.option("--frames", type=click.IntRange(0, 1_000_000), default=None,
+              help="With --headless: render after this many frames (1/60 s each) instead of running a match.")
+@click.option("--screenshot", "screenshot", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="With --headless: write the view after --frames frames (default 120) to this PNG.")
+@click.option("--size", default="1280x720", show_default=True, metavar="WxH", help="Window or screenshot size.")
+@click.option("--fullscreen", is_flag=True, help="Open the window full screen.")
 @network_options
 def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | None, seconds: float | None,
-         seed: int, integrator: str, report_path: Path | None, picture: Path | None,
+         seed: int, integrator: str, report_path: Path | None, picture: Path | None, view: str,
+         frames: int | None, screenshot: Path | None, size: str, fullscreen: bool,
          host: str | None = None, join: str | None = None, player_name: str | None = None,
          password: str | None = None) -> None:
     """Play a match: bots on an arena.
@@ -54,6 +75,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
     Examples:
       tanktool play --headless --arena box --bots 8 --seconds 60 --seed 1 --report match.json
       tanktool play --headless --arena arenas/maze --vehicle heavy --seconds 600
+      tanktool play --headless --frames 120 --screenshot shot.png --view 3d
+      tanktool play --arena maze --view top
     """
     if host is not None or join is not None:
         from .net_play import run_network
@@ -62,9 +85,26 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         return
     from ..sim.match import default_vehicle, format_report, load_match_arena, load_tank_spec, run_match, scoreboard
 
+    width, height = _size(size)
+    if headless and (frames is not None or screenshot is not None):
+        from ..game.headless import screenshot as take_screenshot
+
+        if screenshot is None:
+            raise click.UsageError("--frames needs --screenshot FILE.png")
+        shot = take_screenshot(screenshot, view=view, frames=120 if frames is None else frames, arena=arena,
+                               vehicle=vehicle, bots=8 if bots is None else bots, seed=seed, size=(width, height))
+        echo(f"{shot['view']} view after {shot['frames']} frames: {shot['path']}")
+        return
     if not headless:
-        echo("The game window is not built yet; running a short headless match instead "
-             "(tanktool play --headless for options).")
+        from ..game.app import NoDisplay, run_window
+
+        try:
+            run_window(arena=arena, vehicle=vehicle, bots=3 if bots is None else max(bots - 1, 0), seed=seed,
+                       view=view, size=(width, height), fullscreen=fullscreen)
+            return
+        except NoDisplay as e:
+            echo(f"no display to open the game window ({e}); running a short headless match instead "
+                 "(tanktool play --headless for options).")
         bots = 4 if bots is None else bots
         seconds = 20.0 if seconds is None else seconds
         picture = picture or Path("match.png")

@@ -1,0 +1,464 @@
+"""The game window: start menu, bindings remap screen, the match with pause, restart
+and quit, in a fixed-timestep loop.
+
+The loop follows "Fix Your Timestep": real time accumulates, the simulation takes
+whole steps of ``World.dt`` out of it (at most a quarter second per frame, so a stall
+does not snowball), and the frame is drawn ``alpha = leftover / dt`` of the way
+between the last two steps.
+
+The window is an OpenGL one when moderngl can make a context on it: the 3D view
+draws straight into it, and the top view, menus and remap screen are pygame surfaces
+shown as a full-window texture.  When OpenGL is not available the window is a plain
+pygame one and only the top view is offered.  With no display at all,
+:func:`run_window` raises :class:`NoDisplay` and the CLI falls back to a headless match.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pygame
+
+from ..errors import TanktoolError
+from .input import ACTIONS, Bindings, InputState, describe, input_name, load_bindings, save_bindings
+from .session import DIFFICULTY, GameSession
+
+RESOLUTIONS = ["1280x720", "1600x900", "1920x1080", "1024x576", "800x600"]
+MAX_FRAME = 0.25
+BG = (18, 22, 20)
+HILITE = (250, 210, 70)
+
+
+class NoDisplay(TanktoolError):
+    """There is no screen to open the window on."""
+
+
+def display_problem() -> str | None:
+    """Why no window can be opened here, or None when one can."""
+    driver = os.environ.get("SDL_VIDEODRIVER", "")
+    if driver in ("dummy", "offscreen"):
+        return f"SDL_VIDEODRIVER={driver}"
+    if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        return "neither DISPLAY nor WAYLAND_DISPLAY is set"
+    try:
+        pygame.display.init()
+    except pygame.error as e:
+        return f"SDL cannot open a display: {e}"
+    return None
+
+
+def bundled(kind: str) -> list[str]:
+    """Names of the bundled arenas or vehicles."""
+    from ..sim.match import REPO
+
+    base = REPO / kind
+    manifest = "arena.toml" if kind == "arenas" else "vehicle.toml"
+    return sorted(d.name for d in base.iterdir() if (d / manifest).is_file()) if base.is_dir() else []
+
+
+@dataclass
+class Choice:
+    label: str
+    options: list[Any]
+    index: int = 0
+
+    @property
+    def value(self) -> Any:
+        return self.options[self.index]
+
+    def shift(self, d: int) -> None:
+        self.index = (self.index + d) % len(self.options)
+
+    def set(self, value: Any) -> None:
+        if value in self.options:
+            self.index = self.options.index(value)
+
+
+@dataclass
+class Menu:
+    """The start menu's choices (the 2002 game let the player pick vehicle and arena)."""
+
+    arena: Choice
+    vehicle: Choice
+    bots: Choice = field(default_factory=lambda: Choice("opponents", list(range(0, 8)), 3))
+    difficulty: Choice = field(default_factory=lambda: Choice("difficulty", list(DIFFICULTY), 1))
+    view: Choice = field(default_factory=lambda: Choice("view", ["3d", "top"]))
+    resolution: Choice = field(default_factory=lambda: Choice("resolution", list(RESOLUTIONS)))
+    fullscreen: Choice = field(default_factory=lambda: Choice("fullscreen", [False, True]))
+    cursor: int = 0
+
+    ITEMS = ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen", "bindings", "start", "quit")
+
+    def item(self) -> str:
+        return self.ITEMS[self.cursor]
+
+
+class Presenter:
+    """Shows a finished pygame surface in the window (plain or OpenGL)."""
+
+    def __init__(self, size: tuple[int, int], fullscreen: bool, want_gl: bool) -> None:
+        self.size = size
+        self.ctx = None
+        flags = pygame.FULLSCREEN if fullscreen else 0
+        if want_gl:
+            try:
+                import moderngl
+
+                pygame.display.gl_set_attribute(pygame.GL_CONTEXT_MAJOR_VERSION, 3)
+                pygame.display.gl_set_attribute(pygame.GL_CONTEXT_MINOR_VERSION, 3)
+                pygame.display.gl_set_attribute(pygame.GL_CONTEXT_PROFILE_MASK, pygame.GL_CONTEXT_PROFILE_CORE)
+                self.window = pygame.display.set_mode(size, flags | pygame.OPENGL | pygame.DOUBLEBUF)
+                self.ctx = moderngl.create_context(require=330)
+            except Exception:
+                self.ctx = None         # no OpenGL 3.3 here: a plain window, top view only
+        if self.ctx is None:
+            self.window = pygame.display.set_mode(size, flags)
+        else:
+            from .render3d import HUD_FRAGMENT, HUD_VERTEX
+            import numpy as np
+
+            prog = self.ctx.program(vertex_shader=HUD_VERTEX, fragment_shader=HUD_FRAGMENT)
+            quad = np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype="f4")
+            self._vao = self.ctx.vertex_array(prog, [(self.ctx.buffer(quad.tobytes()), "2f", "in_pos")])
+            self._tex = self.ctx.texture(size, 4)
+        self.canvas = pygame.Surface(size)
+        pygame.display.set_caption("tanktool")
+
+    @property
+    def gl(self) -> bool:
+        return self.ctx is not None
+
+    def show(self, surface: "pygame.Surface") -> None:
+        if self.ctx is None:
+            self.window.blit(surface, (0, 0))
+        else:
+            import moderngl
+
+            self.ctx.screen.use()
+            self.ctx.viewport = (0, 0, *self.size)
+            self.ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+            self._tex.write(pygame.image.tobytes(surface, "RGBA"))
+            self._tex.use(0)
+            self._vao.render(moderngl.TRIANGLE_STRIP)
+        pygame.display.flip()
+
+
+class App:
+    """The whole game as a state machine: ``menu``, ``remap``, ``playing``, ``paused``,
+    ``quit``.  :meth:`handle` takes one pygame event, :meth:`frame` advances real time
+    and draws; tests drive both directly."""
+
+    def __init__(self, presenter: Presenter | None = None, arena: str | None = None, vehicle: str | None = None,
+                 bots: int = 3, seed: int = 0, view: str = "3d", size: tuple[int, int] = (1280, 720),
+                 fullscreen: bool = False, bindings: Bindings | None = None, sound: bool = True,
+                 bindings_file: Path | None = None) -> None:
+        arenas, vehicles = bundled("arenas"), bundled("vehicles")
+        self.menu = Menu(Choice("arena", arenas + ([arena] if arena and arena not in arenas else [])),
+                         Choice("vehicle", vehicles + ([vehicle] if vehicle and vehicle not in vehicles else [])
+                                or [None]))
+        if arena:
+            self.menu.arena.set(arena)
+        if vehicle:
+            self.menu.vehicle.set(vehicle)
+        self.menu.bots.set(min(max(bots, 0), 7))
+        self.menu.view.set(view)
+        res = f"{size[0]}x{size[1]}"
+        if res not in self.menu.resolution.options:
+            self.menu.resolution.options.insert(0, res)
+        self.menu.resolution.set(res)
+        self.menu.fullscreen.set(fullscreen)
+        self.seed = seed
+        self.bindings_file = bindings_file
+        self.input = InputState(bindings or load_bindings(bindings_file))
+        self.presenter = presenter
+        self.state = "menu"
+        self.remap_cursor = 0
+        self.remap_waiting = False
+        self.notice = ""
+        self.session: GameSession | None = None
+        self.view = view
+        self.top = None
+        self.r3d = None
+        self.audio = None
+        self.want_sound = sound
+        self.acc = 0.0
+        self.fps = 0.0
+        self._fps_frames, self._fps_t = 0, time.perf_counter()
+
+    # ------------------------------------------------------------------ lifecycle
+    def size(self) -> tuple[int, int]:
+        w, h = (int(v) for v in str(self.menu.resolution.value).split("x"))
+        return w, h
+
+    def open_window(self) -> None:
+        self.presenter = Presenter(self.size(), bool(self.menu.fullscreen.value), want_gl=True)
+
+    def start(self) -> None:
+        """Start a match with the menu's choices (re-opening the window if its size changed)."""
+        m = self.menu
+        if self.presenter is None or self.presenter.size != self.size():
+            self.open_window()
+        self.session = GameSession(m.arena.value, m.vehicle.value, bots=int(m.bots.value), seed=self.seed,
+                                   difficulty=str(m.difficulty.value), player=True)
+        self._make_views(str(m.view.value))
+        if self.audio is not None:
+            self.audio.close()
+        if self.want_sound:
+            from .sounds import GameAudio
+
+            self.audio = GameAudio(self.session)
+        self.input.release_all()
+        self.acc = 0.0
+        self.state = "playing"
+
+    def _make_views(self, view: str) -> None:
+        from .render_top import TopView
+
+        if self.r3d is not None:
+            self.r3d = None          # its GL objects go with the context it was made on
+        if view == "3d" and not self.presenter.gl:
+            self.notice = "no OpenGL 3.3 on this display: top view only"
+            view = "top"
+        self.view = view
+        self.top = TopView(self.session, self.presenter.size)
+        if view == "3d":
+            from .render3d import Renderer3D
+
+            self.r3d = Renderer3D(self.session, self.presenter.size, ctx=self.presenter.ctx)
+
+    def stop(self) -> None:
+        if self.audio is not None:
+            self.audio.close()
+            self.audio = None
+
+    # ------------------------------------------------------------------ events
+    def handle(self, event: Any) -> None:
+        if event.type == pygame.QUIT:
+            self.state = "quit"
+            return
+        if event.type == getattr(pygame, "WINDOWFOCUSLOST", -1):
+            self.input.release_all()
+        if self.state == "remap":
+            self._handle_remap(event)
+            return
+        actions = self.input.handle(event)
+        if self.state == "menu":
+            self._handle_menu(event)
+        elif self.state == "playing":
+            for a in actions:
+                if a == "pause":
+                    self.state = "paused"
+                elif a == "quit":
+                    self.state = "quit"
+                elif a == "camera" and self.r3d is not None:
+                    self.notice = f"camera: {self.r3d.toggle_camera()}"
+                elif a == "view":
+                    self._make_views("top" if self.view == "3d" else "3d")
+                elif a.startswith("overlay_") and self.top is not None:
+                    self.top.toggle(a[len("overlay_"):])
+                    if self.view != "top":
+                        self.notice = "overlays show in the top view (V)"
+        elif self.state == "paused":
+            if event.type == pygame.KEYDOWN:
+                if event.key in (pygame.K_p, pygame.K_ESCAPE, pygame.K_RETURN) or "pause" in actions:
+                    self.state = "playing"
+                    self.input.release_all()
+                elif event.key == pygame.K_r:
+                    self.session.restart()
+                    self._make_views(self.view)
+                    if self.audio is not None:
+                        self.audio.close()
+                        from .sounds import GameAudio
+
+                        self.audio = GameAudio(self.session)
+                    self.state = "playing"
+                elif event.key == pygame.K_m:
+                    self.stop()
+                    self.state = "menu"
+                elif event.key in (pygame.K_q, pygame.K_F10):
+                    self.state = "quit"
+
+    def _handle_menu(self, event: Any) -> None:
+        m = self.menu
+        step = 0
+        if event.type == pygame.KEYDOWN:
+            step = {pygame.K_LEFT: -1, pygame.K_RIGHT: 1, pygame.K_a: -1, pygame.K_d: 1}.get(event.key, 0)
+            if event.key in (pygame.K_UP, pygame.K_w):
+                m.cursor = (m.cursor - 1) % len(m.ITEMS)
+            elif event.key in (pygame.K_DOWN, pygame.K_s):
+                m.cursor = (m.cursor + 1) % len(m.ITEMS)
+            elif event.key in (pygame.K_RETURN, pygame.K_SPACE, pygame.K_KP_ENTER):
+                self._activate()
+            elif event.key == pygame.K_ESCAPE:
+                self.state = "quit"
+        elif event.type == pygame.JOYHATMOTION:
+            hx, hy = event.value
+            m.cursor = (m.cursor - hy) % len(m.ITEMS)
+            step = hx
+        elif event.type == pygame.JOYBUTTONDOWN and event.button == 0:
+            self._activate()
+        if step and m.item() in ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen"):
+            getattr(m, m.item()).shift(step)
+
+    def _activate(self) -> None:
+        item = self.menu.item()
+        if item == "start":
+            try:
+                self.start()
+            except TanktoolError as e:
+                self.notice = str(e)       # a broken bundle: say so, stay in the menu
+        elif item == "bindings":
+            self.state = "remap"
+            self.remap_cursor = 0
+            self.remap_waiting = False
+        elif item == "quit":
+            self.state = "quit"
+
+    def _handle_remap(self, event: Any) -> None:
+        if self.remap_waiting:
+            if event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE:
+                self.remap_waiting = False          # cancelled; Escape itself stays unbindable here
+                return
+            name = input_name(event)
+            if name is None:
+                return
+            action = ACTIONS[self.remap_cursor]
+            self.input.bindings.remap(action, name)
+            path = save_bindings(self.input.bindings, self.bindings_file)
+            self.notice = f"{action.upper().replace('_', ' ')} = {describe([name])}  (saved to {path})"
+            self.remap_waiting = False
+            return
+        if event.type == pygame.KEYDOWN:
+            if event.key in (pygame.K_UP, pygame.K_w):
+                self.remap_cursor = (self.remap_cursor - 1) % len(ACTIONS)
+            elif event.key in (pygame.K_DOWN, pygame.K_s):
+                self.remap_cursor = (self.remap_cursor + 1) % len(ACTIONS)
+            elif event.key in (pygame.K_RETURN, pygame.K_SPACE, pygame.K_KP_ENTER):
+                self.remap_waiting = True
+            elif event.key == pygame.K_ESCAPE:
+                self.state = "menu"
+        elif event.type == pygame.JOYBUTTONDOWN and event.button == 0:
+            self.remap_waiting = True
+
+    # ------------------------------------------------------------------ time and drawing
+    def advance(self, real_dt: float) -> int:
+        """Add real time and take the fixed steps it pays for; returns how many."""
+        if self.state != "playing" or self.session is None:
+            return 0
+        self.acc += min(max(real_dt, 0.0), MAX_FRAME)
+        dt = self.session.dt
+        steps = 0
+        while self.acc >= dt:
+            events = self.session.step(self.input.command())
+            if self.audio is not None:
+                self.audio.on_events(events)
+            self.acc -= dt
+            steps += 1
+        return steps
+
+    @property
+    def alpha(self) -> float:
+        return self.acc / self.session.dt if self.session is not None else 1.0
+
+    def frame(self, real_dt: float) -> None:
+        self.advance(real_dt)
+        if self.audio is not None and self.state == "playing":
+            self.audio.update(self.alpha)
+        self._fps_frames += 1
+        now = time.perf_counter()
+        if now - self._fps_t >= 0.5:
+            self.fps = self._fps_frames / (now - self._fps_t)
+            self._fps_frames, self._fps_t = 0, now
+        if self.presenter is not None:
+            self.draw()
+
+    def draw(self) -> None:
+        canvas = self.presenter.canvas
+        if self.state in ("menu", "remap"):
+            self._draw_menu(canvas) if self.state == "menu" else self._draw_remap(canvas)
+            self.presenter.show(canvas)
+            return
+        if self.session is None:
+            return
+        msg = "PAUSED   P resume  R restart  M menu  Q quit" if self.state == "paused" else (self.notice or None)
+        if self.view == "3d" and self.r3d is not None:
+            self.r3d.render(self.alpha, self.fps, msg)
+            pygame.display.flip()
+        else:
+            self.top.draw(canvas, self.alpha, self.fps, msg)
+            self.presenter.show(canvas)
+
+    def _draw_menu(self, surf: "pygame.Surface") -> None:
+        from .hud import text
+
+        surf.fill(BG)
+        w, h = surf.get_size()
+        text(surf, "tanktool", (w // 2, 40), 72, anchor="midtop")
+        m = self.menu
+        y = 140
+        for i, item in enumerate(m.ITEMS):
+            colour = HILITE if i == m.cursor else (220, 220, 220)
+            if item in ("bindings", "start", "quit"):
+                label = {"bindings": "key and joystick bindings...", "start": "START", "quit": "quit"}[item]
+            else:
+                c = getattr(m, item)
+                v = c.value
+                shown = {True: "on", False: "off", None: "built-in box tank"}.get(v, v) if not isinstance(v, int) \
+                    or isinstance(v, bool) else v
+                label = f"{c.label:<12}  <  {shown}  >"
+            text(surf, ("> " if i == m.cursor else "  ") + label, (w // 2 - 200, y), 34, colour)
+            y += 42
+        text(surf, "up/down choose, left/right change, Enter select, Esc quit", (w // 2, h - 60), 24,
+             (170, 170, 170), anchor="midtop")
+        if self.notice:
+            text(surf, self.notice, (w // 2, h - 30), 22, (240, 160, 120), anchor="midtop")
+
+    def _draw_remap(self, surf: "pygame.Surface") -> None:
+        from .hud import text
+
+        surf.fill(BG)
+        w, h = surf.get_size()
+        text(surf, "bindings", (w // 2, 30), 56, anchor="midtop")
+        y = 100
+        for i, action in enumerate(ACTIONS):
+            colour = HILITE if i == self.remap_cursor else (220, 220, 220)
+            text(surf, f"{action.replace('_', ' '):<18} {describe(self.input.bindings.inputs(action))}",
+                 (w // 2 - 260, y), 28, colour)
+            y += 30
+        if self.remap_waiting:
+            text(surf, f"press the button for {ACTIONS[self.remap_cursor].upper().replace('_', ' ')}",
+                 (w // 2, h - 100), 40, HILITE, anchor="midtop")
+        else:
+            text(surf, "Enter: remap   Esc: back", (w // 2, h - 100), 26, (170, 170, 170), anchor="midtop")
+        if self.notice:
+            text(surf, self.notice, (w // 2, h - 50), 22, (170, 220, 170), anchor="midtop")
+
+
+def run_window(arena: str | None = None, vehicle: str | None = None, bots: int = 3, seed: int = 0,
+               view: str = "3d", size: tuple[int, int] = (1280, 720), fullscreen: bool = False) -> None:
+    """Open the window and play until the player quits.  Raises NoDisplay when there is
+    no screen."""
+    problem = display_problem()
+    if problem is not None:
+        raise NoDisplay(problem)
+    pygame.init()
+    app = App(None, arena, vehicle, bots, seed, view, size, fullscreen)
+    app.open_window()
+    clock = pygame.time.Clock()
+    last = time.perf_counter()
+    try:
+        while app.state != "quit":
+            for event in pygame.event.get():
+                app.handle(event)
+            now = time.perf_counter()
+            app.frame(now - last)
+            last = now
+            clock.tick(240)         # yield the CPU between frames; the accumulator keeps time
+    finally:
+        app.stop()
+        pygame.quit()

@@ -1,0 +1,170 @@
+"""A live game: one world, the player's tank, computer drivers, and what the front
+ends need beyond the simulation (poses between steps, short-lived visual effects).
+
+The simulation runs at its fixed step; :meth:`GameSession.step` keeps the previous
+poses so renderers can draw at any fraction ``alpha`` between two steps (the
+"interpolate the last two states" half of a fixed-timestep loop).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from ..sim.commands import IDLE, Command
+from ..sim.world import Event, World
+
+#: (think_hz, aim spread in degrees, sight in m) of the scripted bots per difficulty
+DIFFICULTY = {"easy": (4.0, 8.0, 60.0), "normal": (10.0, 3.0, 120.0), "hard": (20.0, 1.0, 160.0)}
+#: seconds each kind of visual effect lasts
+EFFECT_LIFE = {"flash": 0.12, "impact": 0.35, "explosion": 1.2}
+#: a distinct colour per tank (RGB 0..255), the player's first
+TANK_COLOURS = [(230, 200, 40), (210, 60, 50), (60, 120, 220), (60, 180, 90), (200, 90, 200),
+                (240, 140, 40), (60, 200, 200), (150, 150, 150), (120, 80, 40), (250, 250, 250)]
+
+
+def tank_colour(i: int) -> tuple[int, int, int]:
+    return TANK_COLOURS[i % len(TANK_COLOURS)]
+
+
+@dataclass
+class Effect:
+    kind: str            # "flash", "impact", "explosion"
+    x: float
+    y: float
+    z: float
+    t0: float
+
+    def age(self, t: float) -> float:
+        """0 when it starts, 1 when it is over."""
+        return (t - self.t0) / EFFECT_LIFE[self.kind]
+
+
+Driver = Callable[[World, Any], Command]
+
+
+class GameSession:
+    """A match being played.
+
+    Parameters
+    ----------
+    arena, vehicle : bundle folders or bundled names (as ``tanktool play --arena``)
+    bots : number of computer opponents
+    player : whether tank 0 is driven by the local player (else it is a bot too)
+    drivers : optional drivers for the computer tanks (agents); default scripted bots
+    """
+
+    def __init__(self, arena: str | Path | None = None, vehicle: str | Path | None = None, bots: int = 3,
+                 seed: int = 0, difficulty: str = "normal", player: bool = True,
+                 drivers: Sequence[Driver] | None = None) -> None:
+        from ..errors import TanktoolError
+        from ..sim.driver import make_drivers
+        from ..sim.match import default_arena, default_vehicle, load_match_arena, load_tank_spec
+
+        self._args = dict(arena=arena, vehicle=vehicle, bots=bots, seed=seed, difficulty=difficulty,
+                          player=player, drivers=drivers)
+        if difficulty not in DIFFICULTY:
+            raise TanktoolError(f"difficulty must be one of {', '.join(DIFFICULTY)}, got {difficulty!r}")
+        self.arena_ref = arena or default_arena()
+        if self.arena_ref is None:
+            raise TanktoolError("no arena given and none bundled under arenas/")
+        self.vehicle_ref = vehicle or default_vehicle()
+        self.info = load_match_arena(self.arena_ref)
+        self.spec = load_tank_spec(self.vehicle_ref)
+        self.difficulty = difficulty
+        n = bots + (1 if player else 0)
+        if n < 1:
+            raise TanktoolError("a match needs at least one tank")
+        names = (["you"] if player else []) + [f"bot{i + 1}" for i in range(bots)]
+        self.world = World(self.info.walls, [self.spec] * n, self.info.spawns, seed=seed, names=names,
+                           bounds=self.info.bounds)
+        self.player = 0 if player else None
+        if drivers is not None:
+            if len(drivers) != bots:
+                raise TanktoolError(f"{len(drivers)} drivers for {bots} computer tanks")
+            self.drivers: list[Driver | None] = ([None] if player else []) + list(drivers)
+        else:
+            hz, spread, sight = DIFFICULTY[difficulty]
+            self.drivers = list(make_drivers(self.world))
+            for d in self.drivers:
+                d.period, d.aim_spread, d.sight = 1.0 / hz, math.radians(spread), sight
+            if player:
+                self.drivers[0] = None
+        self.effects: list[Effect] = []
+        self.prev = self._poses()
+        self.last_events: list[Event] = []
+
+    # ------------------------------------------------------------------ stepping
+    @property
+    def dt(self) -> float:
+        return self.world.dt
+
+    @property
+    def t(self) -> float:
+        return self.world.t
+
+    def _poses(self) -> list[tuple[float, float, float]]:
+        return [(*t.position, t.heading) for t in self.world.tanks]
+
+    def commands(self, player_command: Command = IDLE) -> list[Command]:
+        w = self.world
+        return [player_command if d is None else d(w, t) for d, t in zip(self.drivers, w.tanks)]
+
+    def step(self, player_command: Command = IDLE) -> list[Event]:
+        """One fixed simulation step; returns its events and records their effects."""
+        self.prev = self._poses()
+        events = self.world.step(None, self.commands(player_command))
+        w = self.world
+        for e in events:
+            if e.kind == "shot":
+                t = w.tanks[e.tank]
+                mx, my, mz = t.spec.muzzle_local
+                x, z = t.to_world(mx, mz)
+                self.effects.append(Effect("flash", x, my, z, w.t))
+            elif e.kind == "hit":
+                self.effects.append(Effect("impact", e.x, 1.2, e.z, w.t))
+            elif e.kind == "kill":
+                self.effects.append(Effect("explosion", e.x, 1.0, e.z, w.t))
+        self.effects = [f for f in self.effects if f.age(w.t) < 1.0]
+        self.last_events = events
+        return events
+
+    def restart(self) -> None:
+        """Same arena, tanks and seed, from the start (drivers given by the caller are
+        reused as they are)."""
+        self.__init__(**self._args)
+
+    # ------------------------------------------------------------------ reading
+    def pose(self, i: int, alpha: float = 1.0) -> tuple[float, float, float]:
+        """(x, z, heading) of tank i's vehicle-frame origin, ``alpha`` of the way from the
+        previous step to the current one."""
+        x0, z0, h0 = self.prev[i]
+        t = self.world.tanks[i]
+        x1, z1 = t.position
+        h1 = t.heading
+        if math.hypot(x1 - x0, z1 - z0) > 5.0:      # a respawn is a jump, not a glide
+            return x1, z1, h1
+        dh = math.remainder(h1 - h0, 2.0 * math.pi)
+        return x0 + alpha * (x1 - x0), z0 + alpha * (z1 - z0), h0 + alpha * dh
+
+    def shell_points(self, alpha: float = 1.0) -> np.ndarray:
+        """(k, 3) positions of the shells in flight."""
+        if not self.world.shells:
+            return np.zeros((0, 3))
+        return np.array([(s.px + alpha * (s.x - s.px), s.py + alpha * (s.y - s.py), s.pz + alpha * (s.z - s.pz))
+                         for s in self.world.shells])
+
+    def focus(self) -> int:
+        """The tank the camera follows: the player, else the first live tank."""
+        if self.player is not None:
+            return self.player
+        return next((t.index for t in self.world.tanks if t.alive), 0)
+
+    def scoreboard(self) -> list[tuple[str, int, int, float, bool]]:
+        """(name, kills, deaths, hit points, alive) best first."""
+        rows = [(t.name, t.kills, t.deaths, max(t.hp, 0.0), t.alive) for t in self.world.tanks]
+        return sorted(rows, key=lambda r: (-r[1], r[2]))

@@ -1,0 +1,57 @@
+"""Game sounds: what happens in a session, heard from the followed tank.
+
+Each tank has a looping engine voice whose pitch follows its speed; shots, hits and
+kills start one-shot voices where they happen.  The listener rides on the followed
+tank, facing where it faces.  All the 3D maths is :func:`tanktool.audio.spatialize`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+from ..audio import Sound
+from ..sim.world import Event
+from .session import GameSession
+
+EAR_HEIGHT = 2.0
+#: one-shot sound per event kind
+EVENT_SOUNDS = {"shot": "shot", "hit": "impact", "kill": "explosion", "wall_bump": "impact"}
+
+
+class GameAudio:
+    """Keeps a :class:`Sound` in step with a session; silent when ``sound`` has no device."""
+
+    def __init__(self, session: GameSession, sound: Sound | None = None) -> None:
+        self.session = session
+        self.sound = sound if sound is not None else Sound()
+        self.engines: list[int] = []
+        for _ in session.world.tanks:
+            v = self.sound.play("engine", loop=True)
+            self.sound.set_range(v, 3.0, 120.0)
+            self.engines.append(v)
+
+    def on_events(self, events: Sequence[Event]) -> None:
+        for e in events:
+            name = EVENT_SOUNDS.get(e.kind)
+            if name is None or (e.kind == "wall_bump" and e.value < 5000.0):
+                continue          # gentle scrapes are not worth a clank
+            v = self.sound.play(name)
+            self.sound.set_source(v, (e.x, 1.5, e.z))
+            self.sound.set_range(v, 4.0, 300.0 if e.kind in ("shot", "kill") else 150.0)
+
+    def update(self, alpha: float = 1.0) -> None:
+        s = self.session
+        me = s.world.tanks[s.focus()]
+        x, z, h = s.pose(me.index, alpha)
+        self.sound.set_listener((x, EAR_HEIGHT, z), (math.cos(h), 0.0, math.sin(h)), (me.vx, 0.0, me.vz))
+        for v, t in zip(self.engines, s.world.tanks):
+            tx, tz, _ = s.pose(t.index, alpha)
+            self.sound.set_source(v, (tx, 1.0, tz), (t.vx, 0.0, t.vz) if t.alive else (0.0, 0.0, 0.0))
+            # revs: idle at 0.7, rising with speed; a wreck's engine is muted
+            self.sound.set_pitch(v, 0.7 + 0.9 * min(t.speed() / t.spec.top_speed, 1.2))
+            self.sound.set_gain(v, 0.5 if t.alive else 0.0)
+        self.sound.update()
+
+    def close(self) -> None:
+        self.sound.shutdown()

@@ -1,0 +1,131 @@
+"""The window's state machine driven by synthetic events on SDL's dummy video driver:
+menu, remap screen, fixed-timestep play, pause, restart, quit; and the fallback of
+``tanktool play`` when there is no display."""
+
+import pygame
+import pytest
+from click.testing import CliRunner
+
+from tanktool.cli.main import cli
+from tanktool.game.app import App, NoDisplay, Presenter, display_problem, run_window
+from tanktool.game.input import load_bindings
+
+
+@pytest.fixture
+def app(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "cfg"))
+    pygame.display.init()
+    pygame.font.init()
+    presenter = Presenter((480, 320), fullscreen=False, want_gl=False)
+    a = App(presenter, arena="box", bots=2, view="top", size=(480, 320), sound=False)
+    yield a
+    a.stop()
+    pygame.display.quit()
+
+
+def key(k, down=True):
+    return pygame.event.Event(pygame.KEYDOWN if down else pygame.KEYUP, key=k, mod=0, unicode="", scancode=0)
+
+
+def press(app, k):
+    app.handle(key(k))
+    app.handle(key(k, down=False))
+
+
+def goto(app, item):
+    while app.menu.item() != item:
+        press(app, pygame.K_DOWN)
+
+
+def test_menu_choices_and_start(app):
+    assert app.state == "menu"
+    app.frame(0.016)                       # draws the menu without error
+    goto(app, "bots")
+    press(app, pygame.K_RIGHT)
+    assert app.menu.bots.value == 3
+    goto(app, "difficulty")
+    press(app, pygame.K_RIGHT)
+    assert app.menu.difficulty.value == "hard"
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    assert app.state == "playing"
+    assert len(app.session.world.tanks) == 4 and app.session.player == 0
+    assert app.view == "top"               # no OpenGL on the dummy driver's plain window
+
+
+def test_fixed_timestep_and_player_drives(app):
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    s = app.session
+    x0, z0, h0 = s.pose(0)
+    app.handle(key(pygame.K_w))
+    # 0.1 s of real time is 12 steps of 1/120 s; a huge stall is capped at 0.25 s
+    assert app.advance(0.1) == 12
+    assert app.advance(5.0) == 30
+    app.frame(1 / 60)
+    assert 0.0 <= app.alpha < 1.0
+    x1, z1, _ = s.pose(0)
+    fx, fz = pygame.math.Vector2(x1 - x0, z1 - z0), pygame.math.Vector2(1, 0).rotate_rad(h0)
+    assert fx.dot(fz) > 0.1                # it moved forwards (0.35 s from rest: ~0.2 m)
+    assert abs(fx.cross(fz)) < 0.02         # and straight
+    app.handle(key(pygame.K_w, down=False))
+
+
+def test_pause_restart_menu_quit(app):
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    app.advance(0.5)
+    press(app, pygame.K_p)
+    assert app.state == "paused"
+    assert app.advance(1.0) == 0           # time stands still
+    app.frame(0.016)
+    press(app, pygame.K_r)                 # restart: same match from the start
+    assert app.state == "playing" and app.session.t == 0.0
+    press(app, pygame.K_ESCAPE)
+    assert app.state == "paused"
+    press(app, pygame.K_m)
+    assert app.state == "menu"
+    app.handle(pygame.event.Event(pygame.QUIT))
+    assert app.state == "quit"
+
+
+def test_views_and_overlays_toggle(app):
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    press(app, pygame.K_F1)
+    press(app, pygame.K_F3)
+    assert app.top.overlays == {"quadtree", "agents"}
+    press(app, pygame.K_v)                 # 3D is not available on a plain window
+    assert app.view == "top" and "OpenGL" in app.notice
+    app.frame(0.02)
+
+
+def test_remap_screen_saves_and_survives_restart(app, tmp_path):
+    goto(app, "bindings")
+    press(app, pygame.K_RETURN)
+    assert app.state == "remap"
+    while app.remap_cursor != 6:           # FIRE
+        press(app, pygame.K_DOWN)
+    press(app, pygame.K_RETURN)
+    assert app.remap_waiting
+    app.frame(0.016)                       # "press the button for FIRE"
+    app.handle(pygame.event.Event(pygame.JOYBUTTONDOWN, instance_id=0, joy=0, button=2))
+    assert not app.remap_waiting and "FIRE" in app.notice
+    assert load_bindings().actions["fire"] == ["joybutton:2"]
+    press(app, pygame.K_ESCAPE)
+    assert app.state == "menu"
+    # a new App (a restart of the game) reads the saved bindings
+    again = App(app.presenter, arena="box", bots=1, view="top", size=(480, 320), sound=False)
+    assert again.input.bindings.actions["fire"] == ["joybutton:2"]
+
+
+def test_no_display_is_a_clear_fallback(tmp_path, monkeypatch):
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
+    assert display_problem() == "SDL_VIDEODRIVER=dummy"
+    with pytest.raises(NoDisplay):
+        run_window()
+    pic = tmp_path / "m.png"
+    r = CliRunner().invoke(cli, ["play", "--arena", "box", "--seconds", "1", "--picture", str(pic)])
+    assert r.exit_code == 0, r.output
+    assert "no display to open the game window (SDL_VIDEODRIVER=dummy)" in r.output
+    assert pic.is_file()

@@ -1,0 +1,128 @@
+"""The 3D view through EGL: screenshots are not blank and show the arena and every
+tank where the camera says they are.  Skipped only when the EGL library is missing
+(CI installs libegl1 and libgl1-mesa-dri, so there they run)."""
+
+import ctypes.util
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from tanktool.cli.main import cli
+from tanktool.game.headless import run_frames
+from tanktool.game.session import GameSession, tank_colour
+
+pytestmark = pytest.mark.skipif(ctypes.util.find_library("EGL") is None,
+                                reason="libEGL is not installed (apt-get install libegl1 libgl1-mesa-dri)")
+
+SIZE = (480, 270)
+
+
+@pytest.fixture(scope="module")
+def overview():
+    from tanktool.game.render3d import Renderer3D
+
+    s = GameSession("box", bots=8, seed=1, player=False)
+    run_frames(s, 30)
+    r = Renderer3D(s, SIZE)
+    r.camera = "overview"
+    img = r.render(hud=False)
+    yield s, r, img
+    r.release()
+
+
+def closest_tint(rgb, n):
+    """Index of the tank colour whose direction in RGB is closest to this pixel's."""
+    v = np.asarray(rgb, float)
+    v = v / (np.linalg.norm(v) + 1e-9)
+    tints = np.array([tank_colour(i) for i in range(n)], float)
+    tints /= np.linalg.norm(tints, axis=1, keepdims=True)
+    return int(np.argmax(tints @ v))
+
+
+def test_not_blank_and_sized(overview):
+    s, r, img = overview
+    assert img.shape == (SIZE[1], SIZE[0], 3) and img.dtype == np.uint8
+    assert img.std() > 10 and len(np.unique(img.reshape(-1, 3), axis=0)) > 50
+
+
+def test_arena_floor_and_walls_are_where_projected(overview):
+    from tanktool.game.render3d import SKY
+
+    s, r, img = overview
+    sky = np.array(SKY) * 255
+    (x0, z0), (x1, z1) = s.world.bounds.tolist()
+    for x, z in [((x0 + x1) / 2, z0 + 12), ((x0 + x1) / 2, z1 - 12), (x0 + 12, (z0 + z1) / 2), (x1 - 12, (z0 + z1) / 2)]:
+        px, py, _ = r.project((x, 0.0, z))
+        assert 0 <= px < SIZE[0] and 0 <= py < SIZE[1]
+        assert np.abs(img[int(py), int(px)] - sky).sum() > 60      # floor, not sky
+    # the top of the outer wall (3 m high) is drawn in the wall's material colour (a red brown)
+    px, py, _ = r.project(((x0 + x1) / 2, 3.0, z0 + 0.25))
+    red, green, blue = img[int(py), int(px)].astype(int)
+    assert red > green + 20 and red > blue + 20
+
+
+def test_every_tank_shows_in_its_colour(overview):
+    s, r, img = overview
+    n = len(s.world.tanks)
+    for t in s.world.tanks:
+        x, z, _ = s.pose(t.index)
+        cx, _, cz = t.spec.centre_of_mass
+        # the roof of the hull beside the turret, seen from above
+        px, py, depth = r.project((x, t.spec.height * 0.7, z))
+        assert -1 < depth < 1
+        patch = img[int(py) - 1:int(py) + 2, int(px) - 1:int(px) + 2].reshape(-1, 3)
+        votes = [closest_tint(p, n) for p in patch]
+        assert votes.count(t.index) >= 5, (t.name, patch.tolist())
+
+
+def test_cameras_cycle_and_chase_sees_the_followed_tank():
+    from tanktool.game.render3d import CAMERAS, Renderer3D
+
+    s = GameSession("paper2002", bots=2, seed=2, player=True)
+    run_frames(s, 10)
+    r = Renderer3D(s, SIZE)
+    try:
+        assert r.camera == "chase"
+        img = r.render(hud=False)
+        x, z, _ = s.pose(0)
+        px, py, _ = r.project((x, s.spec.height * 0.7, z))
+        patch = img[int(py) - 2:int(py) + 3, int(px) - 2:int(px) + 3].reshape(-1, 3)
+        assert sum(closest_tint(p, 3) == 0 for p in patch) >= 13
+        seen = [r.toggle_camera() for _ in CAMERAS]
+        assert seen == ["first-person", "overview", "chase"]
+        r.camera = "first-person"
+        fp = r.render(hud=True, fps=60.0)
+        assert fp.std() > 5 and not np.array_equal(fp, img)
+    finally:
+        r.release()
+
+
+def test_effects_and_shells_are_drawn():
+    from tanktool.game.render3d import Renderer3D
+    from tanktool.game.session import Effect
+
+    s = GameSession("box", bots=2, seed=0, player=False)
+    r = Renderer3D(s, SIZE)
+    try:
+        r.camera = "overview"
+        before = r.render(hud=False)
+        s.effects.append(Effect("explosion", 30.0, 1.0, 30.0, s.t))
+        after = r.render(hud=False)
+        px, py, _ = r.project((30.0, 1.0, 30.0))
+        red, green, blue = after[int(py), int(px)].astype(int)
+        assert red > 200 and red > blue + 80            # a bright orange fireball
+        assert not np.array_equal(before, after)
+    finally:
+        r.release()
+
+
+def test_headless_3d_screenshot_cli(tmp_path):
+    import pygame
+
+    out = tmp_path / "shot.png"
+    r = CliRunner().invoke(cli, ["play", "--headless", "--frames", "30", "--screenshot", str(out),
+                                 "--arena", "paper2002", "--bots", "4", "--size", "320x180"])
+    assert r.exit_code == 0, r.output
+    img = pygame.surfarray.array3d(pygame.image.load(str(out)))
+    assert img.shape[:2] == (320, 180) and img.std() > 10
