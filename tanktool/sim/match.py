@@ -1,5 +1,6 @@
-"""Headless matches: load an arena and a vehicle, put scripted bots in a world, run it
-for a number of simulated seconds as fast as the machine allows, and report.
+"""Headless matches: load an arena and a vehicle, put bots (computer agents, or the
+scripted baseline) in a world, run it for a number of simulated seconds as fast as
+the machine allows, and report.
 
 The report is one JSON-ready dict: ``arena``, ``seed``, ``seconds`` (simulated),
 ``tanks`` (name, kills, deaths, shots, hits, wall_bumps, distance, position [x, z] at
@@ -100,10 +101,29 @@ def _r(v: float, nd: int = 3) -> float:
     return 0.0 if v == 0.0 else v       # no "-0.0" in reports
 
 
+#: who drives the bots: the computer agent (issue 7) or the old scripted stand-in (the baseline)
+BOT_KINDS = ("agent", "scripted")
+
+
+def make_bots(world: World, bot: str = "agent", difficulty: str = "normal") -> list:
+    """One driver per tank: ``sim.agents.Agent`` at ``difficulty``, or ``ScriptedDriver``."""
+    if bot == "scripted":
+        return make_drivers(world)
+    if bot == "agent":
+        from .agents import DIFFICULTIES, make_agents
+
+        if difficulty not in DIFFICULTIES:
+            raise TanktoolError(f"--difficulty must be one of {', '.join(DIFFICULTIES)}, got {difficulty!r}")
+        return make_agents(world, difficulty)
+    raise TanktoolError(f"bots must be one of {', '.join(BOT_KINDS)}, got {bot!r}")
+
+
 def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 60.0, seed: int = 0,
               dt: float = DT, integrator: str = "semi-implicit",
-              on_progress: Callable[[int], None] | None = None, progress_every: int = 120) -> MatchResult:
-    """Run ``bots`` scripted tanks for ``seconds`` of simulated time."""
+              on_progress: Callable[[int], None] | None = None, progress_every: int = 120,
+              bot: str = "agent", difficulty: str = "normal") -> MatchResult:
+    """Run ``bots`` tanks for ``seconds`` of simulated time, driven by computer agents
+    at ``difficulty`` (``bot="agent"``) or by the scripted baseline (``bot="scripted"``)."""
     if bots < 1:
         raise TanktoolError(f"--bots must be at least 1, got {bots}")
     if not (seconds > 0 and math.isfinite(seconds)):
@@ -111,7 +131,7 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
     names = [f"bot{i + 1}" for i in range(bots)]
     world = World(arena.walls, [spec] * bots, arena.spawns, seed=seed, dt=dt, integrator=integrator, names=names,
                   bounds=arena.bounds)
-    drivers = make_drivers(world)
+    drivers = make_bots(world, bot, difficulty)
     steps = int(round(seconds / dt))
     events = []
     trail_every = max(int(round(TRAIL_PERIOD / dt)), 1)
@@ -130,6 +150,8 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
     if on_progress is not None and steps % progress_every:
         on_progress(steps % progress_every)
     report = make_report(world, arena.name, spec.name, seed, events)
+    report["bots"] = bot
+    report["difficulty"] = difficulty if bot == "agent" else None
     report["timing"] = {
         "wall_clock_s": round(wall, 4),
         "steps_per_second": round(steps / wall, 1) if wall > 0 else None,

@@ -1,0 +1,507 @@
+"""The computer opponent: a small state machine over sensors and ``Command`` values.
+
+States (each a method ``_wander``, ``_search``, ``_attack``, ``_evade`` that returns
+the command for this think):
+
+* **Wander** (start): follow a route of grid nodes chosen by the paper's three-node
+  heuristic with memory (``navigation.Wanderer``).
+* **Search** (an enemy was seen or heard, and is not in sight): the quadrant search
+  (``navigation.SearchPlan``), A* paths to each quadrant's centre.
+* **Attack** (an enemy in sight and the reaction time passed): the fuzzy controller
+  (``fuzzy.AttackController``) turns, advances or backs off, strafes to dodge, fires.
+* **Evade** (hit twice within 4 s with half the hit points gone): drive to the nearest
+  node out of the threat's line of sight, or, with no cover near, strafe hard.
+
+Transitions, checked every think (``think_hz`` times a second; the command is held in
+between, as a person holds a key)::
+
+    any      --enemy seen, reaction time over-->  Attack
+    Attack   --enemy lost-->                      Search (from where it was last seen, moved on)
+    Wander   --shot heard / hit taken-->          Search (from the shot / from behind us)
+    Search   --all quadrants done, or 60 s-->     Wander
+    any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
+
+Everything the agent knows comes from ``perception.Senses`` (sight, hearing, memory,
+its own hit points) and the static map (walls and its navigation grid); it acts only
+through ``Command`` values.  Its randomness comes from its own ``random.Random``,
+seeded from the world's, so matches replay exactly.
+
+Difficulty sets the reaction time (delay between first seeing an enemy and acting on
+it), the aim noise (a Gaussian error on the aim, drawn anew after every shot), the
+vision range, the hearing radius and how often it thinks.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from ...nav.steering import heading_from_angle
+from ..commands import IDLE, Command
+from .fuzzy import PREDICT, AttackController, FIRE_THRESHOLD
+from .navigation import Memory, SearchPlan, Wanderer, agent_grid, plan_path
+from .perception import Senses, Sighting, wrap
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..body import Tank
+    from ..world import World
+
+STATES = ("wander", "search", "attack", "evade")
+
+
+@dataclass(frozen=True)
+class Difficulty:
+    """How good an agent is.  Times in seconds, angles in radians, distances in metres."""
+
+    name: str
+    reaction: float
+    aim_noise: float
+    vision_range: float
+    hearing_radius: float
+    think_hz: float
+
+
+DIFFICULTIES: dict[str, Difficulty] = {
+    "easy": Difficulty("easy", reaction=0.6, aim_noise=math.radians(4.0), vision_range=60.0,
+                       hearing_radius=50.0, think_hz=8.0),
+    "normal": Difficulty("normal", reaction=0.2, aim_noise=math.radians(1.5), vision_range=90.0,
+                         hearing_radius=80.0, think_hz=15.0),
+    "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.5), vision_range=130.0,
+                       hearing_radius=120.0, think_hz=20.0),
+}
+
+
+def difficulty(name: str | Difficulty) -> Difficulty:
+    """A difficulty by name (easy, normal, hard)."""
+    if isinstance(name, Difficulty):
+        return name
+    try:
+        return DIFFICULTIES[name]
+    except KeyError:
+        raise ValueError(f"difficulty must be one of {', '.join(DIFFICULTIES)}, got {name!r}") from None
+
+
+class Agent:
+    """A computer opponent; call it as a driver: ``agent(world, tank) -> Command``.
+
+    Parameters
+    ----------
+    rng : its own generator (seed it from the world's for replays)
+    level : a :class:`Difficulty` or its name
+    half_angle : vision cone half-angle [rad] (60 degrees)
+    cell : node spacing of its navigation grid [m]
+    margin : grid clearance beyond the vehicle's footprint radius [m]
+    """
+
+    def __init__(self, rng: random.Random, level: str | Difficulty = "normal", *,
+                 half_angle: float = math.radians(60.0), cell: float = 1.0, margin: float = 0.5) -> None:
+        self.level = difficulty(level)
+        self.rng = rng
+        self.period = 1.0 / self.level.think_hz
+        self.senses = Senses(half_angle, self.level.vision_range, self.level.hearing_radius, 0.15, rng)
+        self.cell = cell
+        self.margin = margin
+        self.state = "wander"
+        self.command: Command = IDLE
+        self.next_think = -math.inf
+        self.grid = None
+        self.memory: Memory | None = None
+        self.wanderer: Wanderer | None = None
+        self.controller: AttackController | None = None
+        # wander route: world points of nodes, and the walker's node and heading
+        self.route: list[tuple[float, float]] = []
+        self.walker: tuple[tuple[int, int], str] | None = None
+        # search / evade
+        self.plan: SearchPlan | None = None
+        self.path: list[tuple[float, float]] = []
+        self.goal: tuple[float, float] | None = None
+        self.state_since = 0.0
+        self.evade_until = 0.0
+        self.evade_cooldown = -math.inf
+        self.explore_after = 0.0
+        self.threat: tuple[float, float] | None = None
+        # attack
+        self.target: int | None = None
+        self.acquired_at = math.inf
+        self.aim_error = rng.gauss(0.0, self.level.aim_noise)
+        self.dodge = 1.0 if rng.random() < 0.5 else -1.0
+        self.dodge_flip = 0.0
+        self.hits: list[float] = []
+        # stuck recovery
+        self.progress_at = (0.0, math.nan, math.nan)
+        self.reverse_until = -math.inf
+        self.reverse_turn = 1.0
+
+    # ------------------------------------------------------------------ driver
+    def __call__(self, world: "World", tank: "Tank") -> Command:
+        if not tank.alive:
+            self._reset()
+            return IDLE
+        if world.t + 1e-12 < self.next_think:
+            return self.command
+        self.next_think = world.t + self.period
+        self.command = self.think(world, tank)
+        return self.command
+
+    def _reset(self) -> None:
+        self.state = "wander"
+        self.route, self.walker, self.path, self.plan, self.goal = [], None, [], None, None
+        self.target, self.acquired_at = None, math.inf
+        self.hits = []
+        self.senses.hp = math.inf
+        self.reverse_until = -math.inf
+        self.next_think = -math.inf
+
+    def _setup(self, world: "World", tank: "Tank") -> None:
+        self.grid = agent_grid(world, self.cell, tank.spec.radius + self.margin)
+        self.memory = Memory(self.grid)
+        self.wanderer = Wanderer(self.grid, self.memory, self.rng)
+        self.controller = AttackController(tank.spec.shell_speed)
+
+    def _enter(self, state: str, t: float) -> None:
+        if state != self.state:
+            self.state = state
+            self.state_since = t
+            self.route, self.walker, self.path = [], None, []
+
+    # ------------------------------------------------------------------ think
+    def think(self, world: "World", tank: "Tank") -> Command:
+        """Perceive, pick the state, act.  Called ``think_hz`` times a second."""
+        if self.grid is None:
+            self._setup(world, tank)
+        t = world.t
+        self.memory.visit(tank.x, tank.z, t)  # type: ignore[union-attr]
+        previous = self.senses.last_seen.get(self.target) if self.target is not None else None
+        seen = self.senses.look(world, tank)
+        heard = self.senses.listen(world, tank)
+        if self.senses.hit_taken(tank) > 0.0:
+            self.hits.append(t)
+        self.hits = [h for h in self.hits if t - h < 4.0]
+
+        sight = self._pick_target(seen)
+        if sight is not None:
+            fresh = previous is None or previous.index != sight.index or t - previous.t > 1.0
+            if self.target != sight.index or fresh:
+                self.acquired_at = t + self.level.reaction
+            self.target = sight.index
+
+        if self.state != "evade" and sight is None and len(self.hits) >= 2 and t >= self.evade_cooldown:
+            threat = (sight.x, sight.z) if sight else self._estimate(t)
+            if threat is not None:
+                self._start_evade(world, tank, threat, t)
+        if self.state == "evade":
+            cmd = self._evade(world, tank, sight)
+            if cmd is not None:
+                return self._unstick(world, tank, cmd)
+            self.evade_cooldown = t + 8.0
+            self._start_search(self.threat or (tank.x, tank.z), t)
+
+        if sight is not None and t >= self.acquired_at:
+            self._enter("attack", t)
+            return self._attack(world, tank, sight)
+        if sight is None and self.state == "attack":
+            est = self._estimate(t)
+            self._start_search(est if est is not None else (tank.x, tank.z), t)
+        elif sight is None and self.state == "wander":
+            if heard is not None:
+                self._start_search((heard.x, heard.z), t)
+            elif self.hits and self.hits[-1] == t:
+                # hit by something unseen: look behind
+                self._start_search((tank.x - 20.0 * tank.c, tank.z - 20.0 * tank.s), t)
+        elif sight is None and self.state == "search" and heard is not None and t - self.state_since > 2.0:
+            self._start_search((heard.x, heard.z), t)
+        if self.state == "search":
+            cmd = self._search(world, tank)
+            if cmd is not None:
+                return self._unstick(world, tank, cmd)
+            self._enter("wander", t)
+        return self._unstick(world, tank, self._wander(world, tank))
+
+    def _pick_target(self, seen: list[Sighting]) -> Sighting | None:
+        """The current target if still in sight (no dithering), else the nearest."""
+        for s in seen:
+            if s.index == self.target:
+                return s
+        return seen[0] if seen else None
+
+    def _estimate(self, t: float) -> tuple[float, float] | None:
+        """Where the enemy probably is: last seen moved on (up to 2 s), or last heard."""
+        s = self.senses.last_seen.get(self.target) if self.target is not None else None
+        h = self.senses.heard
+        if s is not None and (h is None or s.t >= h.t):
+            dt = min(t - s.t, 2.0)
+            return s.x + s.vx * dt, s.z + s.vz * dt
+        if h is not None:
+            return h.x, h.z
+        return None
+
+    # ------------------------------------------------------------------ wander
+    def _wander(self, world: "World", tank: "Tank") -> Command:
+        grid, wand = self.grid, self.wanderer
+        x, z = tank.x, tank.z
+        while self.route and math.hypot(self.route[0][0] - x, self.route[0][1] - z) < 2.5:
+            self.route.pop(0)
+        if self.route and math.hypot(self.route[0][0] - x, self.route[0][1] - z) > 5.0:
+            self.route, self.walker = [], None       # pushed off the route: start again here
+        if self.walker is None:
+            from ...nav.navgrid import nearest_valid_node
+
+            n = nearest_valid_node(grid.valid, grid.node_of(x, z), 6)  # type: ignore[union-attr]
+            if n is None:
+                return self._back_off(tank)
+            self.walker = (n, heading_from_angle(tank.heading))
+            self.route = []
+        if self.path:
+            # exploring: an A* path to a region not seen for a while
+            while len(self.path) > 1 and math.hypot(self.path[0][0] - x, self.path[0][1] - z) < 3.0:
+                self.path.pop(0)
+            if math.hypot(self.path[-1][0] - x, self.path[-1][1] - z) > 4.0:
+                return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
+            self.path, self.route, self.walker = [], [], None
+            return self._wander(world, tank)
+        while len(self.route) < 12:
+            node, h = self.walker
+            nxt = wand.choose(node, h, world.t)  # type: ignore[union-attr]
+            if nxt is None:
+                break
+            self.walker = nxt
+            point = grid.centre(*nxt[0])  # type: ignore[union-attr]
+            looping = point in self.route   # a pocket the heuristic only turns about in
+            self.route.append(point)
+            if looping or (wand.best_novelty < 0.6 and world.t > self.explore_after):  # type: ignore[union-attr]
+                # every way from here leads somewhere seen lately: go to the nearest
+                # region not visited for a while, by A*, then wander again
+                self.explore_after = world.t + 3.0
+                goal = self.memory.frontier(x, z, world.t, wand.forget)  # type: ignore[union-attr]
+                if goal is not None:
+                    self.path = plan_path(grid, (x, z), goal)  # type: ignore[arg-type]
+                    if self.path:
+                        self.route, self.walker = [], None
+                        return self._wander(world, tank)
+        if not self.route:
+            return self._back_off(tank)
+        return self._follow(world, tank, self.route, speed=0.85, lookahead=6.0)
+
+    # ------------------------------------------------------------------ search
+    def _start_search(self, where: tuple[float, float], t: float) -> None:
+        self.plan = SearchPlan(self.grid, where[0], where[1])  # type: ignore[arg-type]
+        self.path, self.goal = [], None
+        self.state = "wander"  # so _enter resets the route
+        self._enter("search", t)
+
+    def _search(self, world: "World", tank: "Tank") -> Command | None:
+        t = world.t
+        if t - self.state_since > 60.0 or self.plan is None:
+            return None
+        x, z = tank.x, tank.z
+        if self.goal is not None and math.hypot(self.goal[0] - x, self.goal[1] - z) < 4.0:
+            self.goal, self.path = None, []
+        tries = 0
+        while self.goal is None or not self.path:
+            tries += 1
+            if tries > 3:
+                return self._follow(world, tank, [], speed=0.0, lookahead=4.0) if self.goal else None
+            self.goal = self.plan.next_goal(self.memory, t)
+            if self.goal is None:
+                return None
+            self.path = plan_path(self.grid, (x, z), self.goal)  # type: ignore[arg-type]
+        while len(self.path) > 1 and math.hypot(self.path[0][0] - x, self.path[0][1] - z) < 3.0:
+            self.path.pop(0)
+        return self._follow(world, tank, self.path, speed=0.9, lookahead=4.0, corner=self._corner(tank))
+
+    # ------------------------------------------------------------------ attack
+    def _attack(self, world: "World", tank: "Tank", s: Sighting) -> Command:
+        ctl = self.controller
+        t = world.t
+        dx, dz = s.x - tank.x, s.z - tank.z
+        d = max(math.hypot(dx, dz), 1e-6)
+        px, pz = -dz / d, dx / d       # the right of the line of sight
+        v_lat = (s.vx - tank.vx) * px + (s.vz - tank.vz) * pz
+        aim = math.atan2(dz, dx) + ctl.lead(v_lat) + self.aim_error  # type: ignore[union-attr]
+        err = wrap(aim - tank.heading)
+        out = ctl(err, tank.omega, d)  # type: ignore[misc]
+        fire = out.fire >= FIRE_THRESHOLD and tank.reload <= self.period
+        if fire:
+            self.aim_error = self.rng.gauss(0.0, self.level.aim_noise)
+        if t >= self.dodge_flip:
+            self.dodge = -self.dodge
+            self.dodge_flip = t + self.rng.uniform(1.0, 2.5)
+        top = tank.spec.top_speed
+        lateral = self._dodge_side(world, tank) * out.strafe_size * 0.5 * top
+        return self._drive(world, tank, out.advance * 0.5 * top, lateral, out.rotate, fire)
+
+    def _dodge_side(self, world: "World", tank: "Tank") -> float:
+        """The dodge direction, flipped when a wall is near on that side."""
+        angle = tank.heading + self.dodge * math.pi / 2
+        if self._free(world, tank, angle, tank.spec.radius + 6.0, (0.0,)) < tank.spec.radius + 5.0:
+            self.dodge = -self.dodge
+        return self.dodge
+
+    # ------------------------------------------------------------------ evade
+    def _start_evade(self, world: "World", tank: "Tank", threat: tuple[float, float], t: float) -> None:
+        self.threat = threat
+        self.state = "wander"
+        self._enter("evade", t)
+        self.evade_until = t + 5.0
+        self.path = []
+        cover = self._cover(world, tank, threat)
+        if cover is not None:
+            self.path = plan_path(self.grid, (tank.x, tank.z), cover)  # type: ignore[arg-type]
+
+    def _cover(self, world: "World", tank: "Tank", threat: tuple[float, float]) -> tuple[float, float] | None:
+        """The nearest of a few sampled nodes 5-25 m away that the threat cannot see."""
+        grid = self.grid
+        i, j = grid.node_of(tank.x, tank.z)  # type: ignore[union-attr]
+        r = int(25.0 / grid.cell)  # type: ignore[union-attr]
+        i0, j0 = max(i - r, 0), max(j - r, 0)
+        win = grid.valid[i0:i + r + 1, j0:j + r + 1]  # type: ignore[union-attr]
+        a, b = win.nonzero()
+        if len(a) == 0:
+            return None
+        best, best_d = None, math.inf
+        for k in range(24):
+            m = self.rng.randrange(len(a))
+            cx, cz = grid.centre(int(a[m]) + i0, int(b[m]) + j0)  # type: ignore[union-attr]
+            d = math.hypot(cx - tank.x, cz - tank.z)
+            if 5.0 <= d < best_d and world.walls.blocked(threat[0], threat[1], cx, cz):
+                best, best_d = (cx, cz), d
+        return best
+
+    def _evade(self, world: "World", tank: "Tank", sight: Sighting | None) -> Command | None:
+        t = world.t
+        if t >= self.evade_until:
+            return None
+        x, z = tank.x, tank.z
+        while len(self.path) > 1 and math.hypot(self.path[0][0] - x, self.path[0][1] - z) < 3.0:
+            self.path.pop(0)
+        if self.path:
+            if math.hypot(self.path[-1][0] - x, self.path[-1][1] - z) < 3.0:
+                return None
+            return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
+        # no cover near: strafe hard across the threat's line, gun on it when seen
+        if sight is not None:
+            cmd = self._attack(world, tank, sight)
+            return self._drive(world, tank, 0.0, self.dodge * 0.5 * tank.spec.top_speed, cmd.rotate, cmd.fire)
+        return self._follow(world, tank, [], speed=0.0, lookahead=4.0)
+
+    # ------------------------------------------------------------------ driving
+    def _follow(self, world: "World", tank: "Tank", points: list[tuple[float, float]], speed: float,
+                lookahead: float, corner: tuple[float, float] | None = None) -> Command:
+        """Pure pursuit of the first point at least ``lookahead`` away (or the last),
+        at up to ``speed`` x top speed, slowing to turn and for ``corner`` (the next
+        waypoint where the path bends)."""
+        if not points:
+            return self._drive(world, tank, 0.0, 0.0, 0.0)
+        x, z = tank.x, tank.z
+        tx, tz = points[-1]
+        for p in points:
+            if math.hypot(p[0] - x, p[1] - z) >= lookahead:
+                tx, tz = p
+                break
+        err = wrap(math.atan2(tz - z, tx - x) - tank.heading)
+        rotate = self.controller.turn(err - PREDICT * tank.omega)  # type: ignore[union-attr]
+        top = tank.spec.top_speed
+        # turn first, then drive: full speed only when pointing the right way
+        v = speed * top * max(0.0, 1.0 - abs(err) / 1.2)
+        if corner is not None:
+            brake = 0.6 * tank.spec.engine_force / tank.spec.mass
+            v = min(v, 3.0 + math.sqrt(2.0 * brake * math.hypot(corner[0] - x, corner[1] - z)))
+        return self._drive(world, tank, v, 0.0, rotate)
+
+    def _free(self, world: "World", tank: "Tank", angle: float, length: float, offsets: tuple[float, ...]) -> float:
+        """Free distance along ``angle`` from points beside the centre, up to ``length``."""
+        c, s = math.cos(angle), math.sin(angle)
+        best = length
+        for o in offsets:
+            ox, oz = tank.x - s * o, tank.z + c * o
+            hit = world.walls.first_hit(ox, oz, ox + c * length, oz + s * length)
+            if hit is not None:
+                best = min(best, hit[0] * length)
+        return best
+
+    def _drive(self, world: "World", tank: "Tank", forward: float, lateral: float, rotate: float,
+               fire: bool = False) -> Command:
+        """Commands that reach a wanted forward and sideways speed [m/s] (+ = right).
+
+        Tracks coast far on their own (the rolling drag is weak), so speed is
+        controlled, braking included, and capped by the walls: the speed from which
+        the tank can still stop, at 60 % of its engine's deceleration, before its
+        centre comes within footprint radius + 1 m of a wall.  Feelers are rays from
+        the centre and beside it, along the way the tank is going.
+        """
+        spec = tank.spec
+        c, s = tank.c, tank.s
+        vf = tank.vx * c + tank.vz * s
+        vr = -tank.vx * s + tank.vz * c
+        bx0, bz0, bx1, bz1 = spec.box
+        half = 0.5 * (bz1 - bz0)
+        length = 0.5 * (bx1 - bx0)
+        if abs(forward) > 0.05:
+            brake = 0.8 * spec.engine_force / spec.mass
+            stop = (bx1 if forward > 0 else -bx0) + 1.0
+            reach = stop + forward * forward / (2.0 * brake) + 1.0
+            angle = tank.heading if forward > 0 else tank.heading + math.pi
+            free = self._free(world, tank, angle, reach, (0.0, half, -half))
+            forward = math.copysign(min(abs(forward), math.sqrt(2.0 * brake * max(free - stop, 0.0))), forward)
+        if abs(lateral) > 0.05:
+            brake = 0.6 * spec.strafe_force / spec.mass
+            stop = spec.radius + 1.0
+            angle = tank.heading + math.copysign(math.pi / 2, lateral)
+            free = self._free(world, tank, angle, stop + 10.0, (0.0, 0.8 * length, -0.8 * length))
+            lateral = math.copysign(min(abs(lateral), math.sqrt(2.0 * brake * max(free - stop, 0.0))), lateral)
+        # a wall closer than the footprint radius + 1.5 m pushes the tank away: turning
+        # in place sweeps the whole footprint circle, and attack moves go anywhere
+        push = spec.radius + 1.5
+        px = pz = 0.0
+        for k in world.walls.near(tank.x, tank.z, push):
+            w = world.walls.walls[k]
+            ax, az, ex, ez, l2, _ = w  # type: ignore[misc]
+            u = min(max(((tank.x - ax) * ex + (tank.z - az) * ez) / l2, 0.0), 1.0)
+            dx, dz = tank.x - (ax + u * ex), tank.z - (az + u * ez)
+            d = math.hypot(dx, dz)
+            if d > 1e-9:
+                px += dx / d * (push - d)
+                pz += dz / d * (push - d)
+        if px or pz:
+            forward += 2.0 * (px * c + pz * s)
+            lateral += 2.0 * (-px * s + pz * c)
+        top = spec.top_speed
+        advance = forward / top + 0.3 * (forward - vf)
+        strafe = lateral / (0.5 * top) + 0.3 * (lateral - vr)
+        return Command(advance=advance, rotate=rotate, strafe=strafe, fire=fire)
+
+    def _corner(self, tank: "Tank") -> tuple[float, float] | None:
+        """The next waypoint of the A* path where it bends (the path's end counts)."""
+        return self.path[0] if self.path else None
+
+    def _back_off(self, tank: "Tank") -> Command:
+        return Command(advance=-0.3, rotate=self.reverse_turn)
+
+    def _unstick(self, world: "World", tank: "Tank", cmd: Command) -> Command:
+        """Pushing but not moving for a second: reverse and turn for 0.8 s, then replan."""
+        t = world.t
+        if t < self.reverse_until:
+            back = self._free(world, tank, tank.heading + math.pi, 8.0, (0.0,))
+            ahead = self._free(world, tank, tank.heading, 8.0, (0.0,))
+            return self._drive(world, tank, -4.0 if back >= ahead else 4.0, 0.0, self.reverse_turn)
+        t0, x0, z0 = self.progress_at
+        if abs(cmd.advance) < 0.3 or not math.isfinite(x0) or math.hypot(tank.x - x0, tank.z - z0) > 0.5:
+            self.progress_at = (t, tank.x, tank.z)
+            return cmd
+        if t - t0 > 1.0:
+            # back out the way there is room for, turning; then plan afresh from here
+            self.reverse_until = t + 0.8
+            self.reverse_turn = 1.0 if self.rng.random() < 0.5 else -1.0
+            self.progress_at = (t + 0.8, math.nan, math.nan)
+            self.route, self.walker, self.path = [], None, []
+            self.explore_after = 0.0
+            return self._drive(world, tank, -4.0, 0.0, self.reverse_turn)
+        return cmd
+
+
+def make_agents(world: "World", level: str | Difficulty = "normal", which: range | list[int] | None = None) -> list[Agent]:
+    """One agent per tank (or per index in ``which``), each seeded from the world's generator."""
+    idx = range(len(world.tanks)) if which is None else which
+    return [Agent(random.Random(world.rng.getrandbits(64)), level) for _ in idx]

@@ -1,0 +1,288 @@
+"""Where an agent drives: its navigation grid, the wander heuristic with memory, the
+quadrant search, and following a list of waypoints.
+
+**The agent's grid.**  The bundled ``navgrid.npz`` is built at 0.5 m for the largest
+vehicle; an agent wants coarser nodes (A* over a few thousand nodes, not forty
+thousand) and its own vehicle's clearance.  So each agent grid is built from the
+world's walls: nodes every ``cell`` metres, valid when at least ``clearance`` (the
+footprint radius plus a margin) from every wall and 4-connected to a spawn point (which
+also throws out the inside of solid blocks), with the paper's row and column run
+numbers.  One grid per (walls, cell, clearance) is cached.
+
+**Wander** is the paper's ternary decision (``nav.steering.children``: the three
+nodes ahead, scored by the free nodes before a wall in the direction each leads) with
+two additions the nav engineer's notes ask for, because the greedy rule alone circles a
+few nodes of an open room: the count is capped (a long hall is not ten times better
+than a short one), and each child is weighted by the *novelty* of where it leads -- the
+time since the agent last visited the region (``region`` metres square) of the node
+``look`` nodes down that way, as a fraction of ``forget`` seconds -- times a small
+random jitter.  With no memory and no jitter the weights are all 1 and the choice is
+exactly ``choose_next``'s (tested on the paper's example).
+
+**Search** is the paper's division into quadrants: the arena's rectangle is split into
+four, ordered by their distance to where the enemy was last seen or heard (the one
+holding it first), and each is split again until its longer side is at most
+``leaf`` metres; the agent drives an A* path (``nav.path.find_path``) to the centre
+of each leaf in that depth-first order, skipping leaves it visited recently.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import weakref
+from collections import deque
+from typing import TYPE_CHECKING, Iterator
+
+import numpy as np
+
+from ...nav.navgrid import NavGrid, Node, STEPS, grid_from_mask, grid_shape, nearest_valid_node, reachable_from, too_close
+from ...nav.path import find_path
+from ...nav.steering import children, decide, heading_of_move
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..world import World
+
+_GRIDS: "weakref.WeakKeyDictionary[object, dict[tuple[float, float], NavGrid]]" = weakref.WeakKeyDictionary()
+
+
+def agent_grid(world: "World", cell: float, clearance: float) -> NavGrid:
+    """The navigation grid agents of this clearance use in ``world`` (cached per wall set)."""
+    per = _GRIDS.setdefault(world.walls, {})
+    key = (float(cell), float(clearance))
+    if key not in per:
+        bounds = np.asarray(world.bounds, dtype=np.float64)
+        shape = grid_shape(bounds, cell)
+        origin = bounds[0].copy()
+        free = ~too_close(world.walls.segments, origin, cell, shape, clearance)
+        g0 = grid_from_mask(free, origin, cell)
+        seeds = []
+        for x, z, _ in world.spawns:
+            n = nearest_valid_node(free, g0.node_of(x, z), int(math.ceil(clearance / cell)) + 2)
+            if n is not None:
+                seeds.append(n)
+        valid = reachable_from(free, seeds) if seeds else free
+        grid = grid_from_mask(valid, origin, cell)
+        grid.clearance = float(clearance)
+        grid.spawn_nodes = seeds
+        per[key] = grid
+    return per[key]
+
+
+class Memory:
+    """When each region (a square of ``region`` metres) was last visited."""
+
+    def __init__(self, grid: NavGrid, region: float = 8.0) -> None:
+        self.grid = grid
+        self.region = region
+        (x0, z0), (x1, z1) = grid.bounds.tolist()
+        self.x0, self.z0 = x0, z0
+        self.nx = max(int(math.ceil((x1 - x0) / region)), 1)
+        self.nz = max(int(math.ceil((z1 - z0) / region)), 1)
+        self.last = [-math.inf] * (self.nx * self.nz)
+        self._goals: list[tuple[int, tuple[float, float]]] | None = None
+        self._flat: list[bool] | None = None
+
+    def key(self, x: float, z: float) -> int:
+        i = min(max(int((x - self.x0) // self.region), 0), self.nx - 1)
+        j = min(max(int((z - self.z0) // self.region), 0), self.nz - 1)
+        return j * self.nx + i
+
+    def visit(self, x: float, z: float, t: float) -> None:
+        self.last[self.key(x, z)] = t
+
+    def since(self, x: float, z: float, t: float) -> float:
+        """Seconds since the region of (x, z) was visited (inf: never)."""
+        return t - self.last[self.key(x, z)]
+
+    def centre(self, key: int) -> tuple[float, float]:
+        j, i = divmod(key, self.nx)
+        return self.x0 + (i + 0.5) * self.region, self.z0 + (j + 0.5) * self.region
+
+    def goals(self) -> list[tuple[int, tuple[float, float]]]:
+        """(region, valid node centre) for every region holding a valid node: the node
+        nearest the region's centre (computed once; cached on the memory)."""
+        if self._goals is None:
+            out = []
+            grid = self.grid
+            steps = int(math.ceil(0.5 * self.region / grid.cell))
+            for key in range(len(self.last)):
+                cx, cz = self.centre(key)
+                n = nearest_valid_node(grid.valid, grid.node_of(cx, cz), steps)
+                if n is not None:
+                    gx, gz = grid.centre(*n)
+                    if self.key(gx, gz) == key:
+                        out.append((key, (gx, gz)))
+            self._goals = out
+        return self._goals
+
+    def frontier(self, x: float, z: float, t: float, older: float) -> tuple[float, float] | None:
+        """The region not visited for ``older`` seconds nearest to (x, z) along the
+        grid (breadth-first over valid nodes, so a wall between does not fool it)."""
+        grid = self.grid
+        stale = {}
+        for key, g in self.goals():
+            if t - self.last[key] > older:
+                stale[grid.node_of(*g)] = g
+        if not stale:
+            return None
+        start = nearest_valid_node(grid.valid, grid.node_of(x, z), 6)
+        if start is None:
+            return None
+        if self._flat is None:
+            self._flat = grid.valid.ravel().tolist()
+        nx, ok = grid.nx, self._flat
+        s0 = start[0] * nx + start[1]
+        seen = {s0}
+        queue = deque([s0])
+        while queue:
+            n = queue.popleft()
+            g = stale.get(divmod(n, nx))
+            if g is not None:
+                return g
+            j = n % nx
+            for m in (n + 1 if j + 1 < nx else -1, n - 1 if j > 0 else -1, n + nx, n - nx):
+                if 0 <= m < len(ok) and ok[m] and m not in seen:
+                    seen.add(m)
+                    queue.append(m)
+        return None
+
+
+class Wanderer:
+    """The paper's decision among the three nodes ahead, with novelty and jitter.
+
+    ``memory`` None and ``jitter`` 0 give ``nav.steering.choose_next``'s choice.
+    """
+
+    def __init__(self, grid: NavGrid, memory: Memory | None = None, rng: random.Random | None = None,
+                 jitter: float = 0.2, cap: int = 12, look: int = 16, forget: float = 60.0,
+                 floor: float = 0.08, straight: float = 1.5) -> None:
+        self.grid = grid
+        self.memory = memory
+        self.rng = rng
+        self.jitter = jitter if rng is not None else 0.0
+        self.cap = cap
+        self.look = look
+        self.forget = forget
+        self.floor = floor
+        self.straight = straight
+        self.best_novelty = 1.0   # of the last choice: low when every way leads somewhere just seen
+
+    def novelty(self, node: Node, heading: str, ahead: int, t: float) -> float:
+        """1 + floor for a way into a region not visited for ``forget`` seconds, down
+        to ``floor`` for one just visited (the region ``look`` nodes down that way)."""
+        if self.memory is None:
+            return 1.0
+        k = min(ahead, self.look)
+        di, dj = STEPS[heading]
+        x, z = self.grid.centre(node[0] + di * k, node[1] + dj * k)
+        return self.floor + min(self.memory.since(x, z, t) / self.forget, 1.0)
+
+    def choose(self, node: Node, heading: str, t: float = 0.0) -> tuple[Node, str] | None:
+        """The next node and the heading after moving there; None when boxed in."""
+        kids = children(self.grid, node, heading)
+        if not kids:
+            return self._turn_in_place(node, heading)
+        if self.memory is None and self.jitter == 0.0:
+            pick = decide({c.name: c.ahead for c in kids})
+            c = next(c for c in kids if c.name == pick)
+            return c.node, c.heading
+        scores = {}
+        self.best_novelty = 0.0
+        for c in kids:
+            w = self.novelty(c.node, c.heading, c.ahead, t)
+            self.best_novelty = max(self.best_novelty, w - self.floor)
+            if self.jitter:
+                w *= 1.0 + self.jitter * self.rng.random()  # type: ignore[union-attr]
+            if c.name == "ahead":
+                w *= self.straight   # keep going: a zigzag of side steps is slower to drive
+            scores[c.name] = (min(c.ahead, self.cap) + 1) * w
+        best = max(scores.values())
+        for name in ("ahead", "right", "left"):
+            if scores.get(name) == best:
+                c = next(c for c in kids if c.name == name)
+                return c.node, c.heading
+        return None  # unreachable
+
+    def _turn_in_place(self, node: Node, heading: str) -> tuple[Node, str] | None:
+        from ...nav.steering import choose_next
+
+        nxt = choose_next(self.grid, node, heading)
+        if nxt is None:
+            return None
+        return nxt, heading_of_move(node, nxt, heading)
+
+
+# ------------------------------------------------------------------ search
+Rect = tuple[float, float, float, float]
+
+
+def _rect_distance(r: Rect, x: float, z: float) -> float:
+    x0, z0, x1, z1 = r
+    dx = max(x0 - x, 0.0, x - x1)
+    dz = max(z0 - z, 0.0, z - z1)
+    return math.hypot(dx, dz)
+
+
+def quadrants(r: Rect) -> list[Rect]:
+    """The four quadrants of a rectangle (x0, z0, x1, z1)."""
+    x0, z0, x1, z1 = r
+    xm, zm = 0.5 * (x0 + x1), 0.5 * (z0 + z1)
+    return [(x0, z0, xm, zm), (xm, z0, x1, zm), (x0, zm, xm, z1), (xm, zm, x1, z1)]
+
+
+def search_order(r: Rect, x: float, z: float, leaf: float) -> Iterator[Rect]:
+    """Leaf quadrants of ``r`` depth first, each level ordered by distance to (x, z)
+    (the quadrant holding it first, ties by centre distance)."""
+    x0, z0, x1, z1 = r
+    if max(x1 - x0, z1 - z0) <= leaf:
+        yield r
+        return
+    subs = sorted(quadrants(r), key=lambda q: (_rect_distance(q, x, z),
+                                               math.hypot(0.5 * (q[0] + q[2]) - x, 0.5 * (q[1] + q[3]) - z)))
+    for q in subs:
+        yield from search_order(q, x, z, leaf)
+
+
+def leaf_goal(grid: NavGrid, r: Rect) -> tuple[float, float] | None:
+    """A valid node's centre inside the quadrant, the nearest to its centre; None if none."""
+    x0, z0, x1, z1 = r
+    cx, cz = 0.5 * (x0 + x1), 0.5 * (z0 + z1)
+    steps = int(math.ceil(max(x1 - x0, z1 - z0) / (2 * grid.cell)))
+    n = nearest_valid_node(grid.valid, grid.node_of(cx, cz), steps)
+    if n is None:
+        return None
+    gx, gz = grid.centre(*n)
+    if not (x0 <= gx <= x1 and z0 <= gz <= z1):
+        return None
+    return gx, gz
+
+
+class SearchPlan:
+    """The quadrant search from an estimate (x, z): goals in the paper's order."""
+
+    def __init__(self, grid: NavGrid, x: float, z: float, leaf: float = 30.0) -> None:
+        self.grid = grid
+        (bx0, bz0), (bx1, bz1) = grid.bounds.tolist()
+        first = nearest_valid_node(grid.valid, grid.node_of(x, z), int(math.ceil(6.0 / grid.cell)))
+        self.goals: list[tuple[float, float]] = [grid.centre(*first)] if first is not None else []
+        for r in search_order((bx0, bz0, bx1, bz1), x, z, leaf):
+            g = leaf_goal(grid, r)
+            if g is not None:
+                self.goals.append(g)
+        self.k = 0
+
+    def next_goal(self, memory: Memory | None, t: float, fresh: float = 25.0) -> tuple[float, float] | None:
+        """The next goal not visited within ``fresh`` seconds; None when all are done."""
+        while self.k < len(self.goals):
+            g = self.goals[self.k]
+            self.k += 1
+            if memory is None or memory.since(g[0], g[1], t) > fresh or self.k == 1:
+                return g
+        return None
+
+
+def plan_path(grid: NavGrid, start: tuple[float, float], goal: tuple[float, float]) -> list[tuple[float, float]]:
+    """A* waypoints from start to goal (the first, our position, dropped); [] when none."""
+    pts = find_path(grid, start, goal, snap=int(math.ceil(4.0 / grid.cell)))
+    return [(float(x), float(z)) for x, z in pts[1:]]

@@ -1,0 +1,139 @@
+"""What an agent can know: sight, hearing and memory (the paper's "perceptores").
+
+* **Sight**: a target is seen when it lies within the vision range, within the cone's
+  half-angle of the heading (the hull carries the gun and the crew's view), and the
+  segment between the two centres crosses no wall.  That last test is the paper's
+  "línea imaginaria R" against every wall, asked of the world's wall quadtree (only
+  the walls in the leaves the segment passes are intersected).  Range and angle are
+  checked first because they cost nothing.
+* **Hearing**: a gunshot within the hearing radius reveals roughly where it came from:
+  the shooter's position plus Gaussian noise growing with distance.  A shot is the
+  shooter's shot counter going up (the same thing the world's ``shot`` event reports).
+* **Memory**: where each enemy was last seen (and its velocity then) and where the
+  latest shot was heard, with times; nothing else about other tanks is kept.
+* **Own state**: hit points (so the agent knows it was hit), speed, reload.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..body import Tank
+    from ..world import World
+
+
+def wrap(a: float) -> float:
+    """An angle in (-pi, pi]."""
+    return math.remainder(a, 2.0 * math.pi)
+
+
+@dataclass(frozen=True)
+class Sighting:
+    """One enemy seen at time ``t``: its index, centre and velocity then, and distance."""
+
+    index: int
+    x: float
+    z: float
+    vx: float
+    vz: float
+    t: float
+    distance: float
+
+
+@dataclass(frozen=True)
+class Heard:
+    """A shot heard at time ``t`` from around (x, z) (noisy)."""
+
+    x: float
+    z: float
+    t: float
+
+
+def in_cone(ox: float, oz: float, heading: float, tx: float, tz: float, half_angle: float, vision_range: float) -> bool:
+    """Is (tx, tz) within range and within ``half_angle`` of ``heading`` seen from (ox, oz)?"""
+    dx, dz = tx - ox, tz - oz
+    d2 = dx * dx + dz * dz
+    if d2 > vision_range * vision_range:
+        return False
+    if d2 == 0.0:
+        return True
+    return abs(wrap(math.atan2(dz, dx) - heading)) <= half_angle
+
+
+def can_see(walls, ox: float, oz: float, heading: float, tx: float, tz: float,
+            half_angle: float, vision_range: float) -> bool:
+    """The sight test: in the cone, in range, and no wall crossing the line of sight.
+
+    ``walls`` is the world's ``WallSet`` (or anything with ``blocked(ax, az, bx, bz)``).
+    """
+    return in_cone(ox, oz, heading, tx, tz, half_angle, vision_range) and not walls.blocked(ox, oz, tx, tz)
+
+
+class Senses:
+    """One agent's sensors and memory.
+
+    Parameters
+    ----------
+    half_angle : vision cone half-angle [rad]
+    vision_range : how far it sees [m]
+    hearing_radius : how far a shot is heard [m]
+    hearing_noise : standard deviation of the heard position, as a fraction of the distance
+    rng : the agent's generator (noise)
+    """
+
+    def __init__(self, half_angle: float, vision_range: float, hearing_radius: float,
+                 hearing_noise: float, rng: random.Random) -> None:
+        self.half_angle = half_angle
+        self.vision_range = vision_range
+        self.hearing_radius = hearing_radius
+        self.hearing_noise = hearing_noise
+        self.rng = rng
+        self.last_seen: dict[int, Sighting] = {}
+        self.heard: Heard | None = None
+        self._shots: dict[int, int] = {}
+        self.hp = math.inf
+
+    def look(self, world: "World", me: "Tank") -> list[Sighting]:
+        """The live enemies in sight now, nearest first; remembered as last seen."""
+        out = []
+        for o in world.tanks:
+            if o is me or not o.alive:
+                continue
+            if can_see(world.walls, me.x, me.z, me.heading, o.x, o.z, self.half_angle, self.vision_range):
+                s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z))
+                self.last_seen[o.index] = s
+                out.append(s)
+        out.sort(key=lambda s: (s.distance, s.index))
+        return out
+
+    def listen(self, world: "World", me: "Tank") -> Heard | None:
+        """Shots fired since the last call within the hearing radius: the nearest one."""
+        best, best_d = None, math.inf
+        for o in world.tanks:
+            if o is me:
+                continue
+            before = self._shots.get(o.index, o.shots)
+            self._shots[o.index] = o.shots
+            if o.shots <= before:
+                continue
+            d = math.hypot(o.x - me.x, o.z - me.z)
+            if d <= self.hearing_radius and d < best_d:
+                best_d = d
+                sd = self.hearing_noise * d
+                best = Heard(o.x + self.rng.gauss(0.0, sd), o.z + self.rng.gauss(0.0, sd), world.t)
+        if best is not None:
+            self.heard = best
+        return best
+
+    def hit_taken(self, me: "Tank") -> float:
+        """Damage taken since the last call (0 on the first call and after a respawn's refill)."""
+        lost = self.hp - me.hp if (me.hp < self.hp and math.isfinite(self.hp)) else 0.0
+        self.hp = me.hp
+        return lost
+
+    def forget(self, index: int) -> None:
+        self.last_seen.pop(index, None)
