@@ -121,9 +121,13 @@ def make_bots(world: World, bot: str = "agent", difficulty: str = "normal") -> l
 def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 60.0, seed: int = 0,
               dt: float = DT, integrator: str = "semi-implicit",
               on_progress: Callable[[int], None] | None = None, progress_every: int = 120,
-              bot: str = "agent", difficulty: str = "normal") -> MatchResult:
+              bot: str = "agent", difficulty: str = "normal",
+              wrap_drivers: Callable[[World, list], list] | None = None) -> MatchResult:
     """Run ``bots`` tanks for ``seconds`` of simulated time, driven by computer agents
-    at ``difficulty`` (``bot="agent"``) or by the scripted baseline (``bot="scripted"``)."""
+    at ``difficulty`` (``bot="agent"``) or by the scripted baseline (``bot="scripted"``).
+
+    ``wrap_drivers(world, drivers) -> drivers`` may wrap or replace the drivers once
+    they are made: sim/replay.py records the commands or plays a recording back."""
     if bots < 1:
         raise TanktoolError(f"--bots must be at least 1, got {bots}")
     if not (seconds > 0 and math.isfinite(seconds)):
@@ -132,6 +136,8 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
     world = World(arena.walls, [spec] * bots, arena.spawns, seed=seed, dt=dt, integrator=integrator, names=names,
                   bounds=arena.bounds)
     drivers = make_bots(world, bot, difficulty)
+    if wrap_drivers is not None:
+        drivers = wrap_drivers(world, drivers)
     steps = int(round(seconds / dt))
     events = []
     trail_every = max(int(round(TRAIL_PERIOD / dt)), 1)

@@ -1,0 +1,372 @@
+"""Match replays: a match is its seed, its setup and every tank's commands.
+
+The simulation is deterministic, so a recorded match played back with the same
+arena, vehicle and commands reaches the same state bit for bit.  The recorder wraps
+the match's drivers (keyboard, agent, scripted bot, peer alike: all produce
+``Command`` values) and keeps a command only when it differs from that tank's
+previous one; playback swaps the drivers for ones that read the tape.
+
+File layout (``.ttr``, all integers little-endian)::
+
+    bytes 0-3   b"TTRP"                  magic
+    byte  4     1                        format version
+    bytes 5-8   u32 H                    header length
+    9 .. 9+H    UTF-8 JSON header        setup, fingerprints, final-state digest
+    9+H ..      zlib stream              the command changes, column by column:
+                  u32[n] step deltas, u16[n] tank, f64[n] advance, f64[n] rotate,
+                  f64[n] strafe, u8[n] fire
+                (each multi-byte column stored as byte planes -- all first bytes,
+                then all second bytes, ... -- which zlib packs much better)
+
+A change record (step k, tank i, command c) means tank i's driver returned c before
+step k+1 (when ``world.steps == k``) and keeps returning it until the next record of
+tank i; before its first record a tank is idle.  The header carries the world's
+random-generator state right after the drivers were made (so playback does not
+depend on how they consumed it), fingerprints of the walls, spawns and vehicle (a
+changed arena is refused, not silently replayed into another match), and a sha256 of
+the final world state and scores so that playback can say whether it matched.
+"""
+
+from __future__ import annotations
+
+import base64
+import hashlib
+import json
+import math
+import os
+import struct
+import zlib
+from dataclasses import dataclass, field, fields
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Callable, Sequence
+
+import numpy as np
+
+from .. import __version__
+from ..errors import FormatError, TanktoolError
+from .commands import IDLE, Command
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .body import Tank, TankSpec
+    from .match import ArenaInfo, MatchResult
+    from .world import World
+
+MAGIC = b"TTRP"
+VERSION = 1
+_PREFIX = struct.Struct("<4sBI")
+#: bytes per change record before compression
+RECORD_BYTES = 4 + 2 + 3 * 8 + 1
+
+
+# ---------------------------------------------------------------- fingerprints
+
+def _plain(value: Any) -> Any:
+    """JSON-ready nested lists; floats keep every bit (json writes repr)."""
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _sha(obj: Any) -> str:
+    return hashlib.sha256(json.dumps(obj, sort_keys=True, default=str).encode()).hexdigest()
+
+
+def arena_fingerprint(arena: "ArenaInfo") -> str:
+    """sha256 of what the simulation sees of an arena: walls (with the auxiliary
+    rectangle), spawn points and bounds."""
+    walls = arena.walls.all_segments() if hasattr(arena.walls, "all_segments") else arena.walls
+    bounds = None if arena.bounds is None else np.asarray(arena.bounds, dtype=np.float64)
+    return _sha([_plain(np.asarray(walls, dtype=np.float64)), _plain(np.asarray(arena.spawns, dtype=np.float64)),
+                 _plain(bounds)])
+
+
+def spec_fingerprint(spec: "TankSpec") -> str:
+    """sha256 of a TankSpec's defining fields (geometry and physics)."""
+    return _sha({f.name: _plain(getattr(spec, f.name)) for f in fields(spec) if f.init})
+
+
+def state_digest(world: "World") -> str:
+    """sha256 of every evolving number of the world and the tanks' scores: equal
+    digests mean equal states bit for bit (repr of a float is exact)."""
+    scores = [(t.kills, t.deaths, t.shots, t.hits, t.wall_bumps, repr(t.distance)) for t in world.tanks]
+    return hashlib.sha256(repr((world.state(), scores)).encode()).hexdigest()
+
+
+# ---------------------------------------------------------------- the tape
+
+@dataclass
+class Replay:
+    """A recorded match.
+
+    header : setup (``arena``, ``vehicle``, ``bots``, ``seconds``, ``seed``, ``dt``,
+             ``integrator``, ``options`` for run_match), fingerprints, ``rng_state``,
+             ``final_state`` digest
+    steps : (n,) int64, the world step count at which each change was made
+    tanks : (n,) int64, tank index of each change
+    values : (n, 3) float64, advance / rotate / strafe
+    fire : (n,) bool
+    """
+
+    header: dict[str, Any]
+    steps: np.ndarray
+    tanks: np.ndarray
+    values: np.ndarray
+    fire: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.steps)
+
+    def timeline(self, tank: int) -> tuple[list[int], list[Command]]:
+        """One tank's change steps and commands, in order."""
+        idx = np.flatnonzero(self.tanks == tank)
+        return ([int(s) for s in self.steps[idx]],
+                [Command(*(float(v) for v in self.values[k]), bool(self.fire[k])) for k in idx])
+
+    def restore_rng(self, world: "World") -> None:
+        """Put the world's generator where it was when the recording started."""
+        raw = base64.b64decode(self.header["rng_state"])
+        words = struct.unpack(f"<{len(raw) // 4}I", raw)
+        world.rng.setstate((3, tuple(words), None))
+
+    def wrap(self, world: "World", drivers: Sequence[Any] = ()) -> list["ReplayDriver"]:
+        """``run_match``'s ``wrap_drivers`` hook: ignore the match's own drivers,
+        restore the recorded generator state and drive every tank from the tape."""
+        if len(world.tanks) != int(self.header["bots"]):
+            raise TanktoolError(f"replay has {self.header['bots']} tanks, the world {len(world.tanks)}")
+        self.restore_rng(world)
+        return [ReplayDriver(*self.timeline(i)) for i in range(len(world.tanks))]
+
+
+class ReplayDriver:
+    """Returns the recorded command of one tank for the world's current step."""
+
+    def __init__(self, steps: list[int], commands: list[Command]) -> None:
+        self.steps = steps
+        self.commands = commands
+        self.cursor = 0
+        self.command: Command = IDLE
+
+    def __call__(self, world: "World", tank: "Tank") -> Command:
+        k = world.steps
+        while self.cursor < len(self.steps) and self.steps[self.cursor] <= k:
+            self.command = self.commands[self.cursor]
+            self.cursor += 1
+        return self.command
+
+
+class _RecordingDriver:
+    def __init__(self, inner: Callable, recorder: "Recorder", index: int) -> None:
+        self.inner = inner
+        self.recorder = recorder
+        self.index = index
+
+    def __call__(self, world: "World", tank: "Tank") -> Command | None:
+        cmd = self.inner(world, tank)
+        self.recorder.record(world.steps, self.index, IDLE if cmd is None else cmd)
+        return cmd
+
+
+@dataclass
+class Recorder:
+    """Collects command changes; ``wrap`` is ``run_match``'s ``wrap_drivers`` hook."""
+
+    steps: list[int] = field(default_factory=list)
+    tanks: list[int] = field(default_factory=list)
+    values: list[tuple[float, float, float]] = field(default_factory=list)
+    fire: list[bool] = field(default_factory=list)
+    rng_state: str = ""
+    last: list[tuple[float, float, float, bool]] = field(default_factory=list)
+
+    def wrap(self, world: "World", drivers: Sequence[Callable]) -> list[Callable]:
+        version, words, _gauss = world.rng.getstate()
+        if version != 3:  # pragma: no cover - CPython's Mersenne Twister
+            raise TanktoolError("cannot record: unexpected random generator state")
+        self.rng_state = base64.b64encode(struct.pack(f"<{len(words)}I", *words)).decode()
+        self.last = [IDLE.to_tuple()] * len(drivers)
+        return [_RecordingDriver(d, self, i) for i, d in enumerate(drivers)]
+
+    def record(self, step: int, tank: int, command: Command) -> None:
+        t = command.to_tuple()
+        # compare bit patterns, not values: -0.0 == 0.0 but must replay as itself
+        if repr(t) == repr(self.last[tank]):
+            return
+        self.last[tank] = t
+        self.steps.append(step)
+        self.tanks.append(tank)
+        self.values.append(t[:3])
+        self.fire.append(t[3])
+
+    def replay(self, header: dict[str, Any]) -> Replay:
+        """The recording as a :class:`Replay` with ``header`` (plus the rng state)."""
+        h = dict(header)
+        h["rng_state"] = self.rng_state
+        return Replay(h, np.asarray(self.steps, dtype=np.int64), np.asarray(self.tanks, dtype=np.int64),
+                      np.asarray(self.values, dtype=np.float64).reshape(-1, 3), np.asarray(self.fire, dtype=bool))
+
+
+# ---------------------------------------------------------------- bytes
+
+def _planes(a: np.ndarray) -> bytes:
+    b = np.ascontiguousarray(a).view(np.uint8).reshape(len(a), a.dtype.itemsize)
+    return b.T.tobytes()
+
+
+def _unplanes(buf: bytes, n: int, dtype: str) -> np.ndarray:
+    size = np.dtype(dtype).itemsize
+    b = np.frombuffer(buf, dtype=np.uint8).reshape(size, n).T.copy()
+    return b.view(dtype).reshape(n)
+
+
+def encode(replay: Replay) -> bytes:
+    """The replay file's bytes."""
+    n = len(replay)
+    steps = replay.steps.astype(np.int64)
+    deltas = np.diff(steps, prepend=0)
+    if n and (deltas.min() < 0 or steps.max() >= 2 ** 32):
+        raise TanktoolError("replay steps must be non-decreasing and below 2**32")
+    body = b"".join([
+        _planes(deltas.astype("<u4")), _planes(replay.tanks.astype("<u2")),
+        _planes(replay.values[:, 0].astype("<f8")), _planes(replay.values[:, 1].astype("<f8")),
+        _planes(replay.values[:, 2].astype("<f8")), replay.fire.astype(np.uint8).tobytes(),
+    ])
+    header = dict(replay.header)
+    header["changes"] = n
+    head = json.dumps(header, sort_keys=True, separators=(",", ":")).encode()
+    return _PREFIX.pack(MAGIC, VERSION, len(head)) + head + zlib.compress(body, 9)
+
+
+def decode(data: bytes, path: str | os.PathLike = "<replay>") -> Replay:
+    """Parse replay bytes; FormatError names ``path`` and the byte offset."""
+    if len(data) < _PREFIX.size or data[:4] != MAGIC:
+        raise FormatError(f"{path}: byte 0: not a tanktool replay (expected magic {MAGIC.decode()})")
+    _, version, hlen = _PREFIX.unpack_from(data)
+    if version != VERSION:
+        raise FormatError(f"{path}: byte 4: replay format version {version}, this tool reads {VERSION}")
+    start = _PREFIX.size
+    if start + hlen > len(data):
+        raise FormatError(f"{path}: byte 5: header of {hlen} bytes runs past the end of the file ({len(data)} bytes)")
+    try:
+        header = json.loads(data[start:start + hlen].decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as e:
+        pos = getattr(e, "pos", getattr(e, "start", 0))
+        raise FormatError(f"{path}: byte {start + pos}: replay header is not valid JSON") from None
+    if not isinstance(header, dict):
+        raise FormatError(f"{path}: byte {start}: replay header must be a JSON object")
+    need = ("bots", "steps", "seed", "dt", "integrator", "rng_state", "changes", "final_state")
+    missing = [k for k in need if k not in header]
+    if missing:
+        raise FormatError(f"{path}: byte {start}: replay header lacks {', '.join(missing)}")
+    n = header["changes"]
+    bots = header["bots"]
+    if not (isinstance(n, int) and n >= 0 and isinstance(bots, int) and bots >= 1):
+        raise FormatError(f"{path}: byte {start}: replay header 'changes'/'bots' must be counts")
+    body_at = start + hlen
+    try:
+        body = zlib.decompress(data[body_at:])
+    except zlib.error as e:
+        raise FormatError(f"{path}: byte {body_at}: command data is damaged ({e})") from None
+    if len(body) != n * RECORD_BYTES:
+        raise FormatError(f"{path}: byte {body_at}: command data holds {len(body)} bytes, "
+                          f"{n} changes need {n * RECORD_BYTES}")
+    o = 0
+    cols = []
+    for dtype in ("<u4", "<u2", "<f8", "<f8", "<f8"):
+        size = np.dtype(dtype).itemsize * n
+        cols.append(_unplanes(body[o:o + size], n, dtype))
+        o += size
+    fire = np.frombuffer(body[o:o + n], dtype=np.uint8)
+    steps = np.cumsum(cols[0].astype(np.int64))
+    tanks = cols[1].astype(np.int64)
+    values = np.column_stack(cols[2:5]) if n else np.zeros((0, 3))
+    if n and (tanks.max() >= bots or steps.max() >= int(header["steps"]) or fire.max() > 1):
+        raise FormatError(f"{path}: byte {body_at}: a command names a tank or step outside the match")
+    if n and not np.isfinite(values).all():
+        raise FormatError(f"{path}: byte {body_at}: a command strength is not finite")
+    return Replay(header, steps, tanks, values, fire.astype(bool))
+
+
+def write_replay(path: str | os.PathLike, replay: Replay) -> int:
+    """Write atomically; returns the file size in bytes."""
+    from ..formats.bundle import atomic_write_bytes
+
+    data = encode(replay)
+    atomic_write_bytes(path, data)
+    return len(data)
+
+
+def read_replay(path: str | os.PathLike) -> Replay:
+    try:
+        data = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise FormatError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise FormatError(f"{path}: is a folder, expected a replay file") from None
+    except OSError as e:
+        raise FormatError(f"{path}: cannot read: {e.strerror}") from None
+    return decode(data, path)
+
+
+# ---------------------------------------------------------------- matches
+
+def record_match(arena: "ArenaInfo", spec: "TankSpec", *, bots: int, seconds: float, seed: int,
+                 arena_ref: str | None = None, vehicle_ref: str | None = None,
+                 on_progress: Callable[[int], None] | None = None,
+                 **options: Any) -> tuple["MatchResult", Replay]:
+    """Run a match with :func:`run_match` (``options``: integrator, dt, bot kind,
+    difficulty, ...) and record it."""
+    from .match import run_match
+
+    rec = Recorder()
+    result = run_match(arena, spec, bots=bots, seconds=seconds, seed=seed, on_progress=on_progress,
+                       wrap_drivers=rec.wrap, **options)
+    world = result.world
+    header = {
+        "format": "tanktool-replay", "tool_version": __version__,
+        "arena": arena.name, "arena_ref": arena_ref if arena_ref is not None else
+        (str(arena.path) if arena.path is not None else arena.name),
+        "arena_sha256": arena_fingerprint(arena),
+        "vehicle": spec.name, "vehicle_ref": vehicle_ref, "vehicle_sha256": spec_fingerprint(spec),
+        "bots": len(world.tanks), "names": world.names, "seconds": float(seconds), "seed": int(seed),
+        "steps": int(world.steps), "dt": world.dt, "integrator": world.integrator,
+        "options": {k: v for k, v in options.items() if k not in ("dt", "integrator")},
+        "final_state": state_digest(world),
+        "winner": result.report.get("winner"),
+    }
+    return result, rec.replay(header)
+
+
+@dataclass
+class Playback:
+    """What :func:`play_replay` produced: the match result and whether its final
+    state is the recorded one."""
+
+    result: "MatchResult"
+    digest: str
+    matches: bool
+
+
+def play_replay(replay: Replay, arena: "ArenaInfo", spec: "TankSpec",
+                on_progress: Callable[[int], None] | None = None) -> Playback:
+    """Play a replay back on ``arena`` with ``spec`` (checked against the
+    recording's fingerprints) and compare the final state."""
+    from .match import run_match
+
+    h = replay.header
+    if h.get("arena_sha256") and arena_fingerprint(arena) != h["arena_sha256"]:
+        raise TanktoolError(f"arena {arena.name!r} is not the one the replay was recorded on "
+                            f"(its walls, spawns or bounds differ)")
+    if h.get("vehicle_sha256") and spec_fingerprint(spec) != h["vehicle_sha256"]:
+        raise TanktoolError(f"vehicle {spec.name!r} is not the one the replay was recorded with")
+    seconds = float(h.get("seconds", int(h["steps"]) * float(h["dt"])))
+    dt = float(h["dt"])
+    if int(round(seconds / dt)) != int(h["steps"]) or not math.isfinite(seconds):
+        raise TanktoolError(f"replay header: seconds {seconds} and dt {dt} do not give {h['steps']} steps")
+    result = run_match(arena, spec, bots=int(h["bots"]), seconds=seconds, seed=int(h["seed"]), dt=dt,
+                       integrator=str(h["integrator"]), on_progress=on_progress, wrap_drivers=replay.wrap,
+                       **dict(h.get("options") or {}))
+    digest = state_digest(result.world)
+    return Playback(result, digest, digest == h["final_state"])
