@@ -242,3 +242,24 @@ def test_difficulty_levels():
         difficulty("godlike")
     w = box_world([(20.0, 10.0), (50.0, 14.0)])
     assert [a.level.name for a in make_agents(w, "hard")] == ["hard", "hard"]
+
+
+def test_play_cli_difficulty_and_bot_driver(tmp_path):
+    import json
+
+    from click.testing import CliRunner
+
+    from tanktool.cli.main import cli
+
+    out = tmp_path / "r.json"
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", "box", "--bots", "3", "--seconds", "3",
+                                 "--difficulty", "hard", "--report", str(out)])
+    assert r.exit_code == 0, r.output
+    rep = json.loads(out.read_text())
+    assert rep["bots"] == "agent" and rep["difficulty"] == "hard"
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", "box", "--bots", "2", "--seconds", "2",
+                                 "--bot-driver", "scripted", "--report", str(out)])
+    assert r.exit_code == 0, r.output
+    assert json.loads(out.read_text())["bots"] == "scripted"
+    r = CliRunner().invoke(cli, ["play", "--headless", "--difficulty", "insane"])
+    assert r.exit_code == 2 and "insane" in r.output and "Traceback" not in r.output

@@ -1,7 +1,8 @@
 """``tanktool play``: a match.
 
-``--headless`` runs scripted bots without window or sound as fast as the machine allows
-and can write a JSON report; with ``--frames``/``--screenshot`` it renders one picture
+``--headless`` runs the bots (computer agents at ``--difficulty``, or with
+``--bot-driver scripted`` the old scripted bots) without window or sound as fast as
+the machine allows and can write a JSON report; with ``--frames``/``--screenshot`` it renders one picture
 of the 3D or top view instead (``tanktool.game.headless``).  Without ``--headless`` the
 game window opens (``tanktool.game.app``); when there is no display to open it on, the
 command says so and does the best thing that exists: a short headless match on the
@@ -40,7 +41,7 @@ def _size(text: str) -> tuple[int, int]:
 
 
 @click.command("play")
-@click.option("--headless", is_flag=True, help="No window or sound: run scripted bots as fast as possible.")
+@click.option("--headless", is_flag=True, help="No window or sound: run the bots as fast as possible.")
 @click.option("--arena", "arena", default=None, metavar="A",
               help="Arena bundle: a folder, or the name of a bundled one (box, maze, paper2002).")
 @click.option("--vehicle", "vehicle", default=None, metavar="V",
@@ -49,6 +50,10 @@ def _size(text: str) -> tuple[int, int]:
 @click.option("--seconds", type=click.FloatRange(0, 86400, min_open=True), default=None,
               help="Simulated seconds (default 60 headless, 20 otherwise).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed: same seed, same match.")
+@click.option("--difficulty", type=click.Choice(["easy", "normal", "hard"]), default="normal", show_default=True,
+              help="Computer opponents' skill: reaction time, aim noise, vision range (headless matches).")
+@click.option("--bot-driver", "bot_driver", type=click.Choice(["agent", "scripted"]), default="agent",
+              show_default=True, help="Who drives the bots: the computer agent, or the old scripted bot (the baseline).")
 @click.option("--integrator", type=click.Choice(["semi-implicit", "euler"]), default="semi-implicit",
               show_default=True, help="Semi-implicit Euler, or the 2002 paper's explicit Euler.")
 @click.option("--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
@@ -68,7 +73,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
          seed: int, integrator: str, report_path: Path | None, picture: Path | None, view: str,
          frames: int | None, screenshot: Path | None, size: str, fullscreen: bool,
          host: str | None = None, join: str | None = None, player_name: str | None = None,
-         password: str | None = None) -> None:
+         password: str | None = None, difficulty: str = "normal", bot_driver: str = "agent") -> None:
     """Play a match: bots on an arena.
 
     \b
@@ -122,7 +127,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
     steps = int(round(seconds * 120))
     with progress(length=steps, label=f"{info.name}: {bots} bots, {seconds:g} s") as bar:
         result = run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
-                           integrator=integrator, on_progress=bar.update)
+                           integrator=integrator, on_progress=bar.update, bot=bot_driver, difficulty=difficulty)
     report = result.report
     echo(scoreboard(report))
     timing = report["timing"]

@@ -1,0 +1,200 @@
+"""Computer opponents, measured: duels against the baseline bot, wall bumps, time to
+first sight, time stuck, and the agents' CPU per simulated step.
+
+For every bundled arena and difficulty:
+
+* **duels**: N one-against-one matches (``--seconds`` each, default 60) of our agent
+  against the baseline, the scripted bot of ``sim.driver.ScriptedDriver`` (roam to
+  random waypoints, feel for walls, back off when stuck, turn on and shoot at the
+  nearest tank within 60 degrees and 120 m, 3 degree aim error).  Match k uses seed k;
+  the agent is tank 0 in even matches and tank 1 in odd ones, so neither gets the
+  better spawns.  A win is more kills than the baseline; equal kills is a draw.
+* **bumps/min**: wall bumps (the world's count: a wall contact with an impulse after
+  0.25 s without one) per simulated minute, in those duels, ours and the baseline's.
+* **stuck**: the fraction of 0.25 s samples, alive, with speed < 0.3 m/s and turn rate
+  < 0.1 rad/s while not attacking (the baseline: while it has no target in view).
+* **first sight**: the agent alone with an enemy that never moves (M runs, seed k,
+  random spawns): simulated seconds until the enemy is first seen, median over the
+  runs, capped at ``--cap`` s (runs that never saw it count as the cap); the baseline
+  in the same situation beside it.
+
+Then the CPU cost: 8 tanks on each arena, all agents (normal) or all baseline bots,
+``--cpu-steps`` steps; the time spent deciding per simulated step, for all 8 together.
+
+    python bench/bots.py [--matches N] [--sight-runs M] [--seconds S] [--arenas a,b]
+                         [--levels easy,normal,hard] [--json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import random
+import statistics
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from tanktool.sim.agents import DIFFICULTIES, Agent  # noqa: E402
+from tanktool.sim.commands import IDLE  # noqa: E402
+from tanktool.sim.driver import ScriptedDriver  # noqa: E402
+from tanktool.sim.match import load_match_arena, load_tank_spec  # noqa: E402
+from tanktool.sim.world import World  # noqa: E402
+
+SAMPLE = 0.25   # seconds between stuck samples
+
+
+def _stuck(tank) -> bool:
+    return tank.alive and tank.speed() < 0.3 and abs(tank.omega) < 0.1
+
+
+def duel(arena, spec, seed: int, level: str, seconds: float) -> dict:
+    """One agent against one baseline bot; the agent's and the baseline's numbers."""
+    ours = seed % 2
+    world = World(arena.walls, [spec, spec], arena.spawns, seed=seed, bounds=arena.bounds)
+    drivers: list = [None, None]
+    drivers[ours] = Agent(random.Random(world.rng.getrandbits(64)), level)
+    drivers[1 - ours] = ScriptedDriver(random.Random(world.rng.getrandbits(64)))
+    agent, base = drivers[ours], drivers[1 - ours]
+    every = int(round(SAMPLE / world.dt))
+    samples = [0, 0]
+    stuck = [0, 0]
+    tanks = world.tanks
+    for k in range(int(round(seconds / world.dt))):
+        world.step(None, [d(world, t) for d, t in zip(drivers, tanks)])
+        if k % every == 0:
+            a, b = tanks[ours], tanks[1 - ours]
+            if a.alive:
+                samples[0] += 1
+                stuck[0] += _stuck(a) and agent.state != "attack"
+            if b.alive:
+                samples[1] += 1
+                stuck[1] += _stuck(b) and base._target(world, b) is None
+    a, b = tanks[ours], tanks[1 - ours]
+    return {"kills": (a.kills, b.kills), "bumps": (a.wall_bumps, b.wall_bumps),
+            "stuck": (stuck[0] / max(samples[0], 1), stuck[1] / max(samples[1], 1))}
+
+
+def first_sight(arena, spec, seed: int, level: str | None, cap: float) -> float:
+    """Seconds until the driver first sees a stationary enemy (``level`` None: the baseline)."""
+    world = World(arena.walls, [spec, spec], arena.spawns, seed=seed, bounds=arena.bounds)
+    rng = random.Random(world.rng.getrandbits(64))
+    me, enemy = world.tanks
+    if level is None:
+        driver = ScriptedDriver(rng)
+
+        def seen() -> bool:
+            return driver._target(world, me) is enemy
+    else:
+        driver = Agent(rng, level)
+
+        def seen() -> bool:
+            return enemy.index in driver.senses.last_seen
+    for _ in range(int(round(cap / world.dt))):
+        world.step(None, [driver(world, me), IDLE])
+        if seen():
+            return world.t
+    return cap
+
+
+def cpu(arena, spec, kind: str, steps: int) -> float:
+    """Mean seconds per simulated step spent by 8 drivers deciding."""
+    world = World(arena.walls, [spec] * 8, arena.spawns, seed=1, bounds=arena.bounds)
+    if kind == "agent":
+        drivers = [Agent(random.Random(world.rng.getrandbits(64)), "normal") for _ in range(8)]
+    else:
+        drivers = [ScriptedDriver(random.Random(world.rng.getrandbits(64))) for _ in range(8)]
+    tanks = world.tanks
+    spent = 0.0
+    for _ in range(steps):
+        t0 = time.perf_counter()
+        cmds = [d(world, t) for d, t in zip(drivers, tanks)]
+        spent += time.perf_counter() - t0
+        world.step(None, cmds)
+    return spent / steps
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--matches", type=int, default=100, help="duels per arena and difficulty (default 100)")
+    ap.add_argument("--sight-runs", type=int, default=20, help="first-sight runs per arena and difficulty")
+    ap.add_argument("--seconds", type=float, default=60.0, help="simulated seconds per duel")
+    ap.add_argument("--cap", type=float, default=180.0, help="first-sight runs stop here [s]")
+    ap.add_argument("--cpu-steps", type=int, default=3000)
+    ap.add_argument("--arenas", default="box,maze,paper2002")
+    ap.add_argument("--levels", default="easy,normal,hard")
+    ap.add_argument("--vehicle", default="light")
+    ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    args = ap.parse_args(argv)
+    spec = load_tank_spec(args.vehicle)
+    arenas = [load_match_arena(a) for a in args.arenas.split(",")]
+    levels = [lv for lv in args.levels.split(",") if lv]
+    for lv in levels:
+        if lv not in DIFFICULTIES:
+            ap.error(f"--levels: {lv!r} is not one of {', '.join(DIFFICULTIES)}")
+    rows = []
+    base_sight: dict[str, float] = {}
+    t_start = time.perf_counter()
+    for arena in arenas:
+        runs = range(args.sight_runs)
+        base_sight[arena.name] = statistics.median(first_sight(arena, spec, k, None, args.cap) for k in runs)
+        for lv in levels:
+            res = [duel(arena, spec, k, lv, args.seconds) for k in range(args.matches)]
+            wins = sum(r["kills"][0] > r["kills"][1] for r in res)
+            losses = sum(r["kills"][0] < r["kills"][1] for r in res)
+            minutes = args.matches * args.seconds / 60.0
+            sights = [first_sight(arena, spec, k, lv, args.cap) for k in runs]
+            rows.append({
+                "arena": arena.name, "level": lv, "matches": args.matches,
+                "wins": wins, "losses": losses, "draws": args.matches - wins - losses,
+                "win_rate": wins / args.matches,
+                "win_rate_decided": wins / (wins + losses) if wins + losses else None,
+                "kills": sum(r["kills"][0] for r in res), "baseline_kills": sum(r["kills"][1] for r in res),
+                "bumps_per_min": sum(r["bumps"][0] for r in res) / minutes,
+                "baseline_bumps_per_min": sum(r["bumps"][1] for r in res) / minutes,
+                "stuck": statistics.fmean(r["stuck"][0] for r in res),
+                "baseline_stuck": statistics.fmean(r["stuck"][1] for r in res),
+                "first_sight_median_s": statistics.median(sights),
+                "first_sight_not_found": sum(s >= args.cap for s in sights),
+                "baseline_first_sight_median_s": base_sight[arena.name],
+            })
+            if not args.json:
+                print(f"  {arena.name} {lv}: done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
+    cpu_rows = [{"arena": a.name, "agent_ms_per_step_8": 1e3 * cpu(a, spec, "agent", args.cpu_steps),
+                 "baseline_ms_per_step_8": 1e3 * cpu(a, spec, "scripted", args.cpu_steps)} for a in arenas]
+    out = {"vehicle": spec.name, "seconds_per_duel": args.seconds, "sight_runs": args.sight_runs,
+           "sight_cap_s": args.cap, "baseline": "sim.driver.ScriptedDriver", "rows": rows, "cpu": cpu_rows,
+           "wall_clock_s": round(time.perf_counter() - t_start, 1)}
+    if args.json:
+        print(json.dumps(out))
+        return 0
+    print(f"agent vs baseline (ScriptedDriver), {spec.name} tanks, 1-on-1 duels of {args.seconds:g} s, "
+          f"{args.matches} per row; first sight: median of {args.sight_runs} runs, cap {args.cap:g} s")
+    head = (f"{'arena':<10} {'level':<7} {'W-L-D':>11} {'win%':>5} {'win% dec':>8} {'kills':>9} "
+            f"{'bumps/min':>11} {'stuck %':>11} {'1st sight s':>13}")
+    print(head)
+    print(f"{'':<10} {'':<7} {'':>11} {'':>5} {'':>8} {'us/base':>9} {'us/base':>11} {'us/base':>11} "
+          f"{'us/base':>13}")
+    print("-" * len(head))
+    for r in rows:
+        dec = f"{100 * r['win_rate_decided']:.0f}" if r["win_rate_decided"] is not None else "-"
+        sight = f"{r['first_sight_median_s']:.0f}/{r['baseline_first_sight_median_s']:.0f}"
+        print(f"{r['arena']:<10} {r['level']:<7} {r['wins']:>3}-{r['losses']}-{r['draws']:<3} "
+              f"{100 * r['win_rate']:>5.0f} {dec:>8} {r['kills']:>4}/{r['baseline_kills']:<4} "
+              f"{r['bumps_per_min']:>5.2f}/{r['baseline_bumps_per_min']:<5.2f} "
+              f"{100 * r['stuck']:>5.1f}/{100 * r['baseline_stuck']:<5.1f} {sight:>13}")
+    print()
+    print(f"{'arena':<10} {'8 agents ms/step':>17} {'8 baseline ms/step':>19}")
+    for c in cpu_rows:
+        print(f"{c['arena']:<10} {c['agent_ms_per_step_8']:>17.3f} {c['baseline_ms_per_step_8']:>19.3f}")
+    print("goals at normal: win rate >= 80 %, < 1 bump/min, stuck < 2 %; agents for 8 tanks < 1 ms per step")
+    print(f"wall clock {out['wall_clock_s']:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
