@@ -63,6 +63,11 @@ def test_overlays_add_quadtree_navgrid_and_agents(box_frame):
     with pytest.raises(ValueError):
         view.toggle("weather")
     info = agent_view(s.drivers[1], s.world, s.world.tanks[1])
+    from tanktool.sim.agents import STATES
+
+    assert info["state"] in STATES and info["sight"] > 0 and 0 < info["fov"] < 3.2
+    scripted = GameSession("box", bots=2, seed=1, player=False, bot="scripted")
+    info = agent_view(scripted.drivers[0], scripted.world, scripted.world.tanks[0])
     assert info["state"] in ("roaming", "attacking", "backing off") and info["sight"] > 0
 
 

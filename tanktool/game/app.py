@@ -161,10 +161,10 @@ class App:
         self.menu = Menu(Choice("arena", arenas + ([arena] if arena and arena not in arenas else [])),
                          Choice("vehicle", vehicles + ([vehicle] if vehicle and vehicle not in vehicles else [])
                                 or [None]))
-        if arena:
-            self.menu.arena.set(arena)
-        if vehicle:
-            self.menu.vehicle.set(vehicle)
+        from ..sim.match import default_arena, default_vehicle
+
+        self.menu.arena.set(arena or default_arena())
+        self.menu.vehicle.set(vehicle or default_vehicle())
         self.menu.bots.set(min(max(bots, 0), 7))
         self.menu.view.set(view)
         res = f"{size[0]}x{size[1]}"
@@ -398,9 +398,12 @@ class App:
 
         surf.fill(BG)
         w, h = surf.get_size()
-        text(surf, "tanktool", (w // 2, 40), 72, anchor="midtop")
+        # the list shrinks to fit small windows: title, items, two lines of help
+        line = max(min(42, (h - 190) // len(self.menu.ITEMS)), 16)
+        size = max(int(line * 0.8), 14)
+        text(surf, "tanktool", (w // 2, 20), max(min(72, h // 8), 28), anchor="midtop")
         m = self.menu
-        y = 140
+        y = 20 + max(min(72, h // 8), 28) + 20
         for i, item in enumerate(m.ITEMS):
             colour = HILITE if i == m.cursor else (220, 220, 220)
             if item in ("bindings", "start", "quit"):
@@ -411,8 +414,8 @@ class App:
                 shown = {True: "on", False: "off", None: "built-in box tank"}.get(v, v) if not isinstance(v, int) \
                     or isinstance(v, bool) else v
                 label = f"{c.label:<12}  <  {shown}  >"
-            text(surf, ("> " if i == m.cursor else "  ") + label, (w // 2 - 200, y), 34, colour)
-            y += 42
+            text(surf, ("> " if i == m.cursor else "  ") + label, (w // 2 - 200, y), size, colour)
+            y += line
         text(surf, "up/down choose, left/right change, Enter select, Esc quit", (w // 2, h - 60), 24,
              (170, 170, 170), anchor="midtop")
         if self.notice:
@@ -424,12 +427,13 @@ class App:
         surf.fill(BG)
         w, h = surf.get_size()
         text(surf, "bindings", (w // 2, 30), 56, anchor="midtop")
-        y = 100
+        y = 90
+        line = max(min(30, (h - 260) // len(ACTIONS)), 14)
         for i, action in enumerate(ACTIONS):
             colour = HILITE if i == self.remap_cursor else (220, 220, 220)
-            text(surf, f"{action.replace('_', ' '):<18} {describe(self.input.bindings.inputs(action))}",
-                 (w // 2 - 260, y), 28, colour)
-            y += 30
+            text(surf, action.replace('_', ' '), (w // 2 - 260, y), line, colour)
+            text(surf, describe(self.input.bindings.inputs(action)), (w // 2 - 20, y), line, colour)
+            y += line
         if self.remap_waiting:
             text(surf, f"press the button for {ACTIONS[self.remap_cursor].upper().replace('_', ' ')}",
                  (w // 2, h - 100), 40, HILITE, anchor="midtop")

@@ -100,7 +100,8 @@ class Hud:
         pygame.draw.rect(surface, (200, 200, 220, 255), (bar.x, bar.bottom + 4, int(bar.w * (1 - reload)), 4))
         # score and frame rate
         text(surface, f"score {focus.kills}   deaths {focus.deaths}", (16, 12), 30)
-        text(surface, f"{fps:5.1f} fps  {view}", (16, 40), 20, colour=(190, 190, 190))
+        rate = f"{fps:5.1f} fps" if fps > 0 else "headless"      # a screenshot has no frame rate
+        text(surface, f"{rate}  {view}", (16, 40), 20, colour=(190, 190, 190))
         text(surface, f"t {session.t:6.1f} s  {session.info.name}", (16, 58), 20, colour=(190, 190, 190))
         # scoreboard
         y = 12
@@ -126,6 +127,9 @@ def save_png(surface: "pygame.Surface", path: str | os.PathLike) -> Path:
     os.close(fd)
     try:
         pygame.image.save(surface, tmp)
+        from ..formats.bundle import _umask
+
+        os.chmod(tmp, 0o666 & ~_umask())      # mkstemp makes 0600; a picture is for everyone
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

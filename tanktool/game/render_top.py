@@ -43,11 +43,14 @@ def agent_view(driver: Any, world: Any, tank: Any) -> dict[str, Any]:
         cmd = getattr(driver, "command", None)
         if cmd is not None and (cmd.fire or getattr(cmd, "strafe", 0.0)):
             state = "attacking"
-    path = getattr(driver, "path", None)
+    # an agent plans a path (search, evade) or walks a route (wander); the bot has a waypoint
+    path = getattr(driver, "path", None) or getattr(driver, "route", None) or None
     if path is None and getattr(driver, "waypoint", None) is not None:
         path = [driver.waypoint]
-    return {"state": None if state is None else str(state), "path": path,
-            "sight": getattr(driver, "sight", None), "fov": getattr(driver, "fov", math.radians(60.0))}
+    senses = getattr(driver, "senses", None)
+    sight = getattr(senses, "vision_range", None) or getattr(driver, "sight", None)
+    fov = getattr(senses, "half_angle", None) or getattr(driver, "fov", math.radians(60.0))
+    return {"state": None if state is None else str(state), "path": path, "sight": sight, "fov": fov}
 
 
 class TopView:

@@ -18,7 +18,8 @@ import numpy as np
 from ..sim.commands import IDLE, Command
 from ..sim.world import Event, World
 
-#: (think_hz, aim spread in degrees, sight in m) of the scripted bots per difficulty
+#: (think_hz, aim spread in degrees, sight in m) of the scripted bots per difficulty; the
+#: computer agents (``sim.agents``, the default) have their own levels of the same names
 DIFFICULTY = {"easy": (4.0, 8.0, 60.0), "normal": (10.0, 3.0, 120.0), "hard": (20.0, 1.0, 160.0)}
 #: seconds each kind of visual effect lasts
 EFFECT_LIFE = {"flash": 0.12, "impact": 0.35, "explosion": 1.2}
@@ -55,18 +56,18 @@ class GameSession:
     arena, vehicle : bundle folders or bundled names (as ``tanktool play --arena``)
     bots : number of computer opponents
     player : whether tank 0 is driven by the local player (else it is a bot too)
-    drivers : optional drivers for the computer tanks (agents); default scripted bots
+    bot : "agent" (``sim.agents.Agent`` at ``difficulty``) or "scripted" (the simple bot)
+    drivers : optional drivers for the computer tanks, instead of ``bot``
     """
 
     def __init__(self, arena: str | Path | None = None, vehicle: str | Path | None = None, bots: int = 3,
                  seed: int = 0, difficulty: str = "normal", player: bool = True,
-                 drivers: Sequence[Driver] | None = None) -> None:
+                 drivers: Sequence[Driver] | None = None, bot: str = "agent") -> None:
         from ..errors import TanktoolError
-        from ..sim.driver import make_drivers
-        from ..sim.match import default_arena, default_vehicle, load_match_arena, load_tank_spec
+        from ..sim.match import default_arena, default_vehicle, load_match_arena, load_tank_spec, make_bots
 
         self._args = dict(arena=arena, vehicle=vehicle, bots=bots, seed=seed, difficulty=difficulty,
-                          player=player, drivers=drivers)
+                          player=player, drivers=drivers, bot=bot)
         if difficulty not in DIFFICULTY:
             raise TanktoolError(f"difficulty must be one of {', '.join(DIFFICULTY)}, got {difficulty!r}")
         self.arena_ref = arena or default_arena()
@@ -88,10 +89,11 @@ class GameSession:
                 raise TanktoolError(f"{len(drivers)} drivers for {bots} computer tanks")
             self.drivers: list[Driver | None] = ([None] if player else []) + list(drivers)
         else:
-            hz, spread, sight = DIFFICULTY[difficulty]
-            self.drivers = list(make_drivers(self.world))
-            for d in self.drivers:
-                d.period, d.aim_spread, d.sight = 1.0 / hz, math.radians(spread), sight
+            self.drivers = list(make_bots(self.world, bot, difficulty))
+            if bot == "scripted":
+                hz, spread, sight = DIFFICULTY[difficulty]
+                for d in self.drivers:
+                    d.period, d.aim_spread, d.sight = 1.0 / hz, math.radians(spread), sight
             if player:
                 self.drivers[0] = None
         self.effects: list[Effect] = []
