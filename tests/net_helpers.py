@@ -26,8 +26,10 @@ def pump(peers, seconds: float = 0.2, states: bool = False) -> list:
     return events
 
 
-def join(peers, address, name: str, password: str | None = None, timeout: float = 5.0, **kw) -> Peer:
-    """Peer.join blocks on its handshake, so run it in a thread while the others poll."""
+def join(peers, address, name: str, password: str | None = None, timeout: float = 5.0, settle: bool = True,
+         **kw) -> Peer:
+    """Peer.join blocks on its handshake, so run it in a thread while the others poll;
+    then (``settle``) add it to ``peers`` and let the mesh form."""
     out: dict = {}
 
     def run() -> None:
@@ -47,8 +49,9 @@ def join(peers, address, name: str, password: str | None = None, timeout: float 
     if "error" in out:
         raise out["error"]
     peer = out["peer"]
-    peers.append(peer)
-    pump(peers, 0.1)
+    if settle:
+        peers.append(peer)
+        pump(peers, 0.1)
     return peer
 
 

@@ -201,3 +201,39 @@ def test_bad_addresses_and_port_in_use(peers):
     free.close()
     with pytest.raises(NetError, match="cannot reach"):
         Peer.join((LOOPBACK, port), "nobody", timeout=1.0)
+
+
+def test_exit_seen_only_by_the_host_reaches_everyone(peers):
+    _session(peers, 3)
+    # a player that joins and leaves before it ever polls: its mesh links never got
+    # past the challenge, so its EXIT reaches only the host; the host's TABLE takes it
+    # out of every table
+    ghost = join(peers, peers[0].tcp_address, "ghost", settle=False)     # the ghost never polls
+    pump(peers, 0.1)
+    assert ghost.number == 4 and all(4 in p.table for p in peers)
+    assert all(4 not in p.links for p in peers[1:])           # only pending links at 2 and 3
+    ghost.close()
+    events = pump(peers, 0.3)
+    assert all(sorted(p.table) == [1, 2, 3] for p in peers)
+    assert {me for me, e in events if e.kind == "left" and e.reason == "left (host)"} == {2, 3}
+    # and when the host then dies, everyone agrees on 2 (not on the ghost)
+    peers[0].close(send_exit=False)
+    pump(peers, 0.2)
+    assert peers[1].host_number == 2 and peers[2].host_number == 2
+
+
+def test_simultaneous_links_keep_one(peers):
+    _session(peers, 3)
+    a, b = peers[1], peers[2]
+    # a second link between 2 and 3, opened by 2 as if both had dialled at once
+    a._close_link(a.links[3])
+    b._close_link(b.links[2])
+    pump(peers, 0.1)          # the closes look like exits; bring both back through the host's table
+    for p in peers:
+        p.table.update({2: a.table.get(2) or peers[0].table[2], 3: b.table.get(3) or peers[0].table[3]})
+    a._link_to(a.table[3])
+    b._link_to(b.table[2])
+    pump(peers, 0.3)
+    assert 3 in a.links and 2 in b.links
+    assert a.links[3].initiated != b.links[2].initiated     # one link, opened by one side
+    assert sorted(a.table) == [1, 2, 3] and sorted(b.table) == [1, 2, 3]

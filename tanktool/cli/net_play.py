@@ -78,7 +78,14 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
         if match is not None:
             match.stop = True
 
+    def restart_stats(signum: int, frame: Any) -> None:
+        # benchmarks measure a window: SIGUSR1 restarts the traffic counters
+        if match is not None:
+            match.restart_stats = True
+
     old = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    if hasattr(signal, "SIGUSR1"):
+        old[signal.SIGUSR1] = signal.signal(signal.SIGUSR1, restart_stats)
     try:
         match = NetMatch(peer, info, spec, seed=seed, log=echo)
         report = match.run(seconds)

@@ -115,6 +115,8 @@ class Link:
     out: bytearray = field(default_factory=bytearray)
     closing: bool = False             # close once ``out`` is flushed (after a refusal)
     outgoing: bool = False            # a mesh link we opened, waiting for its challenge
+    initiated: bool = False           # a mesh link we opened (for simultaneous opens)
+    refused: bool = False             # the other end refused this link: its closing is no exit
 
 
 @dataclass(frozen=True)
@@ -277,9 +279,12 @@ class Peer:
         sock.setblocking(False)
         link = Link(sock, reader, Bucket(TCP_RATE, TCP_BURST, now), now)
         self._bind_link(link, self.host_number)
+        # the joiner links to those in the table it was given; who joins after it (a
+        # NEW_PLAYER maybe already in the backlog) links to it
+        members = [e for n, e in sorted(self.table.items()) if n not in (self.number, self.host_number)]
         self._drain_backlog(link)
-        for n, e in sorted(self.table.items()):
-            if n not in (self.number, self.host_number):
+        for e in members:
+            if e.number in self.table and e.number not in self.links:
                 self._link_to(e)
         return None
 
@@ -297,7 +302,8 @@ class Peer:
             self.dropped["link_failed"] += 1      # it will time out of the table if really gone
             return
         now = self.clock()
-        link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now, outgoing=True)
+        link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now, outgoing=True,
+                    initiated=True)
         self._bind_link(link, e.number)
 
     def _drain_backlog(self, link: Link) -> None:
@@ -356,6 +362,7 @@ class Peer:
         """A state of my tank to every peer, by UDP."""
         if self.udp is None:
             return
+        self.counters["state_rounds"] += 1
         data = self._pack(state)
         for n, e in self.table.items():
             if n == self.number:
@@ -491,6 +498,9 @@ class Peer:
         if m.sender != link.number:
             self.dropped["impostor"] += 1      # a peer speaks only for its own number
             return
+        if isinstance(m.body, P.Refuse) and link.initiated:
+            link.refused = True                # a duplicate link lost the tie-break
+            return
         self.counters["received"] += 1
         self.last_heard[link.number] = now
         body = m.body
@@ -498,6 +508,17 @@ class Peer:
             if m.sender != self.host_number:
                 self.dropped["not_host"] += 1
                 return
+            self._merge_table(body.table, body.number)
+        elif m.type == P.MessageType.TABLE:
+            if m.sender != self.host_number:
+                self.dropped["not_host"] += 1
+                return
+            # the host's table is the reference: who is not in it has left (for
+            # example a player whose EXIT reached only the host)
+            keep = {e.number for e in body.table.entries}
+            for n in list(self.table):
+                if n not in keep and n != self.number:
+                    self._remove(n, "left (host)")
             self._merge_table(body.table, body.number)
         elif isinstance(body, P.Shot):
             if body.tank != m.sender:
@@ -554,7 +575,12 @@ class Peer:
         except OSError:
             self._drop_link(link, "closed")
             return False
-        if n == self.number or n in self.links or (ip != e.ip and e.ip != "0.0.0.0"):
+        mine = self.links.get(n)
+        if mine is not None and mine.initiated and n > self.number and ip == e.ip:
+            # both opened a link at once: the one opened by the higher number stays
+            mine.refused = True
+            self._close_link(mine)
+        elif n == self.number or n in self.links or (ip != e.ip and e.ip != "0.0.0.0"):
             self.dropped["impostor"] += 1
             self._refuse(link, P.RefuseCode.BAD_REQUEST, f"player {n} is already linked")
             return False
@@ -679,7 +705,7 @@ class Peer:
                 self._remove(n, "silent")
 
     def _drop_link(self, link: Link, reason: str) -> None:
-        if link.outgoing:
+        if link.outgoing or link.refused:
             # a mesh link that never opened says nothing about its peer: silence will
             self.dropped["link_failed"] += 1
             self._close_link(link)
@@ -719,6 +745,11 @@ class Peer:
             self.host_number = min(self.table)
             self.host_changes.append((self.session_time(), self.host_number))
             self.events.append(NetEvent("host", self.host_number))
+        if self.is_host and self.links and not self.closed:
+            table = self._pack(P.Assign(self.number, self.session_time(), self._table()), P.MessageType.TABLE)
+            for link in list(self.links.values()):
+                if not link.outgoing:
+                    self._queue(link, table)
 
     def close(self, send_exit: bool = True) -> None:
         """Leave: tell everyone (TCP), close every socket."""
@@ -746,12 +777,19 @@ class Peer:
         self.sel.close()
         self.closed = True
 
+    def reset_stats(self) -> None:
+        """Restart the traffic counters and latency samples (a benchmark's window);
+        drop reasons are kept."""
+        self.counters.clear()
+        self.latencies.clear()
+
     def network_report(self) -> dict[str, Any]:
         """Counters for reports: messages sent / received / dropped, bytes, reasons."""
         return {
             "sent": self.counters["sent"], "received": self.counters["received"],
             "dropped": sum(self.dropped.values()),
             "bytes_sent": self.counters["bytes_sent"], "bytes_received": self.counters["bytes_received"],
+            "state_rounds": self.counters["state_rounds"],
             "states_sent": self.counters["states_sent"], "states_received": self.counters["states_received"],
             "dropped_reasons": dict(sorted(self.dropped.items())),
         }

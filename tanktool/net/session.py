@@ -67,6 +67,8 @@ class NetMatch:
     names: dict[int, str] = field(init=False, default_factory=dict)
     #: set (e.g. from a signal handler) to end the match at the next loop turn
     stop: bool = field(init=False, default=False)
+    #: set to restart the traffic statistics at the next loop turn (SIGUSR1 in the CLI)
+    restart_stats: bool = field(init=False, default=False)
 
     def __post_init__(self) -> None:
         names = [f"p{n}" for n in range(1, P.MAX_PLAYERS + 1)]
@@ -190,10 +192,15 @@ class NetMatch:
         state_period = 1.0 / self.state_hz
         next_view = math.floor(w.t) + 1
         skipped = 0
+        self.stats_since = start
         while not self.stop:
             now = time.monotonic()
             if now >= end:
                 break
+            if self.restart_stats:
+                self.restart_stats = False
+                peer.reset_stats()
+                self.stats_since = now
             self._on_net(peer.poll(max(0.0, min(next_step, next_state, end) - now)))
             now = time.monotonic()
             if now - next_step > MAX_LAG:          # starved of CPU: skip, keep real time
@@ -217,6 +224,8 @@ class NetMatch:
     # ------------------------------------------------------------------ report
     def report(self, wall: float, skipped: int = 0) -> dict[str, Any]:
         peer = self.peer
+        if not hasattr(self, "stats_since"):
+            self.stats_since = time.monotonic() - wall
         peers = []
         for e in peer.players():
             t = self.world.tanks[e.number - 1]
@@ -235,6 +244,7 @@ class NetMatch:
             "name": peer.name,
             "host": peer.host_number,
             "seconds": round(wall, 3),
+            "stats_seconds": round(time.monotonic() - self.stats_since, 3),   # what network counts cover
             "session_time": round(self.world.t, 3),
             "peers": peers,
             "left": self.left,
