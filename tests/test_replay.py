@@ -141,3 +141,33 @@ def test_damaged_files_name_the_byte(recorded, tmp_path):
     with pytest.raises(FormatError, match="no such file"):
         read_replay(tmp_path / "missing.ttr")
     assert MAGIC == b"TTRP"
+
+
+# ---------------------------------------------------------------- tanktool play --record / --replay
+
+def test_cli_record_then_replay_gives_the_same_report(tmp_path):
+    from click.testing import CliRunner
+
+    from tanktool.cli.main import cli
+
+    tape, a, b = tmp_path / "m.ttr", tmp_path / "a.json", tmp_path / "b.json"
+    run = CliRunner().invoke
+    res = run(cli, ["play", "--headless", "--arena", "box", "--bots", "3", "--seconds", "4", "--seed", "2",
+                    "--difficulty", "hard", "--record", str(tape), "--report", str(a)])
+    assert res.exit_code == 0, res.output
+    assert f"replay: {tape} (" in res.output and "command changes)" in res.output
+    res = run(cli, ["play", "--replay", str(tape), "--report", str(b), "--picture", str(tmp_path / "end.png")])
+    assert res.exit_code == 0, res.output
+    assert "replay: final state matches the recording bit for bit" in res.output
+    ra, rb = json.loads(a.read_text()), json.loads(b.read_text())
+    assert _without_timing(ra) == _without_timing(rb) and ra["difficulty"] == "hard" and ra["seed"] == 2
+    assert (tmp_path / "end.png").stat().st_size > 10_000
+    # bad input: one line, exit 2, no traceback
+    (tmp_path / "junk.ttr").write_bytes(b"not a replay")
+    res = run(cli, ["play", "--replay", str(tmp_path / "junk.ttr")])
+    assert res.exit_code == 2 and "junk.ttr: byte 0: not a tanktool replay" in res.output
+    assert "Traceback" not in res.output
+    res = run(cli, ["play", "--replay", str(tape), "--arena", "maze"])
+    assert res.exit_code == 2 and "not the one the replay was recorded on" in res.output
+    res = run(cli, ["play", "--record", str(tape), "--replay", str(tape)])
+    assert res.exit_code == 2 and "cannot be used together" in res.output

@@ -68,12 +68,17 @@ def _size(text: str) -> tuple[int, int]:
               help="With --headless: write the view after --frames frames (default 120) to this PNG.")
 @click.option("--size", default="1280x720", show_default=True, metavar="WxH", help="Window or screenshot size.")
 @click.option("--fullscreen", is_flag=True, help="Open the window full screen.")
+@click.option("--record", "record_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Record the match (setup, seed, every tank's commands) to this replay file (.ttr).")
+@click.option("--replay", "replay_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
+              help="Play a recorded match back from this file: the same final state, bit for bit.")
 @network_options
 def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | None, seconds: float | None,
          seed: int, integrator: str, report_path: Path | None, picture: Path | None, view: str,
          frames: int | None, screenshot: Path | None, size: str, fullscreen: bool,
          host: str | None = None, join: str | None = None, player_name: str | None = None,
-         password: str | None = None, difficulty: str = "normal", bot_driver: str = "agent") -> None:
+         password: str | None = None, difficulty: str = "normal", bot_driver: str = "agent",
+         record_path: Path | None = None, replay_path: Path | None = None) -> None:
     """Play a match: bots on an arena.
 
     \b
@@ -82,6 +87,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --headless --arena arenas/maze --vehicle heavy --seconds 600
       tanktool play --headless --frames 120 --screenshot shot.png --view 3d
       tanktool play --arena maze --view top
+      tanktool play --headless --arena box --seconds 30 --seed 4 --record match.ttr
+      tanktool play --replay match.ttr --report again.json --picture end.png
     """
     if host is not None or join is not None:
         from .net_play import run_network
@@ -91,13 +98,21 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
     from ..sim.match import default_vehicle, format_report, load_match_arena, load_tank_spec, run_match, scoreboard
 
     width, height = _size(size)
+    if record_path is not None or replay_path is not None:
+        # replays are made and played by headless matches (sim/replay.py)
+        if record_path is not None and replay_path is not None:
+            raise click.UsageError("--record and --replay cannot be used together")
+        if frames is not None or screenshot is not None:
+            raise click.UsageError("--record/--replay run headless matches: use --picture for the final view")
+        headless = True
     if headless and (frames is not None or screenshot is not None):
         from ..game.headless import screenshot as take_screenshot
 
         if screenshot is None:
             raise click.UsageError("--frames needs --screenshot FILE.png")
         shot = take_screenshot(screenshot, view=view, frames=120 if frames is None else frames, arena=arena,
-                               vehicle=vehicle, bots=8 if bots is None else bots, seed=seed, size=(width, height))
+                               vehicle=vehicle, bots=8 if bots is None else bots, seed=seed, size=(width, height),
+                               difficulty=difficulty, bot=bot_driver)
         echo(f"{shot['view']} view after {shot['frames']} frames: {shot['path']}")
         return
     if not headless:
@@ -105,7 +120,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
 
         try:
             run_window(arena=arena, vehicle=vehicle, bots=3 if bots is None else max(bots - 1, 0), seed=seed,
-                       view=view, size=(width, height), fullscreen=fullscreen)
+                       view=view, size=(width, height), fullscreen=fullscreen, difficulty=difficulty,
+                       bot=bot_driver)
             return
         except NoDisplay as e:
             echo(f"no display to open the game window ({e}); running a short headless match instead "
@@ -115,7 +131,16 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         picture = picture or Path("match.png")
     bots = 8 if bots is None else bots
     seconds = 60.0 if seconds is None else seconds
-    for out in (report_path, picture):
+    replay = None
+    if replay_path is not None:
+        from ..sim.replay import read_replay
+
+        replay = read_replay(replay_path)
+        # the recording says what was played; --arena/--vehicle may point at moved bundles
+        arena = arena or replay.header.get("arena_ref")
+        vehicle = vehicle or replay.header.get("vehicle_ref")
+        bots, seconds = int(replay.header["bots"]), float(replay.header["seconds"])
+    for out in (report_path, picture, record_path):
         if out is not None and not out.parent.exists():
             raise TanktoolError(f"{out}: folder {out.parent} does not exist")
 
@@ -126,8 +151,21 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         echo("no vehicle bundled yet: using the built-in box tank")
     steps = int(round(seconds * 120))
     with progress(length=steps, label=f"{info.name}: {bots} bots, {seconds:g} s") as bar:
-        result = run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
-                           integrator=integrator, on_progress=bar.update, bot=bot_driver, difficulty=difficulty)
+        if replay is not None:
+            from ..sim.replay import play_replay
+
+            playback = play_replay(replay, info, spec, on_progress=bar.update)
+            result = playback.result
+        elif record_path is not None:
+            from ..sim.replay import record_match
+
+            result, tape = record_match(info, spec, bots=bots, seconds=seconds, seed=seed,
+                                        arena_ref=_stored_ref(_arena_ref(arena)), vehicle_ref=_stored_ref(vref),
+                                        on_progress=bar.update, integrator=integrator, bot=bot_driver,
+                                        difficulty=difficulty)
+        else:
+            result = run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
+                               integrator=integrator, on_progress=bar.update, bot=bot_driver, difficulty=difficulty)
     report = result.report
     echo(scoreboard(report))
     timing = report["timing"]
@@ -143,3 +181,22 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
 
         save_match_picture(result, picture)
         echo(f"picture: {picture}")
+    if record_path is not None:
+        from ..sim.replay import write_replay
+
+        nbytes = write_replay(record_path, tape)
+        echo(f"replay: {record_path} ({nbytes} bytes, {len(tape)} command changes)")
+    if replay is not None:
+        if not playback.matches:
+            raise click.ClickException(f"replay diverged from the recording: final state sha256 "
+                                       f"{playback.digest[:16]}..., recorded {replay.header['final_state'][:16]}...")
+        echo(f"replay: final state matches the recording bit for bit (sha256 {playback.digest[:16]}...)")
+
+
+def _stored_ref(ref: str | None) -> str | None:
+    """A bundle reference as a replay stores it: an existing path made absolute (so
+    the replay plays from any folder), a bundled name as it is."""
+    if ref is None:
+        return None
+    p = Path(ref)
+    return str(p.resolve()) if p.exists() else ref
