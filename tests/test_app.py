@@ -39,6 +39,7 @@ def goto(app, item):
 
 def test_menu_choices_and_start(app):
     assert app.state == "menu"
+    assert app.menu.arena.value == "box" and app.menu.vehicle.value == "light" and app.menu.difficulty.value == "normal"
     app.frame(0.016)                       # draws the menu without error
     goto(app, "bots")
     press(app, pygame.K_RIGHT)
@@ -50,6 +51,7 @@ def test_menu_choices_and_start(app):
     press(app, pygame.K_RETURN)
     assert app.state == "playing"
     assert len(app.session.world.tanks) == 4 and app.session.player == 0
+    assert app.session.difficulty == "hard" and app.session.drivers[0] is None
     assert app.view == "top"               # no OpenGL on the dummy driver's plain window
 
 

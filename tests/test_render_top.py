@@ -81,6 +81,15 @@ def test_headless_top_screenshot_cli(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["top.png"]        # no temporary left behind
 
 
+def test_headless_screenshot_with_scripted_bots(tmp_path):
+    out = tmp_path / "s.png"
+    r = CliRunner().invoke(cli, ["play", "--headless", "--frames", "5", "--screenshot", str(out), "--view", "top",
+                                 "--arena", "box", "--bots", "3", "--size", "320x200", "--bot-driver", "scripted",
+                                 "--difficulty", "easy"])
+    assert r.exit_code == 0, r.output
+    assert pygame.image.load(str(out)).get_size() == (320, 200)
+
+
 def test_headless_screenshot_bad_input_exits_2(tmp_path):
     runner = CliRunner()
     r = runner.invoke(cli, ["play", "--headless", "--screenshot", str(tmp_path / "no" / "x.png"), "--view", "top"])

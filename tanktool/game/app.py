@@ -156,7 +156,7 @@ class App:
     def __init__(self, presenter: Presenter | None = None, arena: str | None = None, vehicle: str | None = None,
                  bots: int = 3, seed: int = 0, view: str = "3d", size: tuple[int, int] = (1280, 720),
                  fullscreen: bool = False, bindings: Bindings | None = None, sound: bool = True,
-                 bindings_file: Path | None = None) -> None:
+                 bindings_file: Path | None = None, difficulty: str = "normal", bot: str = "agent") -> None:
         arenas, vehicles = bundled("arenas"), bundled("vehicles")
         self.menu = Menu(Choice("arena", arenas + ([arena] if arena and arena not in arenas else [])),
                          Choice("vehicle", vehicles + ([vehicle] if vehicle and vehicle not in vehicles else [])
@@ -167,12 +167,14 @@ class App:
         self.menu.vehicle.set(vehicle or default_vehicle())
         self.menu.bots.set(min(max(bots, 0), 7))
         self.menu.view.set(view)
+        self.menu.difficulty.set(difficulty)
         res = f"{size[0]}x{size[1]}"
         if res not in self.menu.resolution.options:
             self.menu.resolution.options.insert(0, res)
         self.menu.resolution.set(res)
         self.menu.fullscreen.set(fullscreen)
         self.seed = seed
+        self.bot = bot
         self.bindings_file = bindings_file
         self.input = InputState(bindings or load_bindings(bindings_file))
         self.presenter = presenter
@@ -204,7 +206,7 @@ class App:
         if self.presenter is None or self.presenter.size != self.size():
             self.open_window()
         self.session = GameSession(m.arena.value, m.vehicle.value, bots=int(m.bots.value), seed=self.seed,
-                                   difficulty=str(m.difficulty.value), player=True)
+                                   difficulty=str(m.difficulty.value), player=True, bot=self.bot)
         self._make_views(str(m.view.value))
         if self.audio is not None:
             self.audio.close()
@@ -444,14 +446,15 @@ class App:
 
 
 def run_window(arena: str | None = None, vehicle: str | None = None, bots: int = 3, seed: int = 0,
-               view: str = "3d", size: tuple[int, int] = (1280, 720), fullscreen: bool = False) -> None:
+               view: str = "3d", size: tuple[int, int] = (1280, 720), fullscreen: bool = False,
+               difficulty: str = "normal", bot: str = "agent") -> None:
     """Open the window and play until the player quits.  Raises NoDisplay when there is
     no screen."""
     problem = display_problem()
     if problem is not None:
         raise NoDisplay(problem)
     pygame.init()
-    app = App(None, arena, vehicle, bots, seed, view, size, fullscreen)
+    app = App(None, arena, vehicle, bots, seed, view, size, fullscreen, difficulty=difficulty, bot=bot)
     app.open_window()
     clock = pygame.time.Clock()
     last = time.perf_counter()
