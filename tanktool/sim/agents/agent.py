@@ -38,6 +38,7 @@ import random
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from ...nav.navgrid import nearest_valid_node
 from ...nav.steering import heading_from_angle
 from ..commands import IDLE, Command
 from .fuzzy import PREDICT, AttackController, FIRE_THRESHOLD
@@ -246,8 +247,6 @@ class Agent:
         if self.route and math.hypot(self.route[0][0] - x, self.route[0][1] - z) > 5.0:
             self.route, self.walker = [], None       # pushed off the route: start again here
         if self.walker is None:
-            from ...nav.navgrid import nearest_valid_node
-
             n = nearest_valid_node(grid.valid, grid.node_of(x, z), 6)  # type: ignore[union-attr]
             if n is None:
                 return self._back_off(tank)
@@ -259,8 +258,12 @@ class Agent:
                 self.path.pop(0)
             if math.hypot(self.path[-1][0] - x, self.path[-1][1] - z) > 4.0:
                 return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
-            self.path, self.route, self.walker = [], [], None
-            return self._wander(world, tank)
+            self.memory.visit(self.path[-1][0], self.path[-1][1], world.t)  # type: ignore[union-attr]
+            self.path, self.route = [], []
+            n = nearest_valid_node(grid.valid, grid.node_of(x, z), 6)  # type: ignore[union-attr]
+            self.walker = (n, heading_from_angle(tank.heading)) if n is not None else None
+            if self.walker is None:
+                return self._back_off(tank)
         while len(self.route) < 12:
             node, h = self.walker
             nxt = wand.choose(node, h, world.t)  # type: ignore[union-attr]
@@ -275,11 +278,15 @@ class Agent:
                 # region not visited for a while, by A*, then wander again
                 self.explore_after = world.t + 3.0
                 goal = self.memory.frontier(x, z, world.t, wand.forget)  # type: ignore[union-attr]
+                if goal is not None and math.hypot(goal[0] - x, goal[1] - z) > 4.0:
+                    path = plan_path(grid, (x, z), goal)  # type: ignore[arg-type]
+                    if path:
+                        self.path, self.route, self.walker = path, [], None
+                        return self._follow(world, tank, path, speed=1.0, lookahead=4.0, corner=path[0])
                 if goal is not None:
-                    self.path = plan_path(grid, (x, z), goal)  # type: ignore[arg-type]
-                    if self.path:
-                        self.route, self.walker = [], None
-                        return self._wander(world, tank)
+                    self.memory.visit(goal[0], goal[1], world.t)  # type: ignore[union-attr]
+                if looping:
+                    break
         if not self.route:
             return self._back_off(tank)
         return self._follow(world, tank, self.route, speed=0.85, lookahead=6.0)
