@@ -157,7 +157,7 @@ class Agent:
 
     def _setup(self, world: "World", tank: "Tank") -> None:
         self.grid = agent_grid(world, self.cell, tank.spec.radius + self.margin)
-        self.memory = Memory(self.grid)
+        self.memory = Memory(self.grid, region=16.0)
         self.wanderer = Wanderer(self.grid, self.memory, self.rng)
         self.controller = AttackController(tank.spec.shell_speed)
 
