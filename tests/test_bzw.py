@@ -215,3 +215,18 @@ def test_cli_bad_world_is_one_line_exit_2_and_nothing_written(tmp_path, name, me
     assert res.exit_code == 2
     assert message in res.output and "Traceback" not in res.output
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_courtyard_every_kind_together(tmp_path):
+    """The docs' example map: bases are pads, the bridge floats, the teleporter is two posts."""
+    w = parse_bzw(BZW / "courtyard.bzw")
+    assert w.counts() == {"base": 2, "box": 6, "pyramid": 2, "wall": 1, "teleporter": 1}
+    assert len(w.warnings) == 1 and ":76: unknown or unsupported object 'link'" in w.warnings[0]
+    r = import_arena(BZW / "courtyard.bzw", tmp_path / "c")
+    # 4 edge + 4 boxes x 4 + the central block 4 + 2 pyramids x 4 + 2 posts x 4 + the thin wall's 2 sides
+    assert len(r.walls) == 4 + 16 + 4 + 8 + 8 + 2 and r.thin_walls == 2
+    assert r.warnings == w.warnings
+    inner = _inner(r.walls, 60.0)
+    mids = inner.mean(axis=1)
+    # nothing under the floating bridge at BZFlag (0, -40), i.e. world (0, 40)
+    assert not ((np.abs(mids[:, 0]) < 15) & (np.abs(mids[:, 1] - 40) < 3)).any()
