@@ -76,3 +76,21 @@ def test_hosted_match_report(tmp_path):
     assert rep["peers"] == [dict(rep["peers"][0], number=1, name="solo")]
     assert set(rep["network"]) >= {"sent", "received", "dropped"}
     assert 1.0 <= rep["session_time"] <= 3.0 and len(rep["views"]) >= 1
+
+
+def test_bots_only_on_the_host():
+    r = _run("--join", "127.0.0.1:5000", "--bots", "2")
+    assert r.exit_code == 2 and "--bots goes with --host" in r.output
+    r = _run("--host", "127.0.0.1:0", "--bots", "8")
+    assert r.exit_code == 2 and "at most 7 bots" in r.output
+
+
+def test_hosted_match_with_bots(tmp_path):
+    out = tmp_path / "bots.json"
+    r = _run("--host", "127.0.0.1:0", "--bots", "3", "--seconds", "1.5", "--report", str(out))
+    assert r.exit_code == 0, r.output
+    rep = json.loads(out.read_text())
+    assert [(p["number"], p["bot"], p["run_by"]) for p in rep["peers"]] == [(1, False, 1), (2, True, 1),
+                                                                             (3, True, 1), (4, True, 1)]
+    moved = [p for p in rep["peers"] if p["bot"]]
+    assert len({tuple(p["position"]) for p in moved}) == 3      # three tanks in three places

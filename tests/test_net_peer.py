@@ -215,7 +215,7 @@ def test_exit_seen_only_by_the_host_reaches_everyone(peers):
     ghost.close()
     events = pump(peers, 0.3)
     assert all(sorted(p.table) == [1, 2, 3] for p in peers)
-    assert {me for me, e in events if e.kind == "left" and e.reason == "left (host)"} == {2, 3}
+    assert {me for me, e in events if e.kind == "left" and e.reason == "dropped by the host"} == {2, 3}
     # and when the host then dies, everyone agrees on 2 (not on the ghost)
     peers[0].close(send_exit=False)
     pump(peers, 0.2)
@@ -237,3 +237,40 @@ def test_simultaneous_links_keep_one(peers):
     assert 3 in a.links and 2 in b.links
     assert a.links[3].initiated != b.links[2].initiated     # one link, opened by one side
     assert sorted(a.table) == [1, 2, 3] and sorted(b.table) == [1, 2, 3]
+
+
+def test_bots_belong_to_the_host_and_move_on_migration(peers):
+    _session(peers, 3)
+    host = peers[0]
+    bots = [host.add_bot("bot1"), host.add_bot("bot2")]
+    assert bots == [4, 5]
+    pump(peers, 0.2)
+    for p in peers:
+        assert p.table[4].owner == 1 and p.table[5].is_bot
+        assert sorted(p.links) == sorted({1, 2, 3} - {p.number})       # nobody links to a bot
+    assert host.speaks_for() == [1, 4, 5] and peers[1].speaks_for() == [2]
+    # the host's states for its bots are taken; player 3 speaking for bot 4 is not
+    host.send_state(P.State(4, 1.0, 7.0, 7.0, 0, 0, 0, 0, 100, True))
+    peers[2].send_state(P.State(4, 1.1, 999.0, 999.0, 0, 0, 0, 0, 100, True))
+    events = pump(peers, 0.2)
+    seen = {(me, e.body.x) for me, e in events if e.kind == "state" and e.body.tank == 4}
+    assert seen == {(2, 7.0), (3, 7.0)}
+    # a hit on a bot is decided by its owner only
+    peers[2].send_event(P.Hit(3, 4, 1.0, 25.0, 0.0, True, 0, 0))
+    host.send_event(P.Hit(2, 4, 1.0, 25.0, 75.0, False, 0, 0))
+    hits = {(me, e.body.shooter) for me, e in pump(peers, 0.2) if e.kind == "hit"}
+    assert hits == {(2, 2), (3, 2)}
+    # the host crashes: player 2 hosts and adopts the bots, everyone agrees
+    host.close(send_exit=False)
+    events = pump(peers, 0.3)
+    for p in peers[1:]:
+        assert p.host_number == 2 and p.table[4].owner == 2 and p.table[5].owner == 2
+    assert {e.number for me, e in events if e.kind == "adopt"} == {4, 5}
+    assert all(me == 2 for me, e in events if e.kind == "adopt")
+    assert peers[1].speaks_for() == [2, 4, 5]
+    # room is counted with the bots: 2 players + 2 bots + 4 more bots fill the 8 places
+    for i in range(4):
+        assert peers[1].add_bot(f"more{i}") is not None
+    assert peers[1].add_bot("too many") is None
+    with pytest.raises(NetError, match="session full"):
+        join(peers, peers[1].tcp_address, "late")

@@ -1,7 +1,8 @@
 """``tanktool play --host [ADDR:]PORT`` / ``--join ADDR:PORT``: network play.
 
 The options are defined here once and stacked on ``play`` (``network_options``); the
-command hands over to :func:`run_network` when either is given.  A network match runs
+command hands over to :func:`run_network` when either is given.  ``--bots N`` with
+``--host`` adds N computer opponents that the host runs (and a new host adopts).  A network match runs
 headless for now (the window issue adds menus for it): the local tank is driven by the
 scripted bot, for ``--seconds`` of real time, and ``--report`` writes the match report
 with ``peers``, ``host_changes`` and ``network`` counters.
@@ -36,8 +37,9 @@ def network_options(f: Callable) -> Callable:
 
 def run_network(host: str | None, join: str | None, player_name: str | None, password: str | None,
                 arena: str | None, vehicle: str | None, seconds: float | None, seed: int,
-                report_path: Path | None, echo: Callable[[str], None]) -> dict[str, Any]:
-    """Host or join a session, play it, print a summary, write the report."""
+                report_path: Path | None, echo: Callable[[str], None], bots: int | None = None) -> dict[str, Any]:
+    """Host or join a session, play it, print a summary, write the report.  ``bots``
+    (default: ``play``'s own ``--bots``) computer opponents run on the host."""
     from ..formats.bundle import atomic_write_text
     from ..net.peer import Peer, parse_address
     from ..net.protocol import name_bytes
@@ -46,6 +48,15 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
 
     if host is not None and join is not None:
         raise click.UsageError("--host and --join exclude each other")
+    if bots is None:
+        # --bots belongs to `play`; read it from there rather than widen play's call
+        ctx = click.get_current_context(silent=True)
+        bots = ctx.params.get("bots") if ctx is not None else None
+    bots = bots or 0
+    if bots and join is not None:
+        raise click.UsageError("computer opponents run on the host: --bots goes with --host")
+    if bots > 7:
+        raise click.UsageError(f"--bots {bots}: a session holds 8 tanks, the host's own included (at most 7 bots)")
     if report_path is not None and not report_path.parent.exists():
         raise TanktoolError(f"{report_path}: folder {report_path.parent} does not exist")
     name = player_name or ("host" if host is not None else "player")
@@ -87,7 +98,7 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
     if hasattr(signal, "SIGUSR1"):
         old[signal.SIGUSR1] = signal.signal(signal.SIGUSR1, restart_stats)
     try:
-        match = NetMatch(peer, info, spec, seed=seed, log=echo)
+        match = NetMatch(peer, info, spec, seed=seed, log=echo, bots=bots)
         report = match.run(seconds)
     finally:
         peer.close()

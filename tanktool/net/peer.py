@@ -30,7 +30,7 @@ import selectors
 import socket
 import time
 from collections import Counter, deque
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from hashlib import sha256
 from typing import Any, Callable
 
@@ -281,7 +281,8 @@ class Peer:
         self._bind_link(link, self.host_number)
         # the joiner links to those in the table it was given; who joins after it (a
         # NEW_PLAYER maybe already in the backlog) links to it
-        members = [e for n, e in sorted(self.table.items()) if n not in (self.number, self.host_number)]
+        members = [e for n, e in sorted(self.table.items())
+                   if n not in (self.number, self.host_number) and not e.is_bot]
         self._drain_backlog(link)
         for e in members:
             if e.number in self.table and e.number not in self.links:
@@ -355,17 +356,44 @@ class Peer:
         return self.clock() - self.session_offset
 
     def players(self) -> list[P.Entry]:
+        """Every table entry (players and computer opponents), by number."""
         return [self.table[n] for n in sorted(self.table)]
+
+    def speaks_for(self) -> list[int]:
+        """The tanks this peer runs: its own and the computer opponents it owns."""
+        return [n for n in sorted(self.table) if n == self.number or self.table[n].owner == self.number]
+
+    def _may_speak(self, sender: int, tank: int) -> bool:
+        e = self.table.get(tank)
+        return tank == sender or (e is not None and e.owner == sender)
+
+    def add_bot(self, name: str) -> int | None:
+        """The host adds a computer opponent (it runs it): its number, or None when full."""
+        if not self.is_host:
+            raise NetError("only the host adds computer opponents")
+        free = [n for n in range(1, P.MAX_PLAYERS + 1) if n not in self.table]
+        if not free:
+            return None
+        n = free[0]
+        me = self.table[self.number]
+        epoch = max(e.epoch for e in self.table.values()) + 1
+        self.table[n] = P.Entry(n, epoch, me.ip, me.tcp_port, me.udp_port, name, owner=self.number)
+        news = self._pack(P.Assign(n, self.session_time(), self._table()), P.MessageType.NEW_PLAYER)
+        for link in list(self.links.values()):
+            if not link.outgoing:
+                self._queue(link, news)
+        self.events.append(NetEvent("joined", n, self.table[n]))
+        return n
 
     # ------------------------------------------------------------------ sending
     def send_state(self, state: P.State) -> None:
-        """A state of my tank to every peer, by UDP."""
+        """A state of a tank I run to every other player, by UDP."""
         if self.udp is None:
             return
         self.counters["state_rounds"] += 1
         data = self._pack(state)
         for n, e in self.table.items():
-            if n == self.number:
+            if n == self.number or e.is_bot:
                 continue
             try:
                 self.udp.sendto(data, (e.ip, e.udp_port))
@@ -518,15 +546,15 @@ class Peer:
             keep = {e.number for e in body.table.entries}
             for n in list(self.table):
                 if n not in keep and n != self.number:
-                    self._remove(n, "left (host)")
+                    self._remove(n, "dropped by the host")
             self._merge_table(body.table, body.number)
         elif isinstance(body, P.Shot):
-            if body.tank != m.sender:
+            if not self._may_speak(m.sender, body.tank):
                 self.dropped["impostor"] += 1
                 return
             self.events.append(NetEvent("shot", m.sender, body))
         elif isinstance(body, P.Hit):
-            if body.victim != m.sender:        # only the victim's peer decides a hit
+            if not self._may_speak(m.sender, body.victim):   # only the victim's peer decides a hit
                 self.dropped["impostor"] += 1
                 return
             self.events.append(NetEvent("hit", m.sender, body))
@@ -628,6 +656,11 @@ class Peer:
             if (e.number, e.epoch) in self.departed or e.number == self.number:
                 continue
             old = self.table.get(e.number)
+            if old is not None and old.epoch == e.epoch and old.owner != e.owner:
+                self.table[e.number] = e           # a computer opponent changed hands
+                if e.owner == self.number:
+                    self.events.append(NetEvent("adopt", e.number, e))
+                continue
             if old is None or old.epoch != e.epoch:
                 if old is not None:
                     self._remove(e.number, "replaced")
@@ -665,7 +698,7 @@ class Peer:
             if m is None:
                 continue
             e = self.table.get(m.sender)
-            if e is None or m.sender == self.number or addr != (e.ip, e.udp_port):
+            if e is None or e.is_bot or m.sender == self.number or addr != (e.ip, e.udp_port):
                 self.dropped["impostor" if e is not None else "unknown"] += 1
                 continue
             if not isinstance(m.body, P.State):
@@ -682,13 +715,14 @@ class Peer:
             self._on_state(m, now)
 
     def _on_state(self, m: P.Message, now: float) -> None:
-        if m.body.tank != m.sender:
+        if not self._may_speak(m.sender, m.body.tank) or m.body.tank == self.number:
             self.dropped["impostor"] += 1
             return
-        if m.seq <= self.last_state_seq.get(m.sender, -1):
+        key = (m.sender, m.body.tank)
+        if m.seq <= self.last_state_seq.get(key, -1):
             self.dropped["stale"] += 1        # latest sequence wins
             return
-        self.last_state_seq[m.sender] = m.seq
+        self.last_state_seq[key] = m.seq
         self.counters["states_received"] += 1
         self.latencies.append(now - m.timestamp)
         self.events.append(NetEvent("state", m.sender, m.body))
@@ -701,7 +735,8 @@ class Peer:
                 self.dropped["pending_timeout"] += 1
                 self._close_link(link)
         for n in list(self.table):
-            if n != self.number and now - self.last_heard.get(n, now) > self.silence:
+            if n in self.table and n != self.number and not self.table[n].is_bot \
+                    and now - self.last_heard.get(n, now) > self.silence:
                 self._remove(n, "silent")
 
     def _drop_link(self, link: Link, reason: str) -> None:
@@ -735,16 +770,24 @@ class Peer:
         if link is not None:
             self._close_link(link)
         self.last_heard.pop(n, None)
-        self.last_state_seq.pop(n, None)
+        for key in [k for k in self.last_state_seq if n in k]:
+            del self.last_state_seq[key]
         self.udp_buckets.pop(n, None)
         if e is None:
             return
         self.departed.add((n, e.epoch))
         self.events.append(NetEvent("left", n, e, reason))
-        if n == self.host_number and self.table:
-            self.host_number = min(self.table)
+        players = [k for k, x in self.table.items() if not x.is_bot]
+        if n == self.host_number and players:
+            self.host_number = min(players)
             self.host_changes.append((self.session_time(), self.host_number))
             self.events.append(NetEvent("host", self.host_number))
+        # its computer opponents go on, run by the host (the new one if it was the host)
+        for k, x in list(self.table.items()):
+            if x.owner == n:
+                self.table[k] = replace(x, owner=self.host_number)
+                if self.host_number == self.number:
+                    self.events.append(NetEvent("adopt", k, self.table[k]))
         if self.is_host and self.links and not self.closed:
             table = self._pack(P.Assign(self.number, self.session_time(), self._table()), P.MessageType.TABLE)
             for link in list(self.links.values()):

@@ -75,6 +75,11 @@ class Entry:
     tcp_port: int
     udp_port: int
     name: str
+    owner: int = 0      # 0: a player; else the number of the peer that runs this computer opponent
+
+    @property
+    def is_bot(self) -> bool:
+        return self.owner != 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -195,7 +200,7 @@ _CHALLENGE = struct.Struct(f"!{NONCE_SIZE}sB")
 _JOIN = struct.Struct(f"!{MAC_SIZE}sHHB")
 _HELLO = struct.Struct(f"!{MAC_SIZE}sI")
 _ASSIGN = struct.Struct("!BdBB")          # number, session t, table host, entry count
-_ENTRY = struct.Struct("!BI4sHHB")        # number, epoch, ip, tcp, udp, name length
+_ENTRY = struct.Struct("!BBI4sHHB")       # number, owner, epoch, ip, tcp, udp, name length
 #: tank, session time [ms], x, z, heading (f32), vx, vz, omega, hp (f16), alive: 26 bytes,
 #: so a state datagram is 45 bytes (73 on the wire) and 30 Hz to 7 peers is 15.3 KB/s
 _STATE = struct.Struct("!BI3f4eB")
@@ -248,7 +253,8 @@ def _encode_table(number: int, session_t: float, table: Table) -> bytes:
     out = [_ASSIGN.pack(number, session_t, table.host, len(table.entries))]
     for e in table.entries:
         name = name_bytes(e.name)
-        out.append(_ENTRY.pack(e.number, e.epoch, _ip_bytes(e.ip), e.tcp_port, e.udp_port, len(name)) + name)
+        out.append(_ENTRY.pack(e.number, e.owner, e.epoch, _ip_bytes(e.ip), e.tcp_port, e.udp_port, len(name))
+                   + name)
     return b"".join(out)
 
 
@@ -268,20 +274,22 @@ def _decode_table(p: bytes) -> Assign:
     for _ in range(count):
         if off + _ENTRY.size > len(p):
             raise BadMessage("length")
-        n, epoch, ip, tcp, udp, nlen = _ENTRY.unpack_from(p, off)
+        n, owner, epoch, ip, tcp, udp, nlen = _ENTRY.unpack_from(p, off)
         off += _ENTRY.size
         if off + nlen > len(p) or not 1 <= nlen <= MAX_NAME:
             raise BadMessage("length")
         name = _read_name(p[off:off + nlen])
         off += nlen
         _player(n)
-        if n in seen or tcp == 0 or udp == 0:
+        if n in seen or tcp == 0 or udp == 0 or owner > MAX_PLAYERS or owner == n:
             raise BadMessage("range")
         seen.add(n)
-        entries.append(Entry(n, epoch, ".".join(str(b) for b in ip), tcp, udp, name))
+        entries.append(Entry(n, epoch, ".".join(str(b) for b in ip), tcp, udp, name, owner))
     if off != len(p):
         raise BadMessage("length")
-    if host not in seen or number not in seen:
+    players = {e.number for e in entries if e.owner == 0}
+    # the host is a player, and every computer opponent belongs to a player in the table
+    if host not in players or number not in seen or any(e.owner and e.owner not in players for e in entries):
         raise BadMessage("range")
     return Assign(number, session_t, Table(host, tuple(entries)))
 

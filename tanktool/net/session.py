@@ -15,7 +15,10 @@ Every peer runs a World with one tank slot per player number (tank ``n - 1`` is 
   So nobody can be killed by a peer that merely claims it, and no two peers ever score a
   hit differently.
 
-Computer opponents are not part of network sessions yet (the host would run them).
+Computer opponents (``bots``) run on the host like its own tank: they have numbers in the
+table (owned by the host), their states and shots go out from the host, and the host
+decides hits on them.  When the host leaves, the new host adopts them where it last saw
+them and drives them on.
 """
 
 from __future__ import annotations
@@ -57,6 +60,7 @@ class NetMatch:
     spec: TankSpec
     seed: int = 0
     driver: Callable[[World, Any], Command] | None = None
+    bots: int = 0
     state_hz: float = STATE_HZ
     log: Callable[[str], None] = lambda line: None
     world: World = field(init=False)
@@ -79,8 +83,14 @@ class NetMatch:
         for t in self.world.tanks:
             if t is not self.me:
                 self._absent(t)
-        if self.driver is None:
-            self.driver = ScriptedDriver(random.Random(self.seed * 1009 + self.peer.number))
+        self.drivers: dict[int, Callable[[World, Any], Command]] = {}
+        if self.driver is not None:
+            self.drivers[self.peer.number] = self.driver
+        for k in range(self.bots):
+            n = self.peer.add_bot(f"bot{k + 1}")
+            if n is None:
+                break
+            self._adopt(n, fresh=True)
         for e in self.peer.players():
             self.names[e.number] = e.name
 
@@ -90,14 +100,34 @@ class NetMatch:
         t.alive = False
         t.respawn_at = math.inf      # only its own peer brings it back
 
+    def _local(self) -> list[int]:
+        return self.peer.speaks_for()
+
+    def _driver(self, n: int) -> Callable[[World, Any], Command]:
+        d = self.drivers.get(n)
+        if d is None:
+            d = self.drivers[n] = ScriptedDriver(random.Random(self.seed * 1009 + n))
+        return d
+
+    def _adopt(self, n: int, fresh: bool = False) -> None:
+        """Run tank ``n`` here from now on (a new computer opponent, or one whose host
+        left): it goes on from where it was last seen; if dead, it respawns in 3 s."""
+        t = self.world.tanks[n - 1]
+        if fresh:            # at the spawn point the world gave its slot
+            t.hp, t.alive, t.reload = t.spec.hit_points, True, 0.0
+        elif not t.alive:
+            t.respawn_at = self.world.t + self.world.respawn_delay
+        self.remotes.pop(n, None)
+
     def _score(self, n: int) -> Score:
         return self.scores.setdefault(n, Score())
 
     def _place_remotes(self, t_view: float) -> None:
         """Remote tanks where their buffered states put them at ``t_view``."""
+        local = set(self._local())
         for tank in self.world.tanks:
             n = tank.index + 1
-            if tank is self.me:
+            if n in local:
                 continue
             rt = self.remotes.get(n) if n in self.peer.table else None
             s = rt.sample(t_view) if rt is not None else None
@@ -123,9 +153,9 @@ class NetMatch:
     def _on_net(self, events: list) -> None:
         for ev in events:
             if ev.kind == "state":
-                self.remotes.setdefault(ev.number, RemoteTank()).push(ev.body)
+                self.remotes.setdefault(ev.body.tank, RemoteTank()).push(ev.body)
             elif ev.kind == "shot":
-                self._score(ev.number).shots += 1
+                self._score(ev.body.tank).shots += 1
                 self._remote_shot(ev.body)
             elif ev.kind == "hit":
                 h: P.Hit = ev.body
@@ -142,6 +172,9 @@ class NetMatch:
                 self.log(f"player {ev.number} ({ev.body.name}) left ({ev.reason})")
             elif ev.kind == "host":
                 self.log(f"host is now player {ev.number}" + (" (me)" if ev.number == self.peer.number else ""))
+            elif ev.kind == "adopt":
+                self._adopt(ev.number)
+                self.log(f"running computer opponent {ev.number} ({ev.body.name})")
 
     def _count_hit(self, shooter: int, victim: int, killed: bool) -> None:
         self._score(shooter).hits += 1
@@ -149,9 +182,9 @@ class NetMatch:
             self._score(shooter).kills += 1
             self._score(victim).deaths += 1
 
-    def _my_state(self) -> P.State:
-        m = self.me
-        return P.State(self.peer.number, max(self.world.t, 0.0), m.x, m.z, math.remainder(m.heading, 2 * math.pi),
+    def _state_of(self, n: int) -> P.State:
+        m = self.world.tanks[n - 1]
+        return P.State(n, max(self.world.t, 0.0), m.x, m.z, math.remainder(m.heading, 2 * math.pi),
                        m.vx, m.vz, m.omega, m.hp, m.alive)
 
     def _record_view(self, second: int) -> None:
@@ -163,23 +196,28 @@ class NetMatch:
 
     def step(self) -> None:
         """One fixed step of the local world, with the network around it."""
-        w, me, n = self.world, self.me, self.peer.number
+        w = self.world
+        local = self._local()
         self._place_remotes(w.t + w.dt - INTERP_DELAY)
-        cmd = self.driver(w, me) if me.alive else IDLE
-        pose = (me.x, me.z, me.heading, me.vx, me.vz)
         commands: list[Command | None] = [None] * len(w.tanks)
-        commands[n - 1] = cmd
+        poses = {}
+        for n in local:
+            t = w.tanks[n - 1]
+            commands[n - 1] = self._driver(n)(w, t) if t.alive else IDLE
+            poses[n] = (t.x, t.z, t.heading, t.vx, t.vz)
         for ev in w.step(None, commands):
-            if ev.kind == "shot" and ev.tank == n - 1:
-                self._score(n).shots += 1
-                self.peer.send_event(P.Shot(n, w.t, *pose))
-            elif ev.kind == "hit" and ev.other == n - 1:
-                # the victim decides: this hit is real, tell everyone
-                killed = not me.alive
-                self._count_hit(ev.tank + 1, n, killed)
-                self.peer.send_event(P.Hit(ev.tank + 1, n, w.t, ev.value, max(me.hp, 0.0), killed, ev.x, ev.z))
+            if ev.kind == "shot" and ev.tank + 1 in poses:
+                self._score(ev.tank + 1).shots += 1
+                self.peer.send_event(P.Shot(ev.tank + 1, w.t, *poses[ev.tank + 1]))
+            elif ev.kind == "hit" and ev.other + 1 in poses:
+                # the victim's peer decides: this hit is real, tell everyone
+                victim = w.tanks[ev.other]
+                killed = not victim.alive
+                self._count_hit(ev.tank + 1, ev.other + 1, killed)
+                self.peer.send_event(P.Hit(ev.tank + 1, ev.other + 1, w.t, ev.value, max(victim.hp, 0.0), killed,
+                                           ev.x, ev.z))
         for t in w.tanks:     # a remote tank "killed" in our world waits for its own peer
-            if t is not me and not t.alive:
+            if t.index + 1 not in poses and not t.alive:
                 t.respawn_at = math.inf
 
     def run(self, seconds: float) -> dict[str, Any]:
@@ -214,7 +252,8 @@ class NetMatch:
                     self._record_view(next_view)
                     next_view = math.floor(w.t) + 1
             if now >= next_state:
-                peer.send_state(self._my_state())
+                for n in self._local():
+                    peer.send_state(self._state_of(n))
                 next_state += state_period
                 if now - next_state > MAX_LAG:
                     next_state = now
@@ -231,6 +270,7 @@ class NetMatch:
             t = self.world.tanks[e.number - 1]
             sc = self._score(e.number)
             peers.append({"number": e.number, "name": e.name, "address": f"{e.ip}:{e.tcp_port}",
+                          "bot": e.is_bot, "run_by": e.owner or e.number,
                           "position": [round(t.x, 3), round(t.z, 3)], "alive": bool(t.alive),
                           "hit_points": round(max(t.hp, 0.0), 2), "shots": sc.shots, "hits": sc.hits,
                           "kills": sc.kills, "deaths": sc.deaths})
