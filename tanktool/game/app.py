@@ -260,7 +260,11 @@ class App:
                 elif a == "camera" and self.r3d is not None:
                     self.notice = f"camera: {self.r3d.toggle_camera()}"
                 elif a == "view":
-                    self._make_views("top" if self.view == "3d" else "3d")
+                    try:
+                        self._make_views("top" if self.view == "3d" else "3d")
+                    except TanktoolError as e:      # e.g. an arena bundle without model.glb
+                        self.notice = str(e)
+                        self._make_views("top")
                 elif a.startswith("overlay_") and self.top is not None:
                     self.top.toggle(a[len("overlay_"):])
                     if self.view != "top":

@@ -83,37 +83,48 @@ class Hud:
         self.minimap = Minimap(session, max(min(size) // 4, 80))
 
     def draw(self, surface: "pygame.Surface", session: GameSession, fps: float, alpha: float = 1.0,
-             message: str | None = None, view: str = "") -> None:
+             message: str | None = None, view: str = "") -> list["pygame.Rect"]:
+        """Draw the HUD; return the rectangles it covers (the 3D view blends only those:
+        a full-window blend costs a software renderer more than the scene)."""
         w, h = self.size
         focus = session.world.tanks[session.focus()]
         # health bar
         frac = max(focus.hp, 0.0) / focus.spec.hit_points
         bar = pygame.Rect(16, h - 40, 260, 22)
-        pygame.draw.rect(surface, (20, 20, 20, 200), bar.inflate(4, 4))
+        health = [bar.inflate(4, 4)]
+        pygame.draw.rect(surface, (20, 20, 20, 200), health[0])
         colour = (60, 200, 80) if frac > 0.5 else (230, 190, 40) if frac > 0.25 else (220, 50, 40)
         pygame.draw.rect(surface, colour + (255,), (bar.x, bar.y, int(bar.w * frac), bar.h))
         label = f"{focus.name}  HP {max(focus.hp, 0):.0f}/{focus.spec.hit_points:.0f}"
         if not focus.alive:
             label += f"  respawn in {max(focus.respawn_at - session.t, 0):.1f} s"
-        text(surface, label, (bar.x + 6, bar.centery), 22, anchor="midleft")
+        health.append(text(surface, label, (bar.x + 6, bar.centery), 22, anchor="midleft"))
         reload = focus.reload / focus.spec.fire_interval if focus.spec.fire_interval > 0 else 0.0
-        pygame.draw.rect(surface, (200, 200, 220, 255), (bar.x, bar.bottom + 4, int(bar.w * (1 - reload)), 4))
+        health.append(pygame.draw.rect(surface, (200, 200, 220, 255),
+                                       (bar.x, bar.bottom + 4, max(int(bar.w * (1 - reload)), 1), 4)))
         # score and frame rate
-        text(surface, f"score {focus.kills}   deaths {focus.deaths}", (16, 12), 30)
         rate = f"{fps:5.1f} fps" if fps > 0 else "headless"      # a screenshot has no frame rate
-        text(surface, f"{rate}  {view}", (16, 40), 20, colour=(190, 190, 190))
-        text(surface, f"t {session.t:6.1f} s  {session.info.name}", (16, 58), 20, colour=(190, 190, 190))
+        info = [text(surface, f"score {focus.kills}   deaths {focus.deaths}", (16, 12), 30),
+                text(surface, f"{rate}  {view}", (16, 40), 20, colour=(190, 190, 190)),
+                text(surface, f"t {session.t:6.1f} s  {session.info.name}", (16, 58), 20, colour=(190, 190, 190))]
         # scoreboard
         y = 12
+        board = []
         for name, kills, deaths, hp, alive in session.scoreboard():
             i = session.world.names.index(name)
             colour = tank_colour(i) if alive else (120, 120, 120)
-            text(surface, f"{name:>6} {kills:2d}/{deaths:<2d}", (w - 16, y), 20, colour=colour, anchor="topright")
+            board.append(text(surface, f"{name:>6} {kills:2d}/{deaths:<2d}", (w - 16, y), 20, colour=colour,
+                              anchor="topright"))
             y += 17
         mm = self.minimap.base.get_size()
-        self.minimap.draw(surface, session, (w - mm[0] - 12, h - mm[1] - 12), alpha)
+        topleft = (w - mm[0] - 12, h - mm[1] - 12)
+        self.minimap.draw(surface, session, topleft, alpha)
+        rects = [g[0].unionall(g[1:]) for g in (health, info, board) if g]
+        rects.append(pygame.Rect(topleft, mm))
         if message:
-            text(surface, message, (w // 2, h // 2), 56, anchor="center")
+            rects.append(text(surface, message, (w // 2, h // 2), 56, anchor="center"))
+        # one pixel of slack: text shadows and antialiasing sit on the edges
+        return [r.inflate(2, 2).clip(surface.get_rect()) for r in rects]
 
 
 def save_png(surface: "pygame.Surface", path: str | os.PathLike) -> Path:

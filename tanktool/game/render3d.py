@@ -400,13 +400,19 @@ class Renderer3D:
             self._hud_surface = pygame.Surface(self.size, pygame.SRCALPHA)
         surf = self._hud_surface
         surf.fill((0, 0, 0, 0))
-        self._hud.draw(surf, self.session, fps, alpha, message, view=f"3D {self.camera}")
+        rects = self._hud.draw(surf, self.session, fps, alpha, message, view=f"3D {self.camera}")
         self.hud_tex.write(pygame.image.tobytes(surf, "RGBA"))
         self.ctx.disable(moderngl.DEPTH_TEST)
         self.ctx.enable(moderngl.BLEND)
         self.ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
         self.hud_tex.use(0)
-        self.hud_vao.render(moderngl.TRIANGLE_STRIP)
+        # blend only where the HUD drew: llvmpipe pays per pixel of a full-window quad
+        h = self.size[1]
+        for r in rects:
+            if r.w > 0 and r.h > 0:
+                self.ctx.scissor = (r.x, h - r.bottom, r.w, r.h)       # GL counts rows from the bottom
+                self.hud_vao.render(moderngl.TRIANGLE_STRIP)
+        self.ctx.scissor = None
         self.ctx.disable(moderngl.BLEND)
 
     def release(self) -> None:
