@@ -143,3 +143,22 @@ def test_bindings_roundtrip_keeps_every_action():
     b = Bindings()
     save_bindings(b)
     assert load_bindings().to_dict() == b.to_dict()
+
+
+def test_mouse_motion_turns_when_bound_and_stops_with_the_frame():
+    b = Bindings()
+    b.remap("turn_right", "mouse:x+")
+    b.remap("turn_left", "mouse:x-")
+    s = InputState(b)
+    move = lambda dx, dy=0: pygame.event.Event(pygame.MOUSEMOTION, rel=(dx, dy), pos=(0, 0), buttons=(0, 0, 0))
+    s.handle(move(6))
+    s.handle(move(6))
+    assert s.command().rotate == pytest.approx(0.5)        # 12 px of 24 px for full strength
+    s.handle(move(-100))
+    assert s.command().rotate == -1.0
+    s.end_frame()                                          # the mouse stopped: so does the turn
+    assert s.command().rotate == 0.0
+    assert input_name(move(3)) is None                     # a nudge is not a remap choice
+    assert input_name(move(-60, 5)) == "mouse:x-"
+    assert input_name(move(2, 50)) == "mouse:y+"
+    assert describe(["mouse:x+"]) == "mouse x+"

@@ -373,6 +373,7 @@ class App:
 
     def frame(self, real_dt: float) -> None:
         self.advance(real_dt)
+        self.input.end_frame()
         if self.audio is not None and self.state == "playing":
             self.audio.update(self.alpha)
         self._fps_frames += 1

@@ -4,7 +4,9 @@
 Every physical input has a name:
 
 - ``key:<pygame key name>`` (``key:w``, ``key:up``, ``key:space``)
-- ``mouse:<button>`` (``mouse:1`` is the left button)
+- ``mouse:<button>`` (``mouse:1`` is the left button), and ``mouse:x+`` / ``mouse:x-`` /
+  ``mouse:y+`` / ``mouse:y-`` for moving the mouse (strength: pixels moved during the
+  frame over ``MOUSE_FULL``; the window calls :meth:`InputState.end_frame` after each frame)
 - ``joybutton:<n>``, and ``joyaxis:<n>+`` / ``joyaxis:<n>-`` for one half of an axis
 
 and :class:`Bindings` maps each action to a list of names.  Driving actions are
@@ -49,7 +51,11 @@ DEFAULTS: dict[str, list[str]] = {
     "overlay_agents": ["key:f3"],
     "quit": ["key:f10"],
 }
-INPUT_NAME = re.compile(r"^(key:.+|mouse:\d+|joybutton:\d+|joyaxis:\d+[+-])$")
+INPUT_NAME = re.compile(r"^(key:.+|mouse:\d+|mouse:[xy][+-]|joybutton:\d+|joyaxis:\d+[+-])$")
+#: mouse travel in one frame [px] that counts as a full-strength action
+MOUSE_FULL = 24.0
+#: a mouse move this long in one event is a deliberate choice on the remap screen
+MOUSE_PRESS = 40
 DEADZONE = 0.15
 #: an axis pushed this far counts as a press when remapping or for menu actions
 AXIS_PRESS = 0.6
@@ -134,6 +140,12 @@ def input_name(event: Any) -> str | None:
         return f"key:{pygame.key.name(event.key)}"
     if event.type == pygame.MOUSEBUTTONDOWN:
         return f"mouse:{event.button}"
+    if event.type == pygame.MOUSEMOTION:
+        dx, dy = event.rel
+        if max(abs(dx), abs(dy)) >= MOUSE_PRESS:
+            axis, v = ("x", dx) if abs(dx) >= abs(dy) else ("y", dy)
+            return f"mouse:{axis}{'+' if v > 0 else '-'}"
+        return None
     if event.type == pygame.JOYBUTTONDOWN:
         return f"joybutton:{event.button}"
     if event.type == pygame.JOYAXISMOTION and abs(event.value) >= AXIS_PRESS:
@@ -154,6 +166,7 @@ class InputState:
         self.axes: dict[tuple[int, int], float] = {}   # (joystick instance, axis) -> value
         self.joy_buttons: dict[int, set[str]] = {}     # instance -> buttons held
         self.joysticks: dict[int, Any] = {}            # instance -> pygame Joystick
+        self.mouse_move = [0.0, 0.0]                   # pixels moved during this frame
 
     # ------------------------------------------------------------------ events
     def handle(self, event: Any) -> list[str]:
@@ -172,6 +185,9 @@ class InputState:
             self.pressed.add(name)
         elif t == pygame.MOUSEBUTTONUP:
             self.pressed.discard(f"mouse:{event.button}")
+        elif t == pygame.MOUSEMOTION:
+            self.mouse_move[0] += float(event.rel[0])
+            self.mouse_move[1] += float(event.rel[1])
         elif t == pygame.JOYBUTTONDOWN:
             name = f"joybutton:{event.button}"
             self.joy_buttons.setdefault(self._joy(event), set()).add(name)
@@ -212,8 +228,13 @@ class InputState:
         for key in [k for k in self.axes if k[0] == instance_id]:
             del self.axes[key]
 
+    def end_frame(self) -> None:
+        """The frame's mouse travel has been used: the next frame starts from rest."""
+        self.mouse_move = [0.0, 0.0]
+
     def release_all(self) -> None:
         """Forget held inputs (the window lost focus: keys released elsewhere never arrive)."""
+        self.mouse_move = [0.0, 0.0]
         self.pressed.clear()
         self.joy_buttons.clear()
         self.axes.clear()
@@ -232,6 +253,9 @@ class InputState:
                         v = v * sign
                         if v > dz:
                             best = max(best, min((v - dz) / (1.0 - dz), 1.0))
+            elif name.startswith("mouse:") and name[6] in "xy":
+                v = self.mouse_move[0 if name[6] == "x" else 1] * (1.0 if name[7] == "+" else -1.0)
+                best = max(best, min(v / MOUSE_FULL, 1.0))
             elif name in held:
                 return 1.0
         return best
