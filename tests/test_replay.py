@@ -171,3 +171,29 @@ def test_cli_record_then_replay_gives_the_same_report(tmp_path):
     assert res.exit_code == 2 and "not the one the replay was recorded on" in res.output
     res = run(cli, ["play", "--record", str(tape), "--replay", str(tape)])
     assert res.exit_code == 2 and "cannot be used together" in res.output
+
+
+def test_game_session_replays_to_the_recorded_state_and_screenshots(box, tmp_path):
+    """The window's session (game/session.py) driven by a tape ends where the match did."""
+    from click.testing import CliRunner
+
+    from tanktool.cli.main import cli
+    from tanktool.game.headless import FRAME, run_frames
+    from tanktool.game.replay_session import replay_frames, replay_session
+
+    arena, spec = box
+    _, replay = record_match(arena, spec, bots=3, seconds=3.0, seed=7, arena_ref="box", vehicle_ref="light")
+    session = replay_session(replay)
+    assert replay_frames(replay, FRAME) == 180
+    run_frames(session, 180)
+    assert session.world.steps == 360 and state_digest(session.world) == replay.header["final_state"]
+    tape = tmp_path / "s.ttr"
+    write_replay(tape, replay)
+    run = CliRunner().invoke
+    shot = tmp_path / "shot.png"
+    res = run(cli, ["play", "--replay", str(tape), "--headless", "--screenshot", str(shot), "--view", "top",
+                    "--size", "320x240"])
+    assert res.exit_code == 0, res.output
+    assert f"top view of {tape} at frame 180 of 180: {shot}" in res.output and shot.stat().st_size > 1000
+    res = run(cli, ["play", "--replay", str(tape), "--headless", "--screenshot", str(shot), "--frames", "181"])
+    assert res.exit_code == 2 and "the recording has 180 frames" in res.output

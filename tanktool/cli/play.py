@@ -102,8 +102,26 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         # replays are made and played by headless matches (sim/replay.py)
         if record_path is not None and replay_path is not None:
             raise click.UsageError("--record and --replay cannot be used together")
+        if replay_path is not None and (frames is not None or screenshot is not None):
+            # one frame of the recorded match, rendered like --screenshot (default: the last)
+            from ..game.headless import FRAME
+            from ..game.headless import screenshot as take_screenshot
+            from ..game.replay_session import replay_frames, replay_session
+            from ..sim.replay import read_replay
+
+            if screenshot is None:
+                raise click.UsageError("--frames needs --screenshot FILE.png")
+            tape = read_replay(replay_path)
+            total = replay_frames(tape, FRAME)
+            n = total if frames is None else frames
+            if n > total:
+                raise TanktoolError(f"{replay_path}: the recording has {total} frames, --frames asked for {n}")
+            shot = take_screenshot(screenshot, view=view, frames=n, size=(width, height),
+                                   session=replay_session(tape, arena, vehicle))
+            echo(f"{shot['view']} view of {replay_path} at frame {shot['frames']} of {total}: {shot['path']}")
+            return
         if frames is not None or screenshot is not None:
-            raise click.UsageError("--record/--replay run headless matches: use --picture for the final view")
+            raise click.UsageError("--record runs a headless match: use --picture for the final view")
         headless = True
     if headless and (frames is not None or screenshot is not None):
         from ..game.headless import screenshot as take_screenshot

@@ -27,7 +27,8 @@ def run_frames(session: Any, frames: int) -> None:
 
 def screenshot(path: str | os.PathLike, view: str = "3d", frames: int = 120, arena: str | None = None,
                vehicle: str | None = None, bots: int = 8, seed: int = 0, size: tuple[int, int] = (1280, 720),
-               overlays: tuple[str, ...] = (), difficulty: str = "normal", bot: str = "agent") -> dict[str, Any]:
+               overlays: tuple[str, ...] = (), difficulty: str = "normal", bot: str = "agent",
+               session: Any = None) -> dict[str, Any]:
     """Render ``view`` after ``frames`` frames of a bots-only match (``bot`` drivers at
     ``difficulty``); write it to ``path``.
 
@@ -49,7 +50,8 @@ def screenshot(path: str | os.PathLike, view: str = "3d", frames: int = 120, are
     from .session import GameSession
 
     pygame.font.init()
-    session = GameSession(arena, vehicle, bots=bots, seed=seed, player=False, difficulty=difficulty, bot=bot)
+    if session is None:  # a prepared session (a replay's, game/replay_session.py) replaces the bots-only match
+        session = GameSession(arena, vehicle, bots=bots, seed=seed, player=False, difficulty=difficulty, bot=bot)
     run_frames(session, frames)
     if view == "top":
         from .render_top import TopView
