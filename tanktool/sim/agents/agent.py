@@ -9,8 +9,9 @@ the command for this think):
   (``navigation.SearchPlan``), A* paths to each quadrant's centre.
 * **Attack** (an enemy in sight and the reaction time passed): the fuzzy controller
   (``fuzzy.AttackController``) turns, advances or backs off, strafes to dodge, fires.
-* **Evade** (hit twice within 4 s with half the hit points gone): drive to the nearest
-  node out of the threat's line of sight, or, with no cover near, strafe hard.
+* **Evade** (hit twice within 4 s by an enemy it cannot see): drive to the nearest of
+  a few sampled nodes out of the threat's line of sight, or, with no cover near,
+  strafe hard.
 
 Transitions, checked every think (``think_hz`` times a second; the command is held in
 between, as a person holds a key)::
@@ -18,6 +19,8 @@ between, as a person holds a key)::
     any      --enemy seen, reaction time over-->  Attack
     Attack   --enemy lost-->                      Search (from where it was last seen, moved on)
     Wander   --shot heard / hit taken-->          Search (from the shot / from behind us)
+    Wander   --every way leads somewhere seen-->  explore: A* to the nearest region not
+                                                  visited for 60 s, then Wander again
     Search   --all quadrants done, or 60 s-->     Wander
     any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
 

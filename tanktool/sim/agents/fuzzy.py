@@ -27,12 +27,13 @@ input       terms                                               breakpoints
 ==========  ==================================================  ========================
 V           left-fast, still, right-fast                        -10, 0, +10 m/s
 e (turn)    NB, NS, Z, PS, PB                                   -0.5, -0.15, 0, 0.15, 0.5 rad
-|e| (fire)  on-target, close, off                               0, 0.03, 0.09 rad
+|e| (fire)  on-target, close, off                               0, 0.04, 0.1 rad
 |e| (move)  aligned, off                                        0.1, 0.6 rad
-D           near, medium, far                                   12, 40, 90 m
+D           near, medium, far                                   15, 45, 90 m
 ==========  ==================================================  ========================
 
-Rules (consequents; outputs are ``Command`` strengths):
+Rules (consequents).  Turn is a ``Command`` strength; advance and strafe are wanted
+speeds, as fractions of half the top speed, that ``Agent._drive`` turns into commands:
 
 * lead: left-fast -> -asin(10/v_s); still -> 0; right-fast -> +asin(10/v_s)
   (v_s = shell speed: the intercept angle of a target crossing at 10 m/s)
@@ -42,17 +43,20 @@ Rules (consequents; outputs are ``Command`` strengths):
   ===========  =====  ======  ===
   |e| \\ D      near  medium  far
   ===========  =====  ======  ===
-  on-target    1.0    1.0     0.7
-  close        0.9    0.5     0.1
+  on-target    1.0    1.0     0.8
+  close        0.9    0.6     0.2
   off          0.0    0.0     0.0
   ===========  =====  ======  ===
 
-* advance: aligned: near -0.5, medium 0.1, far 0.9; off: near -0.2, medium 0, far 0.3
-* strafe size: aligned: near 0.9, medium 0.7, far 0.3; off: near 0.4, medium 0.3, far 0.1
+* advance (x half the top speed, a wanted speed): aligned: near -0.7, medium -0.1,
+  far 0.8; off: near -0.3, medium 0, far 0.3 (so it holds about 50 m, where the
+  baseline's 3 degree aim error misses more often than our 1.5)
+* strafe size (x half the top speed; the side flips every 1-2.5 s and away from walls):
+  aligned: near 1.0, medium 0.9, far 0.6; off: near 0.5, medium 0.4, far 0.2
 
 So: fire readiness falls with |e| and with D; advance rises with D (back off when
-near, close in when far) and its size falls with |e| (turn first, then drive); strafe
-size falls with D and with |e|.
+near, close in when far) and is damped when not aligned (turn first, then drive);
+strafe size falls with D and with |e|; turn and lead rise with their inputs.
 """
 
 from __future__ import annotations
