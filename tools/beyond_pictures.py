@@ -4,8 +4,9 @@
 
 Each import picture shows the model import-arena built (a 3D view, the world frame's
 x and z on the ground, y up) beside the walls it extracted (the bundle's preview).
-The replay picture is the final state of a match recorded on the imported BZFlag
-arena and then played back from the file (the playback must match bit for bit).
+The replay pictures are the final state of a match recorded on the imported BZFlag
+arena and played back from the file (the playback must match bit for bit), and its
+frame at 30 s in the game's 3D view.
 """
 
 from __future__ import annotations
@@ -98,7 +99,13 @@ def main(argv: list[str]) -> int:
             print("error: the replay did not reach the recorded state", file=sys.stderr)
             return 1
         save_match_picture(playback.result, out / "beyond-replay.png")
-    for name in ("beyond-bzw.png", "beyond-plan.png", "beyond-replay.png"):
+        # frame 1800 (t = 30 s) of the same tape in the game's 3D view
+        from tanktool.game.headless import screenshot
+        from tanktool.game.replay_session import replay_session
+
+        screenshot(out / "beyond-replay-3d.png", view="3d", frames=1800, size=(960, 540),
+                   session=replay_session(read_replay(tmp / "court.ttr")))
+    for name in ("beyond-bzw.png", "beyond-plan.png", "beyond-replay.png", "beyond-replay-3d.png"):
         print(out / name)
     return 0
 
