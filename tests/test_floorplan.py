@@ -104,7 +104,7 @@ def test_svg_plan_on_the_command_line(tmp_path):
     res = CliRunner().invoke(cli, ["import-arena", str(PLANS / "yard.svg"), "-o", str(out),
                                    "--wall-height", "2.5", "--wall-thickness", "0.5"])
     assert res.exit_code == 0, res.output
-    assert "arena 'yard': 22 walls + 4 auxiliary, 8 spawns" in res.output
+    assert "arena 'yard': 18 walls + 4 auxiliary, 8 spawns" in res.output
     a = load_arena(out)
     # the wall from (20, 0) to (20, 25) in the SVG: faces at x = 19.75 and 20.25 up to z = 25
     seg = a.walls.segments
@@ -144,3 +144,22 @@ def test_empty_and_binary_dxf(tmp_path):
     binary.write_bytes(b"AutoCAD Binary DXF\r\n\x1a\x00")
     with pytest.raises(FormatError, match="byte 0: binary DXF is not supported"):
         read_plan(binary)
+
+
+def test_closed_shapes_with_nothing_inside_are_filled_but_the_outer_wall_stays_a_ring():
+    outer = np.array([[0, 0], [20, 0], [20, 20], [0, 20], [0, 0]], float)
+    pillar = np.array([[5, 5], [7, 5], [7, 7], [5, 7], [5, 5]], float)
+    yard = np.array([[10, 10], [18, 10], [18, 18], [10, 18], [10, 10]], float)
+    post = np.array([[13, 13], [15, 13]], float)                   # a line inside the yard
+    fp = plan_walls([outer, pillar, yard, post], 0.5)
+    assert fp.covers(shapely.Point(6, 6))                         # the pillar is solid
+    assert not fp.covers(shapely.Point(12, 12))                   # the yard (it encloses a wall) is not
+    assert not fp.covers(shapely.Point(3, 15))                    # nor the arena inside the outer wall
+    assert not plan_walls([outer], 0.5).covers(shapely.Point(10, 10))   # a lone closed shape is a ring
+
+
+def test_round_pillar_of_the_room_is_solid(room):
+    seg = room.walls.segments
+    r = np.hypot(seg[:, :, 0] - 8, seg[:, :, 1] - 22)
+    near = r.max(axis=1) < 3
+    assert near.any() and (r[near] > 2.1).all()                   # only the pillar's outside face

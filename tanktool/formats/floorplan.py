@@ -3,7 +3,9 @@
 Every line, polyline (open or closed), arc, circle and curve of the drawing is the
 centre line of a wall ``thickness`` thick and ``height`` high: the lines are noded
 and merged where they meet end to end (so corners are mitred, not notched), buffered
-by half the thickness with flat ends, and the union is extruded.  A floor
+by half the thickness with flat ends, and the union is extruded.  A closed shape with
+no other line inside it is filled solid (a pillar), except the largest closed shape
+(the outer wall).  A floor
 rectangle covers the walls' bounding box.  DXF text, points and hatches are not
 lines and are ignored.
 
@@ -177,11 +179,36 @@ def plan_walls(lines: list[np.ndarray], thickness: float):
     # invisible in the wall and keeps the wall list short
     merged = shapely.simplify(merged, thickness / 20.0, preserve_topology=True)
     walls = shapely.buffer(merged, thickness / 2.0, cap_style="flat", join_style="mitre", mitre_limit=MITRE_LIMIT)
+    fills = solid_shapes(lines, geoms, thickness)
+    if fills:
+        walls = shapely.union_all([walls, *fills])
     walls = shapely.make_valid(walls)
     polys = [p for p in shapely.get_parts(walls) if p.geom_type == "Polygon" and p.area > 0]
     if not polys:
         raise FormatError("the drawing's lines make no wall area")
     return shapely.multipolygons(polys) if len(polys) > 1 else polys[0]
+
+
+def solid_shapes(lines: list[np.ndarray], geoms: list, thickness: float) -> list:
+    """Closed shapes to fill: those with no other line inside them (a pillar, a block),
+    except the largest closed shape (the arena's outer wall stays a ring).  A closed
+    line has no door, so what it encloses could never be reached anyway."""
+    import shapely
+
+    closed = [i for i, ln in enumerate(lines) if len(ln) >= 4 and np.allclose(ln[0], ln[-1])]
+    if len(closed) < 2:
+        return []            # a lone closed shape is the largest: it stays a ring
+    polys = {i: shapely.make_valid(shapely.Polygon(lines[i])) for i in closed}
+    largest = max(closed, key=lambda i: polys[i].area)
+    out = []
+    for i in closed:
+        if i == largest or polys[i].area <= 0:
+            continue
+        inner = shapely.buffer(polys[i], -thickness / 2.0)
+        if any(j != i and shapely.intersects(inner, geoms[j]) for j in range(len(geoms))):
+            continue             # it encloses other walls: a walled yard, keep it a ring
+        out.append(polys[i])
+    return out
 
 
 def extrude(footprint, height: float) -> tuple[np.ndarray, np.ndarray]:
