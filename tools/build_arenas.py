@@ -32,7 +32,8 @@ def rebuild(folder: Path, out: Path | None = None, navgrid: bool = True) -> None
     target = out or folder
     r = import_arena(folder / src["file"], target, name=doc.get("name", folder.name), up=src.get("up"),
                      scale=float(src.get("scale", 1.0)), height=float(walls.get("height", 1.0)),
-                     tolerance=float(walls.get("tolerance", 0.01)), force=True, navgrid=doc.get("navgrid"))
+                     tolerance=float(walls.get("tolerance", 0.01)), force=True, navgrid=doc.get("navgrid"),
+                     wall_height=src.get("wall_height"), wall_thickness=src.get("wall_thickness"))
     print(f"{folder.name}: {len(r.walls)} walls, {len(r.spawns)} spawns ({r.seconds:.2f} s)")
     if navgrid and importlib.util.find_spec("tanktool.cli.build_navgrid") is not None:
         subprocess.run([sys.executable, "-m", "tanktool", "build-navgrid", str(target)], check=True)
