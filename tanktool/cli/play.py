@@ -69,9 +69,11 @@ def _size(text: str) -> tuple[int, int]:
 @click.option("--size", default="1280x720", show_default=True, metavar="WxH", help="Window or screenshot size.")
 @click.option("--fullscreen", is_flag=True, help="Open the window full screen.")
 @click.option("--record", "record_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Record the match (setup, seed, every tank's commands) to this replay file (.ttr).")
+              help="Record the match (setup, seed, every tank's commands, yours too) to this replay file "
+                   "(.ttr).  In the window the file is written when a match ends and holds the last one.")
 @click.option("--replay", "replay_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Play a recorded match back from this file: the same final state, bit for bit.")
+              help="Play a recorded match back from this file: the same final state, bit for bit.  In the "
+                   "window unless --headless, --report or --picture.")
 @network_options
 def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | None, seconds: float | None,
          seed: int, integrator: str, report_path: Path | None, picture: Path | None, view: str,
@@ -89,6 +91,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --arena maze --view top
       tanktool play --headless --arena box --seconds 30 --seed 4 --record match.ttr
       tanktool play --replay match.ttr --report again.json --picture end.png
+      tanktool play --arena maze --record mine.ttr      (the window; the file holds the last match)
+      tanktool play --replay mine.ttr                   (watch it in the window)
     """
     if host is not None or join is not None:
         from .net_play import run_network
@@ -121,8 +125,25 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             echo(f"{shot['view']} view of {replay_path} at frame {shot['frames']} of {total}: {shot['path']}")
             return
         if frames is not None or screenshot is not None:
-            raise click.UsageError("--record runs a headless match: use --picture for the final view")
-        headless = True
+            raise click.UsageError("--record records a match, --frames/--screenshot render a picture: "
+                                   "use --picture for the final view")
+        for out in (record_path, report_path, picture):
+            if out is not None and not out.parent.exists():
+                raise TanktoolError(f"{out}: folder {out.parent} does not exist")
+        if replay_path is not None and not headless and report_path is None and picture is None:
+            # the recording in the game window; no display: the headless playback and its check
+            from ..game.app import NoDisplay, run_window
+            from ..sim.replay import read_replay
+
+            tape = read_replay(replay_path)
+            try:
+                run_window(view=view, size=(width, height), fullscreen=fullscreen, replay=tape,
+                           replay_name=str(replay_path))
+                return
+            except NoDisplay as e:
+                echo(f"no display to show the replay ({e}); playing it back headless instead.")
+        if replay_path is not None:
+            headless = True
     if headless and (frames is not None or screenshot is not None):
         from ..game.headless import screenshot as take_screenshot
 
@@ -137,9 +158,13 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         from ..game.app import NoDisplay, run_window
 
         try:
-            run_window(arena=arena, vehicle=vehicle, bots=3 if bots is None else max(bots - 1, 0), seed=seed,
-                       view=view, size=(width, height), fullscreen=fullscreen, difficulty=difficulty,
-                       bot=bot_driver)
+            saved = run_window(arena=arena, vehicle=vehicle, bots=3 if bots is None else max(bots - 1, 0),
+                               seed=seed, view=view, size=(width, height), fullscreen=fullscreen,
+                               difficulty=difficulty, bot=bot_driver, record=record_path)
+            for line in saved:
+                echo(line)
+            if record_path is not None and not saved:
+                echo(f"replay: nothing recorded (no match was played), {record_path} not written")
             return
         except NoDisplay as e:
             echo(f"no display to open the game window ({e}); running a short headless match instead "

@@ -156,7 +156,8 @@ class App:
     def __init__(self, presenter: Presenter | None = None, arena: str | None = None, vehicle: str | None = None,
                  bots: int = 3, seed: int = 0, view: str = "3d", size: tuple[int, int] = (1280, 720),
                  fullscreen: bool = False, bindings: Bindings | None = None, sound: bool = True,
-                 bindings_file: Path | None = None, difficulty: str = "normal", bot: str = "agent") -> None:
+                 bindings_file: Path | None = None, difficulty: str = "normal", bot: str = "agent",
+                 record: Path | None = None, replay: Any = None, replay_name: str = "") -> None:
         arenas, vehicles = bundled("arenas"), bundled("vehicles")
         self.menu = Menu(Choice("arena", arenas + ([arena] if arena and arena not in arenas else [])),
                          Choice("vehicle", vehicles + ([vehicle] if vehicle and vehicle not in vehicles else [])
@@ -191,6 +192,14 @@ class App:
         self.acc = 0.0
         self.fps = 0.0
         self._fps_frames, self._fps_t = 0, time.perf_counter()
+        #: ``--record FILE``: every match played is recorded; the file holds the last one
+        self.record_path = Path(record) if record is not None else None
+        #: what was written (one line each), for the command to print when the window closes
+        self.saved: list[str] = []
+        #: ``--replay FILE`` in the window: a ``sim.replay.Replay`` shown instead of the menu
+        self.replay = replay
+        self.replay_name = replay_name
+        self.replay_done = False
 
     # ------------------------------------------------------------------ lifecycle
     def size(self) -> tuple[int, int]:
@@ -205,18 +214,63 @@ class App:
         m = self.menu
         if self.presenter is None or self.presenter.size != self.size():
             self.open_window()
+        if self.replay is not None:
+            self.start_replay()
+            return
+        self.end_match()
         self.session = GameSession(m.arena.value, m.vehicle.value, bots=int(m.bots.value), seed=self.seed,
                                    difficulty=str(m.difficulty.value), player=True, bot=self.bot)
-        self._make_views(str(m.view.value))
+        if self.record_path is not None:
+            self.session.record()
+        self._begin(str(m.view.value))
+
+    def _begin(self, view: str) -> None:
+        self._make_views(view)
+        self._restart_audio()
+        self.input.release_all()
+        self.acc = 0.0
+        self.state = "playing"
+
+    def _restart_audio(self) -> None:
         if self.audio is not None:
             self.audio.close()
+            self.audio = None
         if self.want_sound:
             from .sounds import GameAudio
 
             self.audio = GameAudio(self.session)
-        self.input.release_all()
-        self.acc = 0.0
-        self.state = "playing"
+
+    def start_replay(self) -> None:
+        """Show the replay from its start: the game's session driven by the tape
+        (``game.replay_session``); the player's input only pauses, quits and changes views."""
+        from .replay_session import replay_session
+
+        if self.presenter is None:
+            self.open_window()
+        self.session = replay_session(self.replay)
+        self.replay_done = False
+        self.notice = f"replay {self.replay_name}".strip()
+        self._begin(self.view)
+
+    def end_match(self) -> str | None:
+        """The match being recorded is over (quit, restart, back to the menu): write its
+        tape atomically to ``--record``'s file, replacing the last match's.  A match that
+        never took a step writes nothing.  Returns the line saying what was written."""
+        s = self.session
+        if s is None or s.recorder is None or self.record_path is None:
+            return None
+        if s.world.steps == 0:
+            return None                       # still armed: a match that starts later is recorded
+        s_tape = s.tape()
+        s.recorder = None                     # written once
+        from ..sim.replay import write_replay
+
+        nbytes = write_replay(self.record_path, s_tape)
+        line = (f"replay: {self.record_path} ({nbytes} bytes, {len(s_tape)} command changes, "
+                f"{s.world.steps} steps = {s.world.steps * s.dt:.2f} s)")
+        self.saved.append(line)
+        self.notice = f"recorded to {self.record_path}"
+        return line
 
     def _make_views(self, view: str) -> None:
         from .render_top import TopView
@@ -234,6 +288,7 @@ class App:
             self.r3d = Renderer3D(self.session, self.presenter.size, ctx=self.presenter.ctx)
 
     def stop(self) -> None:
+        self.end_match()
         if self.audio is not None:
             self.audio.close()
             self.audio = None
@@ -249,6 +304,12 @@ class App:
             self._handle_remap(event)
             return
         actions = self.input.handle(event)
+        if self.replay is not None and self.state in ("playing", "paused") and event.type == pygame.KEYDOWN \
+                and event.key == pygame.K_TAB and self.session is not None:
+            n = len(self.session.world.tanks)       # Tab: ride with the next tank
+            self.session.follow = (self.session.focus() + 1) % n
+            self.notice = f"following {self.session.world.tanks[self.session.follow].name}"
+            return
         if self.state == "menu":
             self._handle_menu(event)
         elif self.state == "playing":
@@ -275,15 +336,18 @@ class App:
                     self.state = "playing"
                     self.input.release_all()
                 elif event.key == pygame.K_r:
+                    if self.replay is not None:
+                        self.start_replay()
+                        return
+                    self.end_match()
                     self.session.restart()
+                    if self.record_path is not None:
+                        self.session.record()
                     self._make_views(self.view)
                     if self.audio is not None:
-                        self.audio.close()
-                        from .sounds import GameAudio
-
-                        self.audio = GameAudio(self.session)
+                        self._restart_audio()
                     self.state = "playing"
-                elif event.key == pygame.K_m:
+                elif event.key == pygame.K_m and self.replay is None:
                     self.stop()
                     self.state = "menu"
                 elif event.key in (pygame.K_q, pygame.K_F10):
@@ -360,12 +424,26 @@ class App:
         dt = self.session.dt
         steps = 0
         while self.acc >= dt:
+            if self.session.max_steps is not None and self.session.world.steps >= self.session.max_steps:
+                self._replay_over()
+                self.acc = 0.0
+                break
             events = self.session.step(self.input.command())
             if self.audio is not None:
                 self.audio.on_events(events)
             self.acc -= dt
             steps += 1
         return steps
+
+    def _replay_over(self) -> None:
+        if self.replay_done:
+            return
+        from ..sim.replay import state_digest
+
+        self.replay_done = True
+        same = state_digest(self.session.world) == self.replay.header["final_state"]
+        self.notice = ("end of replay: the recorded final state, bit for bit" if same else
+                       "end of replay: the state DIFFERS from the recording") + "   (Esc, R: again)"
 
     @property
     def alpha(self) -> float:
@@ -392,7 +470,9 @@ class App:
             return
         if self.session is None:
             return
-        msg = "PAUSED   P resume  R restart  M menu  Q quit" if self.state == "paused" else (self.notice or None)
+        paused = "PAUSED   P resume  R restart  Q quit" if self.replay is not None else \
+            "PAUSED   P resume  R restart  M menu  Q quit"
+        msg = paused if self.state == "paused" else (self.notice or None)
         if self.view == "3d" and self.r3d is not None:
             self.r3d.render(self.alpha, self.fps, msg)
             pygame.display.flip()
@@ -452,15 +532,21 @@ class App:
 
 def run_window(arena: str | None = None, vehicle: str | None = None, bots: int = 3, seed: int = 0,
                view: str = "3d", size: tuple[int, int] = (1280, 720), fullscreen: bool = False,
-               difficulty: str = "normal", bot: str = "agent") -> None:
-    """Open the window and play until the player quits.  Raises NoDisplay when there is
-    no screen."""
+               difficulty: str = "normal", bot: str = "agent", record: Path | None = None,
+               replay: Any = None, replay_name: str = "") -> list[str]:
+    """Open the window and play until the player quits (``record``: every match is
+    recorded, the file holds the last one; ``replay``: show that recording instead of
+    the menu).  Returns the lines saying what was written.  Raises NoDisplay when there
+    is no screen."""
     problem = display_problem()
     if problem is not None:
         raise NoDisplay(problem)
     pygame.init()
-    app = App(None, arena, vehicle, bots, seed, view, size, fullscreen, difficulty=difficulty, bot=bot)
+    app = App(None, arena, vehicle, bots, seed, view, size, fullscreen, difficulty=difficulty, bot=bot,
+              record=record, replay=replay, replay_name=replay_name)
     app.open_window()
+    if replay is not None:
+        app.start_replay()
     clock = pygame.time.Clock()
     last = time.perf_counter()
     try:
@@ -474,3 +560,4 @@ def run_window(arena: str | None = None, vehicle: str | None = None, bots: int =
     finally:
         app.stop()
         pygame.quit()
+    return app.saved

@@ -21,6 +21,8 @@ def _headless_sdl() -> None:
 def run_frames(session: Any, frames: int) -> None:
     """Advance ``session`` by ``frames`` frames of simulated time (bots drive every tank)."""
     steps = max(int(round(frames * FRAME / session.dt)), 0)
+    if getattr(session, "max_steps", None) is not None:      # a replay ends with its tape
+        steps = min(steps, session.max_steps - session.world.steps)
     for _ in range(steps):
         session.step()
 

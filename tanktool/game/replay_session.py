@@ -9,6 +9,7 @@ state, bit for bit; rendering frame N of it gives frame N of the match (a video 
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from ..errors import TanktoolError
@@ -36,9 +37,14 @@ def replay_session(replay: Any, arena: str | None = None, vehicle: str | None = 
     if h.get("vehicle_sha256") and spec_fingerprint(session.spec) != h["vehicle_sha256"]:
         raise TanktoolError(f"vehicle {session.spec.name!r} is not the one the replay was recorded with")
     replay.restore_rng(session.world)
+    replay.apply_names(session.world)
+    session.max_steps = int(h["steps"])
+    if isinstance(h.get("player"), int) and 0 <= h["player"] < bots:
+        session.follow = h["player"]          # a window recording: ride with the player's tank
     return session
 
 
 def replay_frames(replay: Any, frame: float) -> int:
-    """How many frames of ``frame`` seconds the recording lasts."""
-    return int(int(replay.header["steps"]) * float(replay.header["dt"]) / frame + 1e-9)
+    """How many frames of ``frame`` seconds the recording lasts (a last part-frame
+    counts: its frame shows the final state)."""
+    return math.ceil(int(replay.header["steps"]) * float(replay.header["dt"]) / frame - 1e-9)

@@ -99,6 +99,13 @@ class GameSession:
         self.effects: list[Effect] = []
         self.prev = self._poses()
         self.last_events: list[Event] = []
+        #: the tank the camera follows when there is no player (None: the first live one)
+        self.follow: int | None = None
+        #: set by :meth:`record`: every tank's commands, and the match's events for its report
+        self.recorder: Any = None
+        self.events: list[Event] = []
+        #: a replay's session stops here (``game.replay_session``)
+        self.max_steps: int | None = None
 
     # ------------------------------------------------------------------ stepping
     @property
@@ -119,8 +126,14 @@ class GameSession:
     def step(self, player_command: Command = IDLE) -> list[Event]:
         """One fixed simulation step; returns its events and records their effects."""
         self.prev = self._poses()
-        events = self.world.step(None, self.commands(player_command))
         w = self.world
+        commands = self.commands(player_command)
+        if self.recorder is not None:
+            for i, c in enumerate(commands):
+                self.recorder.record(w.steps, i, IDLE if c is None else c)
+        events = w.step(None, commands)
+        if self.recorder is not None:
+            self.events.extend(events)
         for e in events:
             if e.kind == "shot":
                 t = w.tanks[e.tank]
@@ -137,8 +150,49 @@ class GameSession:
 
     def restart(self) -> None:
         """Same arena, tanks and seed, from the start (drivers given by the caller are
-        reused as they are)."""
+        reused as they are).  A recording stops: call :meth:`record` again."""
         self.__init__(**self._args)
+
+    # ------------------------------------------------------------------ recording
+    def record(self) -> None:
+        """Record this match from now on (call before the first step): the world's
+        random state and every tank's commands, the player's included, as
+        ``sim.replay`` records a headless match."""
+        from ..errors import TanktoolError
+        from ..sim.replay import Recorder
+
+        if self.world.steps:
+            raise TanktoolError("a match is recorded from its first step")
+        self.recorder = Recorder()
+        self.recorder.wrap(self.world, self.drivers)       # keeps the generator state; drivers stay ours
+        self.events = []
+
+    def report(self) -> dict[str, Any]:
+        """The match report as ``run_match`` makes it, without ``timing`` (needs
+        :meth:`record`, which keeps the events)."""
+        from ..sim.match import make_report
+
+        bot = self._args["bot"]
+        report = make_report(self.world, self.info.name, self.spec.name, int(self._args["seed"]), self.events)
+        report["bots"] = bot
+        report["difficulty"] = self.difficulty if bot == "agent" else None
+        return report
+
+    def tape(self) -> Any:
+        """The recording so far as a ``sim.replay.Replay`` that ``tanktool play
+        --replay`` plays back headless (``run_match`` with the tape driving every tank)
+        or in the window."""
+        from ..errors import TanktoolError
+        from ..sim.replay import match_header
+
+        if self.recorder is None:
+            raise TanktoolError("this match is not being recorded")
+        w = self.world
+        header = match_header(self.info, self.spec, w, seconds=w.steps * w.dt, seed=int(self._args["seed"]),
+                              arena_ref=_stored_ref(self.arena_ref), vehicle_ref=_stored_ref(self.vehicle_ref),
+                              options={"bot": self._args["bot"], "difficulty": self.difficulty},
+                              winner=self.report().get("winner"), source="window", player=self.player)
+        return self.recorder.replay(header)
 
     # ------------------------------------------------------------------ reading
     def pose(self, i: int, alpha: float = 1.0) -> tuple[float, float, float]:
@@ -161,12 +215,23 @@ class GameSession:
                          for s in self.world.shells])
 
     def focus(self) -> int:
-        """The tank the camera follows: the player, else the first live tank."""
+        """The tank the camera follows: the player, else ``follow``, else the first live tank."""
         if self.player is not None:
             return self.player
+        if self.follow is not None and 0 <= self.follow < len(self.world.tanks):
+            return self.follow
         return next((t.index for t in self.world.tanks if t.alive), 0)
 
     def scoreboard(self) -> list[tuple[str, int, int, float, bool]]:
         """(name, kills, deaths, hit points, alive) best first."""
         rows = [(t.name, t.kills, t.deaths, max(t.hp, 0.0), t.alive) for t in self.world.tanks]
         return sorted(rows, key=lambda r: (-r[1], r[2]))
+
+
+def _stored_ref(ref: Any) -> str | None:
+    """A bundle reference as a replay stores it: an existing path made absolute (so the
+    replay plays from any folder), a bundled name as it is."""
+    if ref is None:
+        return None
+    p = Path(ref)
+    return str(p.resolve()) if p.exists() else str(ref)

@@ -138,7 +138,16 @@ class Replay:
         if len(world.tanks) != int(self.header["bots"]):
             raise TanktoolError(f"replay has {self.header['bots']} tanks, the world {len(world.tanks)}")
         self.restore_rng(world)
+        self.apply_names(world)
         return [ReplayDriver(*self.timeline(i)) for i in range(len(world.tanks))]
+
+    def apply_names(self, world: "World") -> None:
+        """Give the tanks the names they had in the recording (a window match calls the
+        player's tank "you"), so reports and scoreboards read the same."""
+        names = self.header.get("names")
+        if isinstance(names, list) and len(names) == len(world.tanks) and all(isinstance(n, str) for n in names):
+            for t, n in zip(world.tanks, names):
+                t.name = n
 
 
 class ReplayDriver:
@@ -323,7 +332,16 @@ def record_match(arena: "ArenaInfo", spec: "TankSpec", *, bots: int, seconds: fl
     rec = Recorder()
     result = run_match(arena, spec, bots=bots, seconds=seconds, seed=seed, on_progress=on_progress,
                        wrap_drivers=rec.wrap, **options)
-    world = result.world
+    header = match_header(arena, spec, result.world, seconds=seconds, seed=seed, arena_ref=arena_ref,
+                          vehicle_ref=vehicle_ref, options=options, winner=result.report.get("winner"))
+    return result, rec.replay(header)
+
+
+def match_header(arena: "ArenaInfo", spec: "TankSpec", world: "World", *, seconds: float, seed: int,
+                 arena_ref: str | None = None, vehicle_ref: str | None = None,
+                 options: dict[str, Any] | None = None, winner: Any = None, **extra: Any) -> dict[str, Any]:
+    """The replay header of a finished match on ``world`` (``extra`` keys are added:
+    the game window adds ``source`` and ``player``)."""
     header = {
         "format": "tanktool-replay", "tool_version": __version__,
         "arena": arena.name, "arena_ref": arena_ref if arena_ref is not None else
@@ -332,11 +350,12 @@ def record_match(arena: "ArenaInfo", spec: "TankSpec", *, bots: int, seconds: fl
         "vehicle": spec.name, "vehicle_ref": vehicle_ref, "vehicle_sha256": spec_fingerprint(spec),
         "bots": len(world.tanks), "names": world.names, "seconds": float(seconds), "seed": int(seed),
         "steps": int(world.steps), "dt": world.dt, "integrator": world.integrator,
-        "options": {k: v for k, v in options.items() if k not in ("dt", "integrator")},
+        "options": {k: v for k, v in (options or {}).items() if k not in ("dt", "integrator")},
         "final_state": state_digest(world),
-        "winner": result.report.get("winner"),
+        "winner": winner,
     }
-    return result, rec.replay(header)
+    header.update(extra)
+    return header
 
 
 @dataclass
