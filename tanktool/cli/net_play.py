@@ -2,10 +2,12 @@
 
 The options are defined here once and stacked on ``play`` (``network_options``); the
 command hands over to :func:`run_network` when either is given.  ``--bots N`` with
-``--host`` adds N computer opponents that the host runs (and a new host adopts).  A network match runs
-headless for now (the window issue adds menus for it): the local tank is driven by the
-scripted bot, for ``--seconds`` of real time, and ``--report`` writes the match report
-with ``peers``, ``host_changes`` and ``network`` counters.
+``--host`` adds N computer opponents that the host runs (and a new host adopts).  Without
+``--headless`` the match opens in the game window (:func:`run_network_window`), your
+tank driven by your keys, until you quit; the window's start menu offers the same
+(network: off/host/join, address).  With ``--headless`` (or no display) the local tank
+is driven by the scripted bot, for ``--seconds`` of real time, and ``--report`` writes
+the match report with ``peers``, ``host_changes`` and ``network`` counters.
 """
 
 from __future__ import annotations
@@ -33,6 +35,34 @@ def network_options(f: Callable) -> Callable:
     f = click.option("--host", "host", default=None, metavar="[ADDR:]PORT",
                      help="Host a network session, listening on ADDR:PORT (ADDR defaults to 127.0.0.1).")(f)
     return f
+
+
+def run_network_window(host: str | None, join: str | None, player_name: str | None, password: str | None,
+                       arena: str | None, vehicle: str | None, bots: int | None, seed: int, view: str,
+                       size: tuple[int, int], fullscreen: bool, echo: Callable[[str], None]) -> bool:
+    """The network match in the game window, your tank driven by your keys (``bots``:
+    computer opponents the host runs, as with --headless).  Returns False when there is
+    no display (the caller then plays it headless)."""
+    from ..game.app import NoDisplay, run_window
+
+    if host is not None and join is not None:
+        raise click.UsageError("--host and --join exclude each other")
+    bots = bots or 0
+    if bots and join is not None:
+        raise click.UsageError("computer opponents run on the host: --bots goes with --host")
+    if bots > 7:
+        raise click.UsageError(f"--bots {bots}: a session holds 8 tanks, the host's own included (at most 7 bots)")
+    network = ("host", host) if host is not None else ("join", join)
+    try:
+        lines = run_window(arena=arena, vehicle=vehicle, bots=bots, seed=seed, view=view, size=size,
+                           fullscreen=fullscreen, network=network, name=player_name, password=password)  # type: ignore[arg-type]
+    except NoDisplay as e:
+        echo(f"no display to open the game window ({e}); the network match runs headless, "
+             "the scripted bot driving your tank.")
+        return False
+    for line in lines:
+        echo(line)
+    return True
 
 
 def run_network(host: str | None, join: str | None, player_name: str | None, password: str | None,

@@ -95,8 +95,11 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --replay mine.ttr                   (watch it in the window)
     """
     if host is not None or join is not None:
-        from .net_play import run_network
+        from .net_play import run_network, run_network_window
 
+        if not headless and run_network_window(host, join, player_name, password, arena, vehicle, bots, seed,
+                                               view, _size(size), fullscreen, echo):
+            return
         run_network(host, join, player_name, password, arena, vehicle, seconds, seed, report_path, echo)
         return
     from ..sim.match import default_vehicle, format_report, load_match_arena, load_tank_spec, run_match, scoreboard

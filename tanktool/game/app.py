@@ -32,6 +32,9 @@ RESOLUTIONS = ["1280x720", "1600x900", "1920x1080", "1024x576", "800x600"]
 MAX_FRAME = 0.25
 BG = (18, 22, 20)
 HILITE = (250, 210, 70)
+#: the menu's network address: host on it, or join the session there
+DEFAULT_ADDRESS = "127.0.0.1:5000"
+ADDRESS_CHARS = set("0123456789.:abcdefghijklmnopqrstuvwxyz")
 
 
 class NoDisplay(TanktoolError):
@@ -90,9 +93,14 @@ class Menu:
     view: Choice = field(default_factory=lambda: Choice("view", ["3d", "top"]))
     resolution: Choice = field(default_factory=lambda: Choice("resolution", list(RESOLUTIONS)))
     fullscreen: Choice = field(default_factory=lambda: Choice("fullscreen", [False, True]))
+    #: network play: off, host a session (listening on ``address``), or join the one at ``address``
+    network: Choice = field(default_factory=lambda: Choice("network", ["off", "host", "join"]))
+    address: str = DEFAULT_ADDRESS
     cursor: int = 0
 
-    ITEMS = ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen", "bindings", "start", "quit")
+    ITEMS = ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen", "network", "address",
+             "bindings", "start", "quit")
+    CHOICES = ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen", "network")
 
     def item(self) -> str:
         return self.ITEMS[self.cursor]
@@ -200,6 +208,10 @@ class App:
         self.replay = replay
         self.replay_name = replay_name
         self.replay_done = False
+        #: typing into the menu's address field
+        self.editing = False
+        self.player_name: str | None = None
+        self.password: str | None = None
 
     # ------------------------------------------------------------------ lifecycle
     def size(self) -> tuple[int, int]:
@@ -218,6 +230,9 @@ class App:
             self.start_replay()
             return
         self.end_match()
+        if m.network.value != "off":
+            self.start_network()
+            return
         self.session = GameSession(m.arena.value, m.vehicle.value, bots=int(m.bots.value), seed=self.seed,
                                    difficulty=str(m.difficulty.value), player=True, bot=self.bot)
         if self.record_path is not None:
@@ -240,6 +255,40 @@ class App:
 
             self.audio = GameAudio(self.session)
 
+    def start_network(self) -> None:
+        """Host or join a network session (the menu's ``network`` and ``address``) and
+        play it in the window: your tank is yours, the others come over the network
+        (``game.net_session``).  Raises NetError/TanktoolError (the menu shows it)."""
+        from ..net.peer import Peer, parse_address
+        from ..sim.match import load_match_arena, load_tank_spec
+        from .net_session import NetGameSession
+
+        m = self.menu
+        mode = str(m.network.value)
+        if self.presenter is None or self.presenter.size != self.size():
+            self.open_window()
+        info = load_match_arena(m.arena.value)
+        spec = load_tank_spec(m.vehicle.value)
+        name = self.player_name or ("host" if mode == "host" else "player")
+        if mode == "host":
+            peer = Peer.host(parse_address(m.address), name, self.password)
+            ip, port = peer.tcp_address
+            said = f"hosting on {ip}:{port} as player 1 ({name})"
+        else:
+            peer = Peer.join(parse_address(m.address, need_host=True), name, self.password)
+            h = peer.table[peer.host_number]
+            said = f"joined {h.ip}:{h.tcp_port} as player {peer.number} ({name})"
+        try:
+            self.session = NetGameSession(peer, info, spec, seed=self.seed,
+                                          bots=int(m.bots.value) if mode == "host" else 0,
+                                          arena_ref=m.arena.value, vehicle_ref=m.vehicle.value)
+            self._begin(str(m.view.value))
+        except BaseException:
+            peer.close()
+            raise
+        self.saved.append(said)
+        self.notice = said
+
     def start_replay(self) -> None:
         """Show the replay from its start: the game's session driven by the tape
         (``game.replay_session``); the player's input only pauses, quits and changes views."""
@@ -257,6 +306,11 @@ class App:
         tape atomically to ``--record``'s file, replacing the last match's.  A match that
         never took a step writes nothing.  Returns the line saying what was written."""
         s = self.session
+        if getattr(s, "realtime", False):       # a network match: leave the session
+            if not s.closed:
+                s.close()
+                self.saved.append(s.summary())
+            return None
         if s is None or s.recorder is None or self.record_path is None:
             return None
         if s.world.steps == 0:
@@ -335,6 +389,8 @@ class App:
                 if event.key in (pygame.K_p, pygame.K_ESCAPE, pygame.K_RETURN) or "pause" in actions:
                     self.state = "playing"
                     self.input.release_all()
+                elif event.key == pygame.K_r and getattr(self.session, "realtime", False):
+                    self.notice = "a network match goes on: no restart (M leaves it)"
                 elif event.key == pygame.K_r:
                     if self.replay is not None:
                         self.start_replay()
@@ -356,6 +412,18 @@ class App:
     def _handle_menu(self, event: Any) -> None:
         m = self.menu
         step = 0
+        if self.editing:
+            if event.type == pygame.KEYDOWN:
+                if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_TAB):
+                    self.editing = False
+                    m.address = m.address.strip() or DEFAULT_ADDRESS
+                elif event.key == pygame.K_BACKSPACE:
+                    m.address = m.address[:-1]
+                else:
+                    ch = (getattr(event, "unicode", "") or "").lower()
+                    if len(ch) == 1 and ch in ADDRESS_CHARS and len(m.address) < 40:
+                        m.address += ch
+            return
         if event.type == pygame.KEYDOWN:
             step = {pygame.K_LEFT: -1, pygame.K_RIGHT: 1, pygame.K_a: -1, pygame.K_d: 1}.get(event.key, 0)
             if event.key in (pygame.K_UP, pygame.K_w):
@@ -372,7 +440,7 @@ class App:
             step = hx
         elif event.type == pygame.JOYBUTTONDOWN and event.button == 0:
             self._activate()
-        if step and m.item() in ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen"):
+        if step and m.item() in m.CHOICES:
             getattr(m, m.item()).shift(step)
 
     def _activate(self) -> None:
@@ -381,7 +449,10 @@ class App:
             try:
                 self.start()
             except TanktoolError as e:
-                self.notice = str(e)       # a broken bundle: say so, stay in the menu
+                self.notice = str(e)       # a broken bundle, nobody at the address: say so, stay in the menu
+        elif item == "address":
+            self.editing = True
+            self.menu.address = ""
         elif item == "bindings":
             self.state = "remap"
             self.remap_cursor = 0
@@ -417,7 +488,15 @@ class App:
 
     # ------------------------------------------------------------------ time and drawing
     def advance(self, real_dt: float) -> int:
-        """Add real time and take the fixed steps it pays for; returns how many."""
+        """Add real time and take the fixed steps it pays for; returns how many.  A
+        network match keeps its own clock (and runs on while paused: the others do)."""
+        if getattr(self.session, "realtime", False) and self.state in ("playing", "paused"):
+            from ..sim.commands import IDLE
+
+            events = self.session.advance(self.input.command() if self.state == "playing" else IDLE)
+            if self.audio is not None:
+                self.audio.on_events(events)
+            return len({e.step for e in events})
         if self.state != "playing" or self.session is None:
             return 0
         self.acc += min(max(real_dt, 0.0), MAX_FRAME)
@@ -447,6 +526,8 @@ class App:
 
     @property
     def alpha(self) -> float:
+        if getattr(self.session, "realtime", False):
+            return self.session.alpha()
         return self.acc / self.session.dt if self.session is not None else 1.0
 
     def frame(self, real_dt: float) -> None:
@@ -495,6 +576,11 @@ class App:
             colour = HILITE if i == m.cursor else (220, 220, 220)
             if item in ("bindings", "start", "quit"):
                 label = {"bindings": "key and joystick bindings...", "start": "START", "quit": "quit"}[item]
+                if item == "start" and m.network.value != "off":
+                    label = f"START: {m.network.value} {m.address}"
+            elif item == "address":
+                field_text = m.address + ("_" if self.editing else "")
+                label = f"{'address':<12}  [ {field_text} ]" + ("" if self.editing or i != m.cursor else "  Enter: type")
             else:
                 c = getattr(m, item)
                 v = c.value
@@ -533,20 +619,32 @@ class App:
 def run_window(arena: str | None = None, vehicle: str | None = None, bots: int = 3, seed: int = 0,
                view: str = "3d", size: tuple[int, int] = (1280, 720), fullscreen: bool = False,
                difficulty: str = "normal", bot: str = "agent", record: Path | None = None,
-               replay: Any = None, replay_name: str = "") -> list[str]:
+               replay: Any = None, replay_name: str = "", network: tuple[str, str] | None = None,
+               name: str | None = None, password: str | None = None) -> list[str]:
     """Open the window and play until the player quits (``record``: every match is
     recorded, the file holds the last one; ``replay``: show that recording instead of
-    the menu).  Returns the lines saying what was written.  Raises NoDisplay when there
-    is no screen."""
+    the menu; ``network``: ("host" or "join", address) starts that network match at
+    once).  Returns the lines saying what happened (files written, network summary).
+    Raises NoDisplay when there is no screen."""
     problem = display_problem()
     if problem is not None:
         raise NoDisplay(problem)
     pygame.init()
     app = App(None, arena, vehicle, bots, seed, view, size, fullscreen, difficulty=difficulty, bot=bot,
               record=record, replay=replay, replay_name=replay_name)
+    app.player_name, app.password = name, password
     app.open_window()
-    if replay is not None:
-        app.start_replay()
+    try:
+        if replay is not None:
+            app.start_replay()
+        elif network is not None:
+            app.menu.network.set(network[0])
+            app.menu.address = network[1]
+            app.start_network()
+    except BaseException:
+        app.stop()
+        pygame.quit()
+        raise
     clock = pygame.time.Clock()
     last = time.perf_counter()
     try:

@@ -87,7 +87,7 @@ class Hud:
         """Draw the HUD; return the rectangles it covers (the 3D view blends only those:
         a full-window blend costs a software renderer more than the scene)."""
         w, h = self.size
-        focus = session.world.tanks[session.focus()]
+        focus = session.focus_tank()
         # health bar
         frac = max(focus.hp, 0.0) / focus.spec.hit_points
         bar = pygame.Rect(16, h - 40, 260, 22)

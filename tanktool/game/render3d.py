@@ -291,7 +291,7 @@ class Renderer3D:
 
     def camera_pose(self, alpha: float) -> tuple[np.ndarray, np.ndarray]:
         s = self.session
-        t = s.world.tanks[s.focus()]
+        t = s.focus_tank()
         x, z, h = s.pose(t.index, alpha)
         f = np.array([math.cos(h), 0.0, math.sin(h)])
         p = np.array([x, 0.0, z])

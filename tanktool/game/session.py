@@ -222,6 +222,10 @@ class GameSession:
             return self.follow
         return next((t.index for t in self.world.tanks if t.alive), 0)
 
+    def focus_tank(self) -> Any:
+        """The tank :meth:`focus` names."""
+        return self.world.tanks[self.focus()]
+
     def scoreboard(self) -> list[tuple[str, int, int, float, bool]]:
         """(name, kills, deaths, hit points, alive) best first."""
         rows = [(t.name, t.kills, t.deaths, max(t.hp, 0.0), t.alive) for t in self.world.tanks]

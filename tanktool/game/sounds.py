@@ -42,7 +42,11 @@ class GameAudio:
 
     def update(self, alpha: float = 1.0) -> None:
         s = self.session
-        me = s.world.tanks[s.focus()]
+        while len(self.engines) < len(s.world.tanks):      # a network match: players come and go
+            v = self.sound.play("engine", loop=True)
+            self.sound.set_range(v, 3.0, 120.0)
+            self.engines.append(v)
+        me = s.focus_tank()
         x, z, h = s.pose(me.index, alpha)
         self.sound.set_listener((x, EAR_HEIGHT, z), (math.cos(h), 0.0, math.sin(h)), (me.vx, 0.0, me.vz))
         for v, t in zip(self.engines, s.world.tanks):

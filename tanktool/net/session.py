@@ -194,8 +194,9 @@ class NetMatch:
             tanks[str(n)] = [round(t.x, 3), round(t.z, 3), bool(t.alive)]
         self.views.append({"t": second, "tanks": tanks})
 
-    def step(self) -> None:
-        """One fixed step of the local world, with the network around it."""
+    def step(self) -> list:
+        """One fixed step of the local world, with the network around it; returns the
+        world's events of this step."""
         w = self.world
         local = self._local()
         self._place_remotes(w.t + w.dt - INTERP_DELAY)
@@ -205,7 +206,8 @@ class NetMatch:
             t = w.tanks[n - 1]
             commands[n - 1] = self._driver(n)(w, t) if t.alive else IDLE
             poses[n] = (t.x, t.z, t.heading, t.vx, t.vz)
-        for ev in w.step(None, commands):
+        events = w.step(None, commands)
+        for ev in events:
             if ev.kind == "shot" and ev.tank + 1 in poses:
                 self._score(ev.tank + 1).shots += 1
                 self.peer.send_event(P.Shot(ev.tank + 1, w.t, *poses[ev.tank + 1]))
@@ -219,46 +221,67 @@ class NetMatch:
         for t in w.tanks:     # a remote tank "killed" in our world waits for its own peer
             if t.index + 1 not in poses and not t.alive:
                 t.respawn_at = math.inf
+        return events
+
+    def begin(self) -> None:
+        """Start the real-time clocks (``run`` does; a front end that calls :meth:`pump`
+        from its own loop calls this first)."""
+        start = time.monotonic()
+        self.started = start
+        self.next_step = start
+        self.next_state = start
+        self.next_view = math.floor(self.world.t) + 1
+        self.skipped = 0
+        self.stats_since = start
+
+    def pump(self, until: float | None = None, before_step: Callable[[], None] | None = None) -> list:
+        """One turn of the real-time loop: read the network (waiting at most until the
+        next step or state is due, or ``until``; without ``until`` it does not wait),
+        take the steps that are due (``before_step`` is called before each), send the
+        local tanks' states when due.  Returns the events of the steps taken."""
+        w, peer = self.world, self.peer
+        now = time.monotonic()
+        if self.restart_stats:
+            self.restart_stats = False
+            peer.reset_stats()
+            self.stats_since = now
+        wait = 0.0 if until is None else max(0.0, min(self.next_step, self.next_state, until) - now)
+        self._on_net(peer.poll(wait))
+        now = time.monotonic()
+        if now - self.next_step > MAX_LAG:          # starved of CPU: skip, keep real time
+            self.skipped += int((now - self.next_step) / w.dt)
+            self.next_step = now
+            w.t = peer.session_time()
+        events: list = []
+        while self.next_step <= now:
+            if before_step is not None:
+                before_step()
+            events.extend(self.step())
+            self.next_step += w.dt
+            if w.t >= self.next_view:
+                self._record_view(self.next_view)
+                self.next_view = math.floor(w.t) + 1
+        if now >= self.next_state:
+            for n in self._local():
+                peer.send_state(self._state_of(n))
+            self.next_state += 1.0 / self.state_hz
+            if now - self.next_state > MAX_LAG:
+                self.next_state = now
+        return events
 
     def run(self, seconds: float) -> dict[str, Any]:
         """Play ``seconds`` of real time; return the report."""
-        w, peer = self.world, self.peer
-        start = time.monotonic()
-        end = start + seconds
-        next_step = start
-        next_state = start
-        state_period = 1.0 / self.state_hz
-        next_view = math.floor(w.t) + 1
-        skipped = 0
-        self.stats_since = start
+        self.begin()
+        end = self.started + seconds
         while not self.stop:
-            now = time.monotonic()
-            if now >= end:
+            if time.monotonic() >= end:
                 break
-            if self.restart_stats:
-                self.restart_stats = False
-                peer.reset_stats()
-                self.stats_since = now
-            self._on_net(peer.poll(max(0.0, min(next_step, next_state, end) - now)))
-            now = time.monotonic()
-            if now - next_step > MAX_LAG:          # starved of CPU: skip, keep real time
-                skipped += int((now - next_step) / w.dt)
-                next_step = now
-                w.t = peer.session_time()
-            while next_step <= now:
-                self.step()
-                next_step += w.dt
-                if w.t >= next_view:
-                    self._record_view(next_view)
-                    next_view = math.floor(w.t) + 1
-            if now >= next_state:
-                for n in self._local():
-                    peer.send_state(self._state_of(n))
-                next_state += state_period
-                if now - next_state > MAX_LAG:
-                    next_state = now
-        wall = time.monotonic() - start
-        return self.report(wall, skipped)
+            self.pump(until=end)
+        return self.finish()
+
+    def finish(self) -> dict[str, Any]:
+        """The report of the match so far (``run`` ends with it)."""
+        return self.report(time.monotonic() - self.started, self.skipped)
 
     # ------------------------------------------------------------------ report
     def report(self, wall: float, skipped: int = 0) -> dict[str, Any]:

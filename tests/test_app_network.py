@@ -1,0 +1,195 @@
+"""Network play in the game window (SDL's dummy driver): the menu's network item and
+address field, a window that hosts and one that joins, each against a headless
+``NetMatch`` peer in a thread on loopback.  Conditions are polled until a generous
+deadline: nothing here depends on how fast a loaded machine is."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import pygame
+import pytest
+
+from tanktool.game.app import App, Presenter
+from tanktool.net.peer import Peer
+from tanktool.net.session import NetMatch
+from tanktool.sim.match import load_match_arena, load_tank_spec
+
+DEADLINE = 60.0
+
+
+def key(k, down=True, uni=""):
+    return pygame.event.Event(pygame.KEYDOWN if down else pygame.KEYUP, key=k, mod=0, unicode=uni, scancode=0)
+
+
+def press(app, k, uni=""):
+    app.handle(key(k, uni=uni))
+    app.handle(key(k, down=False))
+
+
+def goto(app, item):
+    while app.menu.item() != item:
+        press(app, pygame.K_DOWN)
+
+
+def type_address(app, text):
+    goto(app, "address")
+    press(app, pygame.K_RETURN)              # Enter: type into the field
+    assert app.editing and app.menu.address == ""
+    for ch in text:
+        press(app, pygame.K_UNKNOWN, ch)
+    press(app, pygame.K_RETURN)
+    assert not app.editing and app.menu.address == text
+
+
+@pytest.fixture
+def app(tmp_path, monkeypatch):
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "cfg"))
+    pygame.display.init()
+    pygame.font.init()
+    presenter = Presenter((320, 240), fullscreen=False, want_gl=False)
+    a = App(presenter, arena="box", bots=0, view="top", size=(320, 240), sound=False)
+    yield a
+    a.stop()
+    pygame.display.quit()
+
+
+class Headless:
+    """A headless peer (scripted driver) playing a NetMatch in a thread."""
+
+    def __init__(self, make_peer, bots: int = 0) -> None:
+        self.report = None
+        self.error = None
+        self.match = None
+        self.ready = threading.Event()
+        self.thread = threading.Thread(target=self._run, args=(make_peer, bots), daemon=True)
+        self.thread.start()
+
+    def _run(self, make_peer, bots: int) -> None:
+        try:
+            peer = make_peer()
+            try:
+                self.match = NetMatch(peer, load_match_arena("box"), load_tank_spec("light"), seed=4, bots=bots)
+                self.ready.set()
+                self.report = self.match.run(DEADLINE * 3)
+            finally:
+                peer.close()
+        except Exception as e:           # handed to the test thread
+            self.error = e
+            self.ready.set()
+
+    def finish(self) -> dict:
+        if self.match is not None:
+            self.match.stop = True
+        self.thread.join(DEADLINE)
+        assert not self.thread.is_alive()
+        if self.error is not None:
+            raise self.error
+        return self.report
+
+
+def play_until(app, condition, hold=()):
+    """Run the window's frames in real time, keys held, until ``condition()``."""
+    for k in hold:
+        app.handle(key(k))
+    deadline = time.monotonic() + DEADLINE
+    last = time.perf_counter()
+    while not condition():
+        assert time.monotonic() < deadline, "condition not reached"
+        now = time.perf_counter()
+        app.frame(now - last)
+        last = now
+        time.sleep(0.004)
+    for k in hold:
+        app.handle(key(k, down=False))
+
+
+def test_menu_network_item_and_address_field(app):
+    assert app.menu.network.value == "off" and app.menu.address == "127.0.0.1:5000"
+    goto(app, "network")
+    press(app, pygame.K_RIGHT)
+    assert app.menu.network.value == "host"
+    press(app, pygame.K_RIGHT)
+    assert app.menu.network.value == "join"
+    type_address(app, "127.0.0.1:1")     # w, a, s, d typed into the field do not move the cursor
+    app.frame(0.016)                          # draws "START: join 127.0.0.1:1"
+    goto(app, "start")
+    press(app, pygame.K_RETURN)               # nobody there: one line, still in the menu
+    assert app.state == "menu" and "cannot reach 127.0.0.1:1" in app.notice
+    type_address(app, "nonsense")
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    assert app.state == "menu" and "expected ADDR:PORT" in app.notice
+
+
+def test_window_hosts_a_headless_peer_joins(app):
+    goto(app, "network")
+    press(app, pygame.K_RIGHT)                # host
+    type_address(app, "127.0.0.1:0")          # any free port
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    assert app.state == "playing", app.notice
+    s = app.session
+    assert s.realtime and s.player == 0 and "hosting on 127.0.0.1:" in app.notice
+    address = s.peer.tcp_address
+    assert [t.index for t in s.world.tanks] == [0]          # alone: one tank shown, not 8
+    x0, z0 = s.world_all.tanks[0].position
+    joiner = Headless(lambda: Peer.join(address, "bob", timeout=DEADLINE))
+    try:
+        # the joiner's tank appears in the window's session, placed from its states;
+        # meanwhile the player holds W and the tank drives on its own keys
+        play_until(app, lambda: 1 in [t.index for t in s.world.tanks] and s.world_all.tanks[1].alive
+                   and s.match.remotes[2].states and s.world_all.tanks[0].distance > 2.0, hold=(pygame.K_w,))
+        assert s.world_all.tanks[1].name == "bob"
+        assert [r[0] for r in s.scoreboard()].count("bob") == 1
+        # and the headless peer sees the window's tank where the window drives it
+        m = joiner.match
+        play_until(app, lambda: 1 in m.remotes and len(m.remotes[1].states) > 5)
+        app.frame(0.016)
+        x1, z1 = s.world_all.tanks[0].position
+        assert abs(x1 - x0) + abs(z1 - z0) > 1.0
+    finally:
+        report = joiner.finish()
+    assert report["me"] == 2 and {p["number"] for p in report["peers"]} == {1, 2}
+    assert report["network"]["received"] > 10
+    seen = [v["tanks"]["1"] for v in report["views"] if "1" in v["tanks"]]
+    assert seen, report["views"]
+    press(app, pygame.K_p)
+    assert app.state == "paused"
+    press(app, pygame.K_m)                    # leave the session, back to the menu
+    assert app.state == "menu" and s.closed and any(line.startswith("network:") for line in app.saved)
+
+
+def test_window_joins_a_headless_host_with_a_bot(app):
+    host = Headless(lambda: Peer.host(("127.0.0.1", 0), "alice"), bots=1)
+    try:
+        assert host.ready.wait(DEADLINE) and host.error is None
+        ip, port = host.match.peer.tcp_address
+        goto(app, "network")
+        press(app, pygame.K_LEFT)             # off -> join
+        assert app.menu.network.value == "join"
+        type_address(app, f"{ip}:{port}")
+        goto(app, "start")
+        press(app, pygame.K_RETURN)           # Peer.join blocks; the host's thread answers
+        assert app.state == "playing", app.notice
+        s = app.session
+        assert s.player == 2 and "as player 3" in app.notice        # the host's bot took number 2
+        play_until(app, lambda: {0, 1, 2} <= {t.index for t in s.world.tanks} and s.world_all.tanks[0].alive
+                   and s.world_all.tanks[1].alive)
+        names = {t.index: t.name for t in s.world.tanks}
+        assert names[0] == "alice" and names[1] == "bot1"
+        play_until(app, lambda: 3 in host.match.remotes and len(host.match.remotes[3].states) > 5,
+                   hold=(pygame.K_d,))
+        app.handle(pygame.event.Event(pygame.QUIT))
+        app.stop()                            # EXIT to everyone
+        assert any(line.startswith("network:") for line in app.saved)
+        deadline = time.monotonic() + DEADLINE
+        while not any(x["number"] == 3 for x in list(host.match.left)):
+            assert time.monotonic() < deadline, "the host never saw the window leave"
+            time.sleep(0.02)
+    finally:
+        app.stop()
+        report = host.finish()
+    assert [x["reason"] for x in report["left"] if x["number"] == 3] == ["exit"]
+    assert any(p["shots"] >= 0 and p["number"] == 2 and p["bot"] for p in report["peers"])
