@@ -20,7 +20,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import __version__
-from .errors import ArenaError, FormatError
+from .errors import ArenaError
 from .formats.walls_txt import WallList
 
 #: defaults of the [navgrid] table until build-navgrid rewrites it

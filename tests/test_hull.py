@@ -5,7 +5,7 @@ import pytest
 import trimesh
 
 from tanktool.geometry.hull import (
-    convex_hull_2d, footprint_polygon, hull_points, min_area_rectangle, points_in_prism, polygon_area,
+    convex_hull_2d, footprint_polygon, hull_points, points_in_prism, polygon_area,
 )
 
 

@@ -212,7 +212,6 @@ def walls_case(name: str, code: str, segs, dirs, mutate=None, aux=(-1.0, -1.0, R
 
 def make_cases() -> None:
     segs, dirs = base_walls()
-    bottom = segs[0]  # (0,0)-(40,0)
 
     # --- walls.txt syntax
     def replace_wall(text, seg, new):

@@ -30,7 +30,6 @@ def pair_rules(walls: WallList, grid: float) -> list[Diagnostic]:
     """A202 duplicates, A203 overlaps along the length, A204 X crossings."""
     path = str(walls.path or "walls.txt")
     seg = walls.segments
-    n = len(seg)
     d = seg[:, 1] - seg[:, 0]
     length = np.hypot(d[:, 0], d[:, 1])
     live = np.flatnonzero(length > 0)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from .options import force_option, name_option, progress, scale_option, up_option
+from .options import force_option, name_option, out_option, progress, scale_option, up_option
 
 #: models with more faces than this get a progress bar
 PROGRESS_FACES = 100_000
@@ -26,8 +26,7 @@ def _face_count_guess(model: Path) -> int:
 
 @click.command("import-arena")
 @click.argument("model", type=click.Path(path_type=Path))
-@click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
-              help="Bundle folder to write (default: ./<name>).")
+@out_option
 @name_option
 @up_option
 @scale_option

@@ -20,7 +20,7 @@ import numpy as np
 from .. import __version__
 from ..errors import VehicleError
 from .main import echo
-from .options import force_option, name_option, scale_option, up_option
+from .options import force_option, name_option, out_option, scale_option, up_option
 
 HULL_POINTS = (8, 16)
 LEVELS = (1, 5)
@@ -194,8 +194,7 @@ DRIVE_COMMENT = """\
 
 @click.command("import-vehicle")
 @click.argument("model", type=click.Path(path_type=Path))
-@click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
-              help="Bundle folder to write (default: ./<name>).")
+@out_option
 @name_option
 @up_option
 @scale_option

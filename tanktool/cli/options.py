@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+from pathlib import Path
 
 import click
 
@@ -15,6 +16,9 @@ scale_option = click.option(
     help="Multiply the model's coordinates (after the axis conversion) to get metres.",
 )
 force_option = click.option("--force", is_flag=True, help="Overwrite an existing bundle.")
+out_option = click.option(
+    "-o", "--out", type=click.Path(path_type=Path), default=None, help="Bundle folder to write (default: ./<name>).",
+)
 name_option = click.option("--name", default=None, help="Bundle name (default: the model's file stem).")
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import os
+import re
 import shutil
 import sys
 import tempfile
@@ -59,6 +60,31 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> None:
     atomic_write_bytes(path, text.encode("utf-8"))
 
 
+def read_input(path: str | os.PathLike, expected: str = "a file", label: str | None = None) -> bytes:
+    """The bytes of an input file.  A missing file, a folder or an unreadable file is a
+    FormatError naming ``label`` (default: the path) and saying what was ``expected``."""
+    label = label or str(path)
+    try:
+        return Path(path).read_bytes()
+    except FileNotFoundError:
+        raise FormatError(f"{label}: no such file") from None
+    except IsADirectoryError:
+        raise FormatError(f"{label}: is a folder, expected {expected}") from None
+    except OSError as e:
+        raise FormatError(f"{label}: cannot read: {e.strerror}") from None
+
+
+def read_input_text(path: str | os.PathLike, expected: str = "a text file") -> str:
+    """An input file as UTF-8 text; bytes that are not UTF-8 are a FormatError naming the
+    line and the byte offset."""
+    data = read_input(path, expected)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = data[: e.start].count(b"\n") + 1
+        raise FormatError(f"{path}:{line}: not UTF-8 text (byte offset {e.start})") from None
+
+
 def read_toml(path: str | os.PathLike) -> dict[str, Any]:
     """Read a TOML file; a syntax error becomes a FormatError naming the file."""
     path = Path(path)
@@ -73,10 +99,18 @@ def read_toml(path: str | os.PathLike) -> dict[str, Any]:
         raise FormatError(f"{path}: not UTF-8 text at byte {e.start}") from None
 
 
+#: an array of scalars that tomli_w spread over one line per item
+_SCALAR_ARRAY = re.compile(r"\[\n((?:[ \t]+[^\[\]{}\n]+,\n)+)[ \t]*\]")
+
+
 def dumps_toml(data: dict[str, Any]) -> str:
+    """TOML text; arrays of numbers (points, bounds) each on one line, as people write them."""
     import tomli_w
 
-    return tomli_w.dumps(data)
+    def one_line(m: re.Match) -> str:
+        return "[" + ", ".join(item.strip()[:-1] for item in m.group(1).splitlines()) + "]"
+
+    return _SCALAR_ARRAY.sub(one_line, tomli_w.dumps(data))
 
 
 def write_toml(path: str | os.PathLike, data: dict[str, Any]) -> None:

@@ -45,6 +45,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import FormatError
+from .bundle import read_input
 
 #: BZFlag's default world half-width (``world size``; bzfs doubles it)
 WORLD_SIZE = 400.0
@@ -154,12 +155,7 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
     """
     path = Path(path)
     if text is None:
-        try:
-            data = path.read_bytes()
-        except FileNotFoundError:
-            raise FormatError(f"{path}: no such file") from None
-        except OSError as e:
-            raise FormatError(f"{path}: cannot read: {e.strerror}") from None
+        data = read_input(path, "a .bzw file")
         try:
             text = data.decode("utf-8")
         except UnicodeDecodeError:

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FormatError
+from .bundle import read_input
 
 #: extensions handled here
 PLAN_EXTENSIONS = {".dxf", ".svg"}
@@ -121,12 +122,7 @@ def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
 
     path = Path(path)
     fmt = path.suffix.lower()[1:]
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise FormatError(f"{path}: no such file") from None
-    except OSError as e:
-        raise FormatError(f"{path}: cannot read: {e.strerror}") from None
+    data = read_input(path, "a floor plan")
     if fmt == "dxf":
         check_dxf(path, data)
     elif fmt == "svg":

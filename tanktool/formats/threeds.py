@@ -29,13 +29,12 @@ from __future__ import annotations
 import os
 import struct
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO, Iterator, Sequence, Union
 
 import numpy as np
 
 from ..errors import FormatError
-from .bundle import atomic_write_bytes
+from .bundle import atomic_write_bytes, read_input
 
 if TYPE_CHECKING:
     import trimesh
@@ -556,14 +555,7 @@ def read_3ds(source: str | os.PathLike | bytes | BinaryIO, name: str | None = No
         label = name or "<bytes>"
     elif isinstance(source, (str, os.PathLike)):
         label = name or str(source)
-        try:
-            data = Path(source).read_bytes()
-        except FileNotFoundError:
-            raise FormatError(f"{label}: no such file") from None
-        except IsADirectoryError:
-            raise FormatError(f"{label}: is a folder, expected a .3ds file") from None
-        except OSError as e:
-            raise FormatError(f"{label}: cannot read: {e.strerror}") from None
+        data = read_input(source, "a .3ds file", label)
     else:
         data = source.read()
         label = name or str(getattr(source, "name", "<stream>"))

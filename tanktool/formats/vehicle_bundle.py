@@ -22,7 +22,7 @@ import numpy as np
 
 from ..errors import FormatError, VehicleError
 from ..geometry.spheres import SphereTree, read_spheres
-from .bundle import atomic_write_text, read_toml
+from .bundle import atomic_write_text, read_input_text, read_toml
 
 HULL_MIN, HULL_MAX = 8, 16
 
@@ -62,12 +62,7 @@ def write_hull(path: str | os.PathLike, points: np.ndarray, header: str = "") ->
 def read_hull(path: str | os.PathLike) -> np.ndarray:
     """Read ``hull.txt`` as (k, 3), 8 <= k <= 16; defects raise FormatError with the line."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise FormatError(f"{path}: no such file") from None
-    except UnicodeDecodeError as e:
-        raise FormatError(f"{path}: not UTF-8 text at byte {e.start}") from None
+    text = read_input_text(path, "a hull.txt file")
     rows: list[tuple[float, float, float]] = []
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.split("#", 1)[0].strip()

@@ -13,12 +13,11 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
 from ..errors import FormatError
-from .bundle import atomic_write_text
+from .bundle import atomic_write_text, read_input_text
 
 AUX_MARKER = "# auxiliary"
 
@@ -170,19 +169,7 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
 
 def read_walls(path: str | os.PathLike) -> WallList:
     """Read ``walls.txt``; errors name the file and line."""
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError:
-        raise FormatError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise FormatError(f"{path}: is a folder, expected a walls.txt file") from None
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as e:
-        line = data[: e.start].count(b"\n") + 1
-        raise FormatError(f"{path}:{line}: not UTF-8 text (byte offset {e.start})") from None
-    return parse_walls(text, str(path))
+    return parse_walls(read_input_text(path, "a walls.txt file"), str(path))
 
 
 def format_walls(walls: WallList, header: str | None = None) -> str:

@@ -448,13 +448,10 @@ def write_spheres(path: str | os.PathLike, tree: SphereTree, header: str = "") -
 
 def read_spheres(path: str | os.PathLike) -> SphereTree:
     """Read ``spheres.txt``; any defect is a FormatError naming the file and line."""
+    from ..formats.bundle import read_input_text
+
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise FormatError(f"{path}: no such file") from None
-    except UnicodeDecodeError as e:
-        raise FormatError(f"{path}: not UTF-8 text at byte {e.start}") from None
+    text = read_input_text(path, "a spheres.txt file")
     rows: list[tuple[int, int, int, float, float, float, float]] = []
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.split("#", 1)[0].strip()
