@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from tanktool.formats.threeds import load_scene, read_3ds, write_3ds
+from tanktool.formats.threeds import load_scene, read_3ds
+from tanktool.formats.threeds_write import write_3ds
 
 
 def grid(faces: int) -> tuple[np.ndarray, np.ndarray]:

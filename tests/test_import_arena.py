@@ -144,7 +144,7 @@ def test_bad_options_exit_2(tmp_path):
 
 
 def test_3ds_model_is_read_z_up(tmp_path):
-    from tanktool.formats.threeds import scene_to_3ds_objects, write_3ds
+    from tanktool.formats.threeds_write import scene_to_3ds_objects, write_3ds
 
     room = trimesh.load(write_room(tmp_path / "room.obj"), force="mesh")
     write_3ds(tmp_path / "room.3ds", scene_to_3ds_objects(room))

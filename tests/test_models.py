@@ -10,7 +10,8 @@ import trimesh
 
 from tanktool.errors import FormatError
 from tanktool.formats import models
-from tanktool.formats.threeds import read_3ds, write_3ds
+from tanktool.formats.threeds import read_3ds
+from tanktool.formats.threeds_write import write_3ds
 
 MODELS = Path(__file__).resolve().parent / "data" / "models3ds"
 

@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 
 from tanktool.errors import FormatError
-from tanktool.formats import threeds
+from tanktool.formats import threeds, threeds_write
 from tanktool.formats.models import detect_format
-from tanktool.formats.threeds import read_3ds, write_3ds
+from tanktool.formats.threeds import read_3ds
+from tanktool.formats.threeds_write import write_3ds
 
 MODELS = Path(__file__).resolve().parent / "data" / "models3ds"
 
@@ -393,7 +394,7 @@ def test_scene_to_3ds_objects_round_trip(tmp_path: Path) -> None:
     scene.add_geometry(box, node_name="hull")
     scene.add_geometry(plain, node_name="turret", transform=trimesh.transformations.translation_matrix([0, 2, 0]))
 
-    objects = threeds.scene_to_3ds_objects(scene)
+    objects = threeds_write.scene_to_3ds_objects(scene)
     assert sorted(o[0] for o in objects) == ["hull_0", "hull_1", "turret"]
     hull_z_up = np.vstack([o[1] for o in objects if o[0].startswith("hull")])
     # Y-up (x, y, z) -> Z-up (x, -z, y): the box's height (Y 0..1) becomes file Z

@@ -205,7 +205,7 @@ def write_obj(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]]) -> None
 
 
 def write_3ds_model(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]]) -> None:
-    from tanktool.formats.threeds import write_3ds
+    from tanktool.formats.threeds_write import write_3ds
 
     to_z_up = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.float64)  # (x, y, z) -> (x, -z, y)
     objects = [(name, mesh.vertices @ to_z_up.T, mesh.faces, COLOURS[kind]) for name, kind, mesh in parts]

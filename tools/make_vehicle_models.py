@@ -145,7 +145,7 @@ def tank_scene(s: TankSpec) -> trimesh.Scene:
 
 
 def write_tank_3ds(spec: TankSpec, path: Path) -> None:
-    from tanktool.formats.threeds import scene_to_3ds_objects, write_3ds
+    from tanktool.formats.threeds_write import scene_to_3ds_objects, write_3ds
 
     write_3ds(path, scene_to_3ds_objects(tank_scene(spec)))
 
