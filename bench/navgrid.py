@@ -36,14 +36,13 @@ sys.path.insert(0, str(ROOT))
 from tanktool.formats.walls_txt import WallList  # noqa: E402
 from tanktool.nav.navgrid import (  # noqa: E402
     build_navgrid,
-    classify_reference,
     free_space,
     grid_shape,
     node_coords,
     open_ends,
-    reference_node,
     _oriented,
 )
+from tanktool.nav.reference2002 import classify_reference, reference_node  # noqa: E402
 from tanktool.nav.quadtree import WallQuadtree  # noqa: E402
 from tanktool.nav.synthetic import block_maze  # noqa: E402
 

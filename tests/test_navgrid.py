@@ -12,7 +12,6 @@ from tanktool.nav.navgrid import (
     NavGrid,
     build_navgrid,
     classify,
-    classify_reference,
     format_table,
     free_space,
     grid_shape,
@@ -21,6 +20,7 @@ from tanktool.nav.navgrid import (
     runs,
     too_close,
 )
+from tanktool.nav.reference2002 import classify_reference
 from tanktool.nav.synthetic import assemble, block_maze, box_arena, random_arena, rect
 
 ROOT = Path(__file__).resolve().parent.parent
