@@ -97,6 +97,9 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
     if host is not None or join is not None:
         from .net_play import run_network, run_network_window
 
+        if record_path is not None or replay_path is not None:
+            raise click.UsageError("network matches are not recorded: --record/--replay go without --host/--join")
+
         if not headless and run_network_window(host, join, player_name, password, arena, vehicle, bots, seed,
                                                view, _size(size), fullscreen, echo):
             return

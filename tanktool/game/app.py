@@ -22,7 +22,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import pygame
+os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")   # the command's output is ours
+
+import pygame  # noqa: E402
 
 from ..errors import TanktoolError
 from .input import ACTIONS, Bindings, InputState, describe, input_name, load_bindings, save_bindings
@@ -34,6 +36,8 @@ BG = (18, 22, 20)
 HILITE = (250, 210, 70)
 #: the menu's network address: host on it, or join the session there
 DEFAULT_ADDRESS = "127.0.0.1:5000"
+#: seconds a notice stays over the match
+NOTICE_S = 4.0
 ADDRESS_CHARS = set("0123456789.:abcdefghijklmnopqrstuvwxyz")
 
 
@@ -210,6 +214,7 @@ class App:
         self.replay_done = False
         #: typing into the menu's address field
         self.editing = False
+        self._notice_seen, self._notice_t = "", 0.0
         self.player_name: str | None = None
         self.password: str | None = None
 
@@ -553,7 +558,10 @@ class App:
             return
         paused = "PAUSED   P resume  R restart  Q quit" if self.replay is not None else \
             "PAUSED   P resume  R restart  M menu  Q quit"
-        msg = paused if self.state == "paused" else (self.notice or None)
+        if self.notice != self._notice_seen:        # a notice shows for NOTICE_S seconds over the match
+            self._notice_seen, self._notice_t = self.notice, time.perf_counter()
+        fresh = self.replay_done or time.perf_counter() - self._notice_t < NOTICE_S
+        msg = paused if self.state == "paused" else (self.notice if self.notice and fresh else None)
         if self.view == "3d" and self.r3d is not None:
             self.r3d.render(self.alpha, self.fps, msg)
             pygame.display.flip()

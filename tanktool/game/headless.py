@@ -15,6 +15,7 @@ VIEWS = ("3d", "top")
 def _headless_sdl() -> None:
     # pygame surfaces and fonts need no window; make sure SDL never tries to open one
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 
 

@@ -131,7 +131,9 @@ class NetGameSession:
         r = self.report or self.match.finish()
         net = r["network"]
         return (f"network: {r['seconds']:.1f} s as player {r['me']} of {len(r['peers'])}, host player {r['host']}; "
-                f"sent {net['sent']}, received {net['received']}, dropped {net['dropped']}")
+                f"sent {net['sent']}, received {net['received']}, dropped {net['dropped']}"
+                + (f" ({', '.join(f'{k} {v}' for k, v in sorted(net['dropped_reasons'].items()))})"
+                   if net.get("dropped_reasons") else ""))
 
     # ------------------------------------------------------------------ what GameSession offers
     @property
