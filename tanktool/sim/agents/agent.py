@@ -3,8 +3,10 @@
 States (each a method ``_wander``, ``_search``, ``_attack``, ``_evade`` that returns
 the command for this think):
 
-* **Wander** (start): follow a route of grid nodes chosen by the paper's three-node
-  heuristic with memory (``navigation.Wanderer``).
+* **Wander** (start): explore.  A* to the block that sees the most of what was not
+  seen in the last minute per metre of path (``navigation.Coverage.goal``: the sight
+  memory); when nothing is left unseen, a route of grid nodes chosen by the paper's
+  three-node heuristic with memory (``navigation.Wanderer``).
 * **Search** (an enemy was seen or heard, and is not in sight): the quadrant search
   (``navigation.SearchPlan``), A* paths to each quadrant's centre.
 * **Attack** (an enemy in sight and the reaction time passed): the fuzzy controller
@@ -19,8 +21,6 @@ between, as a person holds a key)::
     any      --enemy seen, reaction time over-->  Attack
     Attack   --enemy lost-->                      Search (from where it was last seen, moved on)
     Wander   --shot heard / hit taken-->          Search (from the shot / from behind us)
-    Wander   --every way leads somewhere seen-->  explore: A* to the nearest region not
-                                                  visited for 60 s, then Wander again
     Search   --all quadrants done, or 60 s-->     Wander
     any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
 
@@ -45,13 +45,17 @@ from ...nav.navgrid import nearest_valid_node
 from ...nav.steering import heading_from_angle
 from ..commands import IDLE, Command
 from .fuzzy import PREDICT, AttackController, FIRE_THRESHOLD
-from .navigation import Memory, SearchPlan, Wanderer, agent_grid, plan_path
+from .navigation import Coverage, Memory, SearchPlan, Wanderer, agent_grid, plan_path, views_for
 from .perception import Senses, Sighting, wrap
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..body import Tank
     from ..world import World
 
+#: corners: braking at this fraction of the engine's deceleration, and up to this much
+#: faster than 3 m/s through a bend gentler than a right angle [m/s]
+CORNER_BRAKE = 0.8
+CORNER_FAST = 6.0
 STATES = ("wander", "search", "attack", "evade")
 
 
@@ -112,6 +116,11 @@ class Agent:
         self.next_think = -math.inf
         self.grid = None
         self.memory: Memory | None = None
+        self.views = None
+        self.coverage: Coverage | None = None
+        self.goal_cell = -1
+        self.goal_gain = 0.0
+        self.recheck = 0.0
         self.wanderer: Wanderer | None = None
         self.controller: AttackController | None = None
         # wander route: world points of nodes, and the walker's node and heading
@@ -124,7 +133,6 @@ class Agent:
         self.state_since = 0.0
         self.evade_until = 0.0
         self.evade_cooldown = -math.inf
-        self.explore_after = 0.0
         self.threat: tuple[float, float] | None = None
         # attack
         self.target: int | None = None
@@ -163,6 +171,8 @@ class Agent:
         self.memory = Memory(self.grid, region=16.0)
         self.wanderer = Wanderer(self.grid, self.memory, self.rng)
         self.controller = AttackController(tank.spec.shell_speed)
+        self.views = views_for(world, self.grid)
+        self.coverage = Coverage(self.views, self.senses.half_angle, self.senses.vision_range)
 
     def _enter(self, state: str, t: float) -> None:
         if state != self.state:
@@ -177,6 +187,7 @@ class Agent:
             self._setup(world, tank)
         t = world.t
         self.memory.visit(tank.x, tank.z, t)  # type: ignore[union-attr]
+        self.coverage.look(tank.x, tank.z, tank.heading, t)  # type: ignore[union-attr]
         previous = self.senses.last_seen.get(self.target) if self.target is not None else None
         seen = self.senses.look(world, tank)
         heard = self.senses.listen(world, tank)
@@ -243,6 +254,35 @@ class Agent:
 
     # ------------------------------------------------------------------ wander
     def _wander(self, world: "World", tank: "Tank") -> Command:
+        """Explore: an A* path to the block that sees the most of what was not seen in
+        the last minute, per metre of path (``Coverage.goal``), chosen again when that
+        is seen on the way (its gain halved) or reached; with nothing left unseen
+        anywhere, the paper's three-node heuristic."""
+        t, x, z = world.t, tank.x, tank.z
+        cov = self.coverage
+        if self.path:
+            while len(self.path) > 1 and math.hypot(self.path[0][0] - x, self.path[0][1] - z) < 3.0:
+                self.path.pop(0)
+            arrived = math.hypot(self.path[-1][0] - x, self.path[-1][1] - z) < 4.0
+            if not arrived and t >= self.recheck:
+                self.recheck = t + 1.0
+                if cov.gain(self.goal_cell, t) < 0.5 * self.goal_gain:
+                    arrived = True
+            if not arrived:
+                return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
+            self.path = []
+        best = cov.goal(x, z, t)
+        if best is not None:
+            cell, gain = best
+            gx, gz = self.views.points[cell]
+            path = plan_path(self.grid, (x, z), (float(gx), float(gz)))
+            if path:
+                self.path, self.goal_cell, self.goal_gain, self.recheck = path, cell, gain, t + 1.0
+                return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
+        return self._heuristic(world, tank)
+
+    def _heuristic(self, world: "World", tank: "Tank") -> Command:
+        """The paper's ternary decision with memory: a 12-node route ahead."""
         grid, wand = self.grid, self.wanderer
         x, z = tank.x, tank.z
         while self.route and math.hypot(self.route[0][0] - x, self.route[0][1] - z) < 2.5:
@@ -255,18 +295,6 @@ class Agent:
                 return self._back_off(tank)
             self.walker = (n, heading_from_angle(tank.heading))
             self.route = []
-        if self.path:
-            # exploring: an A* path to a region not seen for a while
-            while len(self.path) > 1 and math.hypot(self.path[0][0] - x, self.path[0][1] - z) < 3.0:
-                self.path.pop(0)
-            if math.hypot(self.path[-1][0] - x, self.path[-1][1] - z) > 4.0:
-                return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
-            self.memory.visit(self.path[-1][0], self.path[-1][1], world.t)  # type: ignore[union-attr]
-            self.path, self.route = [], []
-            n = nearest_valid_node(grid.valid, grid.node_of(x, z), 6)  # type: ignore[union-attr]
-            self.walker = (n, heading_from_angle(tank.heading)) if n is not None else None
-            if self.walker is None:
-                return self._back_off(tank)
         while len(self.route) < 12:
             node, h = self.walker
             nxt = wand.choose(node, h, world.t)  # type: ignore[union-attr]
@@ -274,22 +302,9 @@ class Agent:
                 break
             self.walker = nxt
             point = grid.centre(*nxt[0])  # type: ignore[union-attr]
-            looping = point in self.route   # a pocket the heuristic only turns about in
+            if point in self.route:     # a pocket the heuristic only turns about in
+                break
             self.route.append(point)
-            if looping or (wand.best_novelty < 0.6 and world.t > self.explore_after):  # type: ignore[union-attr]
-                # every way from here leads somewhere seen lately: go to the nearest
-                # region not visited for a while, by A*, then wander again
-                self.explore_after = world.t + 3.0
-                goal = self.memory.frontier(x, z, world.t, wand.forget)  # type: ignore[union-attr]
-                if goal is not None and math.hypot(goal[0] - x, goal[1] - z) > 4.0:
-                    path = plan_path(grid, (x, z), goal)  # type: ignore[arg-type]
-                    if path:
-                        self.path, self.route, self.walker = path, [], None
-                        return self._follow(world, tank, path, speed=1.0, lookahead=4.0, corner=path[0])
-                if goal is not None:
-                    self.memory.visit(goal[0], goal[1], world.t)  # type: ignore[union-attr]
-                if looping:
-                    break
         if not self.route:
             return self._back_off(tank)
         return self._follow(world, tank, self.route, speed=0.85, lookahead=6.0)
@@ -339,8 +354,9 @@ class Agent:
             self.dodge = -self.dodge
             self.dodge_flip = t + self.rng.uniform(1.0, 2.5)
         top = tank.spec.top_speed
-        lateral = self._dodge_side(world, tank) * out.strafe_size * 0.5 * top
-        return self._drive(world, tank, out.advance * 0.5 * top, lateral, out.rotate, fire)
+        advance, strafe = out.advance, out.strafe_size
+        lateral = self._dodge_side(world, tank) * strafe * 0.5 * top
+        return self._drive(world, tank, advance * 0.5 * top, lateral, out.rotate, fire)
 
     def _dodge_side(self, world: "World", tank: "Tank") -> float:
         """The dodge direction, flipped when a wall is near on that side."""
@@ -416,8 +432,16 @@ class Agent:
         # turn first, then drive: full speed only when pointing the right way
         v = speed * top * max(0.0, 1.0 - abs(err) / 1.2)
         if corner is not None:
-            brake = 0.6 * tank.spec.engine_force / tank.spec.mass
-            v = min(v, 3.0 + math.sqrt(2.0 * brake * math.hypot(corner[0] - x, corner[1] - z)))
+            # the speed to take the bend at: 3 m/s for a right angle or sharper, more
+            # for a gentler one; braking at CORNER_BRAKE of the engine's deceleration
+            brake = CORNER_BRAKE * tank.spec.engine_force / tank.spec.mass
+            bend = math.pi / 2
+            k = points.index(corner) if corner in points else -1
+            if 0 <= k < len(points) - 1:
+                nx, nz = points[k + 1]
+                bend = abs(wrap(math.atan2(nz - corner[1], nx - corner[0]) - math.atan2(corner[1] - z, corner[0] - x)))
+            vc = 3.0 + CORNER_FAST * max(0.0, 1.0 - bend / (math.pi / 2))
+            v = min(v, vc + math.sqrt(2.0 * brake * math.hypot(corner[0] - x, corner[1] - z)))
         return self._drive(world, tank, v, 0.0, rotate)
 
     def _free(self, world: "World", tank: "Tank", angle: float, length: float, offsets: tuple[float, ...]) -> float:
@@ -506,7 +530,6 @@ class Agent:
             self.reverse_turn = 1.0 if self.rng.random() < 0.5 else -1.0
             self.progress_at = (t + 0.8, math.nan, math.nan)
             self.route, self.walker, self.path = [], None, []
-            self.explore_after = 0.0
             return self._drive(world, tank, -4.0, 0.0, self.reverse_turn)
         return cmd
 

@@ -48,9 +48,10 @@ speeds, as fractions of half the top speed, that ``Agent._drive`` turns into com
   off          0.0    0.0     0.0
   ===========  =====  ======  ===
 
-* advance (x half the top speed, a wanted speed): aligned: near -0.7, medium -0.1,
-  far 0.8; off: near -0.3, medium 0, far 0.3 (so it holds about 50 m, where the
-  baseline's 3 degree aim error misses more often than our 1.5)
+* advance (x half the top speed, a wanted speed): aligned: near -0.7, medium -0.5,
+  far 0.6; off: near -0.3, medium -0.2, far 0.2 (so it holds about 65 m where the
+  arena allows: an aim error in angle misses more the farther the target, and the
+  baseline's 3 degrees suffer more from it than our 1.5)
 * strafe size (x half the top speed; the side flips every 1-2.5 s and away from walls):
   aligned: near 1.0, medium 0.9, far 0.6; off: near 0.5, medium 0.4, far 0.2
 
@@ -120,7 +121,7 @@ DIST = Variable("distance", ("near", "medium", "far"), (15.0, 45.0, 90.0))
 
 TURN = (-1.0, -0.6, 0.0, 0.6, 1.0)
 FIRE = ((1.0, 1.0, 0.8), (0.9, 0.6, 0.2), (0.0, 0.0, 0.0))
-ADVANCE = ((-0.7, -0.1, 0.8), (-0.3, 0.0, 0.3))
+ADVANCE = ((-0.7, -0.5, 0.6), (-0.3, -0.2, 0.2))
 STRAFE = ((1.0, 0.9, 0.6), (0.5, 0.4, 0.2))
 #: fire when the readiness reaches this
 FIRE_THRESHOLD = 0.5

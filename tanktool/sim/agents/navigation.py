@@ -1,5 +1,5 @@
 """Where an agent drives: its navigation grid, the wander heuristic with memory, the
-quadrant search, and following a list of waypoints.
+sight memory and exploration, the quadrant search.
 
 **The agent's grid.**  The bundled ``navgrid.npz`` is built at 0.5 m for the largest
 vehicle; an agent wants coarser nodes (A* over a few thousand nodes, not forty
@@ -18,6 +18,17 @@ time since the agent last visited the region (``region`` metres square) of the n
 ``look`` nodes down that way, as a fraction of ``forget`` seconds -- times a small
 random jitter.  With no memory and no jitter the weights are all 1 and the choice is
 exactly ``choose_next``'s (tested on the paper's example).
+
+**Explore** (what Wander does now) uses a memory of what was *seen*, not only where
+the agent drove: ``Views`` cuts the grid into 4 m blocks (coarser in big arenas), one
+representative valid node each, and works out once per arena which blocks are in line
+of sight of which (the walls against every pair of representatives) and which blocks
+touch; ``Coverage`` keeps, per agent, when each block was last in its vision cone,
+within its vision range and in line of sight.  The exploration goal is the block that
+sees the most *stale* blocks (not seen for ``fresh`` = 60 s; staleness grows to 1 at
+``forget`` = 90 s, never seen is 1) per metre of path to it (Dijkstra over touching
+blocks, + 10 m), so it looks into what it has not looked at, nearest first, without
+ever reading where an enemy is.
 
 **Search** is the paper's division into quadrants: the arena's rectangle is split into
 four, ordered by their distance to where the enemy was last seen or heard (the one
@@ -286,3 +297,194 @@ def plan_path(grid: NavGrid, start: tuple[float, float], goal: tuple[float, floa
     """A* waypoints from start to goal (the first, our position, dropped); [] when none."""
     pts = find_path(grid, start, goal, snap=int(math.ceil(4.0 / grid.cell)))
     return [(float(x), float(z)) for x, z in pts[1:]]
+
+
+# ------------------------------------------------------------------ what was seen
+class Views:
+    """The static half of the sight memory: the agent's grid cut into square *blocks*
+    (``block`` metres; coarser in big arenas, so there are at most ``max_blocks``), one
+    representative point per block (its valid node nearest the block's centre), the
+    line of sight between every two representatives (no wall crossing the segment:
+    the same test as ``perception.can_see``, for all pairs at once), their distances,
+    and which blocks touch (a valid node of one 4-adjacent to a valid node of the other).
+    Built once per (walls, grid) and cached: it is the map, not anything seen.
+    """
+
+    def __init__(self, grid: NavGrid, segments: np.ndarray, block: float = 4.0, max_blocks: int = 700) -> None:
+        valid = np.asarray(grid.valid, dtype=bool)
+        k = max(int(round(block / grid.cell)), 1)
+        while True:
+            bz, bx = -(-valid.shape[0] // k), -(-valid.shape[1] // k)
+            pad = np.zeros((bz * k, bx * k), dtype=bool)
+            pad[:valid.shape[0], :valid.shape[1]] = valid
+            has = pad.reshape(bz, k, bx, k).any(axis=(1, 3))
+            if has.sum() <= max_blocks:
+                break
+            k += 1
+        self.k = k
+        self.grid = grid
+        self.shape = (bz, bx)
+        self.index = np.full((bz, bx), -1, dtype=np.int64)     # block -> cell number
+        pts, nodes = [], []
+        for bi, bj in zip(*np.nonzero(has)):
+            sub = valid[bi * k:(bi + 1) * k, bj * k:(bj + 1) * k]
+            ii, jj = np.nonzero(sub)
+            c = 0.5 * (k - 1)
+            m = int(np.argmin((ii - c) ** 2 + (jj - c) ** 2))
+            n = (int(bi * k + ii[m]), int(bj * k + jj[m]))
+            self.index[bi, bj] = len(pts)
+            nodes.append(n)
+            pts.append(grid.centre(*n))
+        self.nodes = nodes
+        self.points = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+        n = len(pts)
+        p = self.points
+        self.distance = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
+        # line of sight, all pairs: segment p_a -> p_b against every wall
+        seg = np.asarray(segments, dtype=np.float64).reshape(-1, 2, 2)
+        w0, e = seg[:, 0], seg[:, 1] - seg[:, 0]
+        vis = np.zeros((n, n), dtype=bool)
+        for a in range(n):
+            r = p - p[a]                                      # (n, 2)
+            q = w0 - p[a]                                     # (m, 2)
+            den = r[:, None, 0] * e[None, :, 1] - r[:, None, 1] * e[None, :, 0]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                s = (q[None, :, 0] * e[None, :, 1] - q[None, :, 1] * e[None, :, 0]) / den
+                u = (q[None, :, 0] * r[:, None, 1] - q[None, :, 1] * r[:, None, 0]) / den
+            cross = (den != 0.0) & (s >= 0.0) & (s <= 1.0) & (u >= 0.0) & (u <= 1.0)
+            vis[a] = ~cross.any(axis=1)
+        self.visible = vis
+        # neighbouring blocks (path distances between blocks go through these)
+        cell_of = np.full(valid.shape, -1, dtype=np.int64)
+        ii, jj = np.nonzero(valid)
+        cell_of[ii, jj] = self.index[ii // k, jj // k]
+        self.cell_of = cell_of
+        pairs = set()
+        for a, b in ((cell_of[:, :-1], cell_of[:, 1:]), (cell_of[:-1, :], cell_of[1:, :])):
+            m = (a >= 0) & (b >= 0) & (a != b)
+            pairs.update(zip(a[m].tolist(), b[m].tolist()))
+        self.neighbours: list[list[tuple[int, float]]] = [[] for _ in range(n)]
+        for a, b in pairs:
+            d = float(self.distance[a, b])
+            self.neighbours[a].append((b, d))
+            self.neighbours[b].append((a, d))
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def cell_at(self, x: float, z: float) -> int:
+        """The block cell holding (x, z), or the one of the nearest valid node; -1 if none."""
+        n = self.grid.node_of(x, z)
+        c = int(self.cell_of[n])
+        if c >= 0:
+            return c
+        m = nearest_valid_node(self.grid.valid, n, 6)
+        return int(self.cell_of[m]) if m is not None else -1
+
+    def path_distances(self, start: int) -> np.ndarray:
+        """Dijkstra over touching blocks: metres from ``start`` to every block (inf: unreachable)."""
+        import heapq
+
+        dist = [math.inf] * len(self.points)
+        dist[start] = 0.0
+        heap = [(0.0, start)]
+        nb = self.neighbours
+        while heap:
+            d, a = heapq.heappop(heap)
+            if d > dist[a]:
+                continue
+            for b, w in nb[a]:
+                nd = d + w
+                if nd < dist[b]:
+                    dist[b] = nd
+                    heapq.heappush(heap, (nd, b))
+        return np.asarray(dist)
+
+
+_VIEWS: dict[tuple, Views] = {}
+
+
+def views_for(world: "World", grid: NavGrid) -> Views:
+    """The :class:`Views` of this arena and grid (cached by the walls' content)."""
+    seg = np.asarray(world.walls.segments, dtype=np.float64)
+    key = (hash(seg.tobytes()), hash(np.asarray(grid.valid).tobytes()), float(grid.cell),
+           tuple(np.asarray(grid.origin, dtype=np.float64).tolist()))
+    v = _VIEWS.get(key)
+    if v is None:
+        if len(_VIEWS) >= 8:
+            _VIEWS.pop(next(iter(_VIEWS)))
+        v = _VIEWS[key] = Views(grid, seg)
+    return v
+
+
+class Coverage:
+    """When each block was last in the agent's sight: the dynamic half of the sight
+    memory, and the exploration it drives.
+
+    ``look`` marks the blocks whose representative lies in the vision cone (from the
+    agent's own position), within the vision range and in line of sight of the agent's
+    block (``Views.visible``), plus the block it stands in.  A block's *staleness* is the
+    time since it was last seen over ``forget`` seconds, capped at 1: an enemy who moves
+    may be anywhere not watched lately.  ``goal`` is the exploration target: the block
+    that sees the most staleness (summed over the blocks in sight of it, within the
+    vision range) per metre of path to it, path distances along touching blocks.
+    """
+
+    def __init__(self, views: Views, half_angle: float, vision_range: float, forget: float = 90.0,
+                 fresh: float = 60.0) -> None:
+        self.views = views
+        self.half_angle = half_angle
+        self.vision_range = vision_range
+        self.forget = forget
+        self.fresh = fresh
+        self.seen = np.full(len(views), -math.inf)
+        self.sees = (views.visible & (views.distance <= vision_range)).astype(np.float64)
+
+    def look(self, x: float, z: float, heading: float, t: float) -> None:
+        v = self.views
+        c = v.cell_at(x, z)
+        if c < 0:
+            return
+        self.seen[c] = t
+        cand = np.flatnonzero(self.sees[c])
+        if len(cand) == 0:
+            return
+        p = v.points[cand]
+        dx, dz = p[:, 0] - x, p[:, 1] - z
+        ang = np.abs(np.remainder(np.arctan2(dz, dx) - heading + math.pi, 2.0 * math.pi) - math.pi)
+        near = dx * dx + dz * dz < (0.75 * v.k * v.grid.cell) ** 2
+        self.seen[cand[(ang <= self.half_angle) | near]] = t
+
+    def staleness(self, t: float) -> np.ndarray:
+        age = t - self.seen
+        return np.where(age < self.fresh, 0.0, np.minimum(age / self.forget, 1.0))
+
+    def since(self, x: float, z: float, t: float) -> float:
+        """Seconds since the block of (x, z) was seen (inf: never)."""
+        c = self.views.cell_at(x, z)
+        return t - self.seen[c] if c >= 0 else math.inf
+
+    def gain(self, cell: int, t: float) -> float:
+        """The staleness in sight of ``cell``."""
+        return float(self.sees[cell] @ self.staleness(t))
+
+    def goal(self, x: float, z: float, t: float, weight: np.ndarray | None = None,
+             least: float = 1.0, d0: float = 10.0) -> tuple[int, float] | None:
+        """(block, its gain) of the best block to go and look from; None when nothing in
+        sight of any reachable block has at least ``least`` staleness.  ``weight``
+        multiplies each block's staleness (a prior of where enemies are likely)."""
+        v = self.views
+        c = v.cell_at(x, z)
+        if c < 0:
+            return None
+        s = self.staleness(t)
+        if weight is not None:
+            s = s * weight
+        gain = self.sees @ s
+        dist = v.path_distances(c)
+        score = np.where(np.isfinite(dist) & (gain >= least), gain / (dist + d0), -1.0)
+        score[c] = -1.0
+        best = int(np.argmax(score))
+        if score[best] <= 0.0:
+            return None
+        return best, float(gain[best])

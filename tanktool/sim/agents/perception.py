@@ -9,6 +9,8 @@
 * **Hearing**: a gunshot within the hearing radius reveals roughly where it came from:
   the shooter's position plus Gaussian noise growing with distance.  A shot is the
   shooter's shot counter going up (the same thing the world's ``shot`` event reports).
+* What a seen enemy shows: its position, velocity and the way its hull (and so its
+  gun) points, as a player sees an enemy tank's hull.
 * **Memory**: where each enemy was last seen (and its velocity then) and where the
   latest shot was heard, with times; nothing else about other tanks is kept.
 * **Own state**: hit points (so the agent knows it was hit), speed, reload.
@@ -33,7 +35,8 @@ def wrap(a: float) -> float:
 
 @dataclass(frozen=True)
 class Sighting:
-    """One enemy seen at time ``t``: its index, centre and velocity then, and distance."""
+    """One enemy seen at time ``t``: its index, centre and velocity then, distance, and
+    which way its hull (and gun) points."""
 
     index: int
     x: float
@@ -42,6 +45,7 @@ class Sighting:
     vz: float
     t: float
     distance: float
+    heading: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -104,7 +108,7 @@ class Senses:
             if o is me or not o.alive:
                 continue
             if can_see(world.walls, me.x, me.z, me.heading, o.x, o.z, self.half_angle, self.vision_range):
-                s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z))
+                s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z), o.heading)
                 self.last_seen[o.index] = s
                 out.append(s)
         out.sort(key=lambda s: (s.distance, s.index))
