@@ -4,6 +4,7 @@ menu, remap screen, fixed-timestep play, pause, restart, quit; and the fallback 
 
 import pygame
 import pytest
+from app_helpers import goto, key, press
 from click.testing import CliRunner
 
 from tanktool.cli.main import cli
@@ -21,20 +22,6 @@ def app(tmp_path, monkeypatch):
     yield a
     a.stop()
     pygame.display.quit()
-
-
-def key(k, down=True):
-    return pygame.event.Event(pygame.KEYDOWN if down else pygame.KEYUP, key=k, mod=0, unicode="", scancode=0)
-
-
-def press(app, k):
-    app.handle(key(k))
-    app.handle(key(k, down=False))
-
-
-def goto(app, item):
-    while app.menu.item() != item:
-        press(app, pygame.K_DOWN)
 
 
 def test_menu_choices_and_start(app):

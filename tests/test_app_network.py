@@ -10,6 +10,7 @@ import time
 
 import pygame
 import pytest
+from app_helpers import goto, key, press
 
 from tanktool.game.app import App, Presenter
 from tanktool.net.peer import Peer
@@ -17,20 +18,6 @@ from tanktool.net.session import NetMatch
 from tanktool.sim.match import load_match_arena, load_tank_spec
 
 DEADLINE = 60.0
-
-
-def key(k, down=True, uni=""):
-    return pygame.event.Event(pygame.KEYDOWN if down else pygame.KEYUP, key=k, mod=0, unicode=uni, scancode=0)
-
-
-def press(app, k, uni=""):
-    app.handle(key(k, uni=uni))
-    app.handle(key(k, down=False))
-
-
-def goto(app, item):
-    while app.menu.item() != item:
-        press(app, pygame.K_DOWN)
 
 
 def type_address(app, text):

@@ -7,26 +7,13 @@ import json
 
 import pygame
 import pytest
+from app_helpers import goto, key, press
 from click.testing import CliRunner
 
 from tanktool.cli.main import cli
 from tanktool.game.app import App, Presenter
 from tanktool.sim.match import load_match_arena, load_tank_spec
 from tanktool.sim.replay import play_replay, read_replay, state_digest
-
-
-def key(k, down=True):
-    return pygame.event.Event(pygame.KEYDOWN if down else pygame.KEYUP, key=k, mod=0, unicode="", scancode=0)
-
-
-def press(app, k):
-    app.handle(key(k))
-    app.handle(key(k, down=False))
-
-
-def goto(app, item):
-    while app.menu.item() != item:
-        press(app, pygame.K_DOWN)
 
 
 @pytest.fixture

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..sim.commands import IDLE, Command
-from .session import Effect
+from .session import Effect, update_effects
 
 
 class _Shown:
@@ -99,17 +99,7 @@ class NetGameSession:
         self.command = command
         events = self.match.pump(before_step=self._before_step)
         w = self.world_all
-        for e in events:
-            if e.kind == "shot":
-                t = w.tanks[e.tank]
-                mx, my, mz = t.spec.muzzle_local
-                x, z = t.to_world(mx, mz)
-                self.effects.append(Effect("flash", x, my, z, w.t))
-            elif e.kind == "hit":
-                self.effects.append(Effect("impact", e.x, 1.2, e.z, w.t))
-            elif e.kind == "kill":
-                self.effects.append(Effect("explosion", e.x, 1.0, e.z, w.t))
-        self.effects = [f for f in self.effects if f.age(w.t) < 1.0]
+        self.effects = update_effects(self.effects, events, w)
         for n, name in self.match.names.items():     # the players' names on the scoreboard
             w.tanks[n - 1].name = name
         self.last_events = events

@@ -45,6 +45,24 @@ class Effect:
         return (t - self.t0) / EFFECT_LIFE[self.kind]
 
 
+def update_effects(effects: list[Effect], events: Sequence[Event], world: World) -> list[Effect]:
+    """The effects still alive after a step, plus those its events start: a muzzle
+    flash per shot, an impact per hit, an explosion per kill."""
+    t = world.t
+    out = [f for f in effects if f.age(t) < 1.0]
+    for e in events:
+        if e.kind == "shot":
+            tank = world.tanks[e.tank]
+            mx, my, mz = tank.spec.muzzle_local
+            x, z = tank.to_world(mx, mz)
+            out.append(Effect("flash", x, my, z, t))
+        elif e.kind == "hit":
+            out.append(Effect("impact", e.x, 1.2, e.z, t))
+        elif e.kind == "kill":
+            out.append(Effect("explosion", e.x, 1.0, e.z, t))
+    return out
+
+
 Driver = Callable[[World, Any], Command]
 
 
@@ -134,17 +152,7 @@ class GameSession:
         events = w.step(None, commands)
         if self.recorder is not None:
             self.events.extend(events)
-        for e in events:
-            if e.kind == "shot":
-                t = w.tanks[e.tank]
-                mx, my, mz = t.spec.muzzle_local
-                x, z = t.to_world(mx, mz)
-                self.effects.append(Effect("flash", x, my, z, w.t))
-            elif e.kind == "hit":
-                self.effects.append(Effect("impact", e.x, 1.2, e.z, w.t))
-            elif e.kind == "kill":
-                self.effects.append(Effect("explosion", e.x, 1.0, e.z, w.t))
-        self.effects = [f for f in self.effects if f.age(w.t) < 1.0]
+        self.effects = update_effects(self.effects, events, w)
         self.last_events = events
         return events
 

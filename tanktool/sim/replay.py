@@ -37,7 +37,6 @@ import os
 import struct
 import zlib
 from dataclasses import dataclass, field, fields
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, Callable, Sequence
 
 import numpy as np
@@ -308,15 +307,9 @@ def write_replay(path: str | os.PathLike, replay: Replay) -> int:
 
 
 def read_replay(path: str | os.PathLike) -> Replay:
-    try:
-        data = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise FormatError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise FormatError(f"{path}: is a folder, expected a replay file") from None
-    except OSError as e:
-        raise FormatError(f"{path}: cannot read: {e.strerror}") from None
-    return decode(data, path)
+    from ..formats.bundle import read_input
+
+    return decode(read_input(path, "a replay file"), path)
 
 
 # ---------------------------------------------------------------- matches
