@@ -170,3 +170,49 @@ def test_read_spheres_errors_name_file_and_line(tmp_path, text, message):
     with pytest.raises(FormatError) as e:
         read_spheres(f)
     assert message in str(e.value) and str(f) in str(e.value)
+
+
+def _room(L=20.0, W=10.0, H=20.0, t=0.3) -> trimesh.Trimesh:
+    """Six thin wall plates around empty space (like test1.3ds)."""
+    walls = []
+    for size, pos in [([L, t, W], [0, 0, 0]), ([L, t, W], [0, H, 0]), ([t, H, W], [-L / 2, H / 2, 0]),
+                      ([t, H, W], [L / 2, H / 2, 0]), ([L, H, t], [0, H / 2, -W / 2]), ([L, H, t], [0, H / 2, W / 2])]:
+        b = trimesh.creation.box(size)
+        b.apply_translation(pos)
+        walls.append(b)
+    return trimesh.util.concatenate(walls)
+
+
+def test_thin_plate_leaves_tile_it_along_length_and_width():
+    plate = trimesh.creation.box([8.0, 0.05, 4.0])
+    pts = build_points(plate.vertices, plate.faces, 3000)
+    tree = build_sphere_tree(pts, levels=3, branching=4)
+    leaves = tree.leaves()
+    assert len(leaves) == 16 and contains_points(tree, pts).all()
+    # 16 tiles of 2 x 1 m need radius sqrt(1 + 0.25) = 1.118 each; the root needs 4.47
+    assert tree.radii[leaves].max() <= 1.2
+    span = np.ptp(tree.centers[leaves], axis=0)
+    assert span[0] > 0.75 * 8.0 and span[2] > 0.6 * 4.0 and span[1] < 0.05 + 1e-9
+
+
+def test_hollow_room_leaves_claim_much_less_than_plain_kmeans():
+    from tanktool.geometry.spheres import _exact_tree, _kmeans_parts, _union_count
+
+    room = _room()
+    pts = build_points(room.vertices, room.faces, 3000)
+    tree = build_sphere_tree(pts, levels=3, branching=4)
+    assert len(tree.leaves()) == 16 and contains_points(tree, pts).all()
+    for i in range(1, len(tree)):  # every point of a leaf lies in all its ancestors too
+        assert tree.level[i] == tree.level[tree.parent[i]] + 1
+    plain = _exact_tree(pts, _kmeans_parts(pts, 3, 4, 0), 0)
+    # the union of the leaf spheres (the space the tree claims): columns spanning two
+    # facing walls instead of spheres centred on the plates
+    assert _union_count(tree) < 0.85 * _union_count(plain)
+
+
+def test_tree_is_never_worse_than_plain_kmeans(tank_tree):
+    from tanktool.geometry.spheres import _exact_tree, _kmeans_parts, _union_count
+
+    pts, tree = tank_tree
+    plain = _exact_tree(pts, _kmeans_parts(pts, 3, 4, 0), 0)
+    assert _union_count(tree) <= _union_count(plain) + 1e-9

@@ -200,52 +200,80 @@ def _descend(tree: SphereTree, hit: np.ndarray) -> list[int]:
 # ---------------------------------------------------------------------------
 # minimum enclosing sphere
 
+# 13 directions (axes, face and body diagonals): the points extreme along them
+# start the core set of the minimum sphere and stand for a part's extent
+_DIRS = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [1, -1, 0], [1, 0, 1], [1, 0, -1],
+                  [0, 1, 1], [0, 1, -1], [1, 1, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], dtype=np.float64)
+_DIRS /= np.linalg.norm(_DIRS, axis=1)[:, None]
 
-def _ball_from(boundary: list[np.ndarray]) -> tuple[np.ndarray, float]:
-    """Smallest ball with all of ``boundary`` (1..4 points) on its surface."""
-    p0 = boundary[0]
-    if len(boundary) == 1:
-        return p0.copy(), 0.0
-    # centre = p0 + A^T x with the centre equidistant from all points, lying in their
-    # affine hull: solve the (m-1)x(m-1) Gram system; degenerate sets fall back to lstsq
-    A = np.array([p - p0 for p in boundary[1:]])
-    G = A @ A.T
-    rhs = 0.5 * np.sum(A * A, axis=1)
-    try:
-        x = np.linalg.solve(G, rhs)
-        if not np.all(np.isfinite(x)):
-            raise np.linalg.LinAlgError
-    except np.linalg.LinAlgError:
-        x = np.linalg.lstsq(G, rhs, rcond=None)[0]
-    c = p0 + A.T @ x
-    r = max(float(np.linalg.norm(p - c)) for p in boundary)
-    return c, r
+Ball = tuple  # ((x, y, z), r²) in plain floats
 
 
-def _welzl(P: np.ndarray, n: int, boundary: list[np.ndarray]) -> tuple[np.ndarray, float]:
-    """Minimum ball of P[:n] with ``boundary`` on its surface (Welzl, iterative over P).
+def _ball2(a, b) -> Ball:
+    c = ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2)
+    return c, (a[0] - c[0]) ** 2 + (a[1] - c[1]) ** 2 + (a[2] - c[2]) ** 2
 
-    The scan for the next point outside the current ball is vectorised; recursion
-    only goes as deep as the boundary set (at most 4 points in 3D).
-    """
-    if boundary:
-        c, r = _ball_from(boundary)
+
+def _ball3(a, b, c) -> Ball:
+    """Circumcircle of a triangle in 3D (the farthest pair's ball if it is degenerate)."""
+    ab = (b[0] - a[0], b[1] - a[1], b[2] - a[2])
+    ac = (c[0] - a[0], c[1] - a[1], c[2] - a[2])
+    n = (ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0])
+    nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
+    lab = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]
+    lac = ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2]
+    if nn <= 1e-20 * lab * lac:
+        return max((_ball2(a, b), _ball2(a, c), _ball2(b, c)), key=lambda t: t[1])
+    acn = (ac[1] * n[2] - ac[2] * n[1], ac[2] * n[0] - ac[0] * n[2], ac[0] * n[1] - ac[1] * n[0])
+    nab = (n[1] * ab[2] - n[2] * ab[1], n[2] * ab[0] - n[0] * ab[2], n[0] * ab[1] - n[1] * ab[0])
+    o = tuple((lab * acn[i] + lac * nab[i]) / (2 * nn) for i in range(3))
+    return (a[0] + o[0], a[1] + o[1], a[2] + o[2]), o[0] * o[0] + o[1] * o[1] + o[2] * o[2]
+
+
+def _ball4(a, b, c, d) -> Ball:
+    """Circumsphere of a tetrahedron (the largest face circle's ball if it is flat)."""
+    u = (b[0] - a[0], b[1] - a[1], b[2] - a[2])
+    v = (c[0] - a[0], c[1] - a[1], c[2] - a[2])
+    w = (d[0] - a[0], d[1] - a[1], d[2] - a[2])
+    vw = (v[1] * w[2] - v[2] * w[1], v[2] * w[0] - v[0] * w[2], v[0] * w[1] - v[1] * w[0])
+    wu = (w[1] * u[2] - w[2] * u[1], w[2] * u[0] - w[0] * u[2], w[0] * u[1] - w[1] * u[0])
+    uv = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+    det = u[0] * vw[0] + u[1] * vw[1] + u[2] * vw[2]
+    uu, vv, ww = (sum(t * t for t in x) for x in (u, v, w))
+    if abs(det) <= 1e-10 * (uu * vv * ww) ** 0.5:
+        return max((_ball3(a, b, c), _ball3(a, b, d), _ball3(a, c, d), _ball3(b, c, d)), key=lambda t: t[1])
+    o = tuple((uu * vw[i] + vv * wu[i] + ww * uv[i]) / (2 * det) for i in range(3))
+    return (a[0] + o[0], a[1] + o[1], a[2] + o[2]), o[0] * o[0] + o[1] * o[1] + o[2] * o[2]
+
+
+def _mtf(P: list, n: int, R: list) -> Ball:
+    """Welzl's move-to-front recursion: the smallest ball of P[:n] with R on its surface."""
+    if len(R) == 0:
+        c, r2 = P[0], 0.0
+        start = 1
     else:
-        c, r = P[0].copy(), 0.0
-    if len(boundary) == 4:
-        return c, r
-    start = 0
-    while True:
-        if start >= n:
-            return c, r
-        d2 = np.sum((P[start:n] - c) ** 2, axis=1)
-        tol = (r * (1 + 1e-10) + 1e-12) ** 2
-        out = np.flatnonzero(d2 > tol)
-        if len(out) == 0:
-            return c, r
-        i = start + int(out[0])
-        c, r = _welzl(P, i, boundary + [P[i]])
-        start = i + 1
+        c, r2 = (R[0], 0.0) if len(R) == 1 else _ball2(*R) if len(R) == 2 else _ball3(*R) if len(R) == 3 else _ball4(*R)
+        if len(R) == 4:
+            return c, r2
+        start = 0
+    for i in range(start, n):
+        p = P[i]
+        if (p[0] - c[0]) ** 2 + (p[1] - c[1]) ** 2 + (p[2] - c[2]) ** 2 > r2 * (1 + 1e-12) + 1e-24:
+            c, r2 = _mtf(P, i, R + [p])
+            P.insert(0, P.pop(i))
+    return c, r2
+
+
+def _small_ball(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """Minimum ball of a few (up to ~100) points: Welzl in plain floats, fast for small sets."""
+    P = [tuple(p) for p in points.tolist()]
+    c, r2 = _mtf(P, len(P), [])
+    return np.array(c, dtype=np.float64), float(np.sqrt(max(r2, 0.0)))
+
+
+def _core(proj: np.ndarray) -> np.ndarray:
+    """Indices of the points extreme along the 13 directions (``proj`` = points @ _DIRS.T)."""
+    return np.unique(np.concatenate([proj.argmax(axis=0), proj.argmin(axis=0)]))
 
 
 def min_enclosing_sphere(points: np.ndarray, seed: int = 0) -> tuple[np.ndarray, float]:
@@ -261,15 +289,10 @@ def min_enclosing_sphere(points: np.ndarray, seed: int = 0) -> tuple[np.ndarray,
     # points along 13 directions start it, and each round adds the farthest
     # violators.  The answer is the exact minimum sphere of the core set, which
     # encloses everything once no point is outside, i.e. the exact sphere of all.
-    dirs = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 0], [1, -1, 0], [1, 0, 1], [1, 0, -1],
-                     [0, 1, 1], [0, 1, -1], [1, 1, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], dtype=np.float64)
-    proj = pts @ dirs.T
-    core = np.unique(np.concatenate([proj.argmax(axis=0), proj.argmin(axis=0)]))
+    core = _core(pts @ _DIRS.T)
     rng = np.random.default_rng(seed)
     for _ in range(100):
-        cand = pts[core]
-        cand = cand[rng.permutation(len(cand))]
-        c, r = _welzl(cand, len(cand), [])
+        c, r = _small_ball(pts[core[rng.permutation(len(core))]])
         d2 = np.sum((pts - c) ** 2, axis=1)
         out = np.flatnonzero(d2 > (r * (1 + 1e-9) + 1e-12) ** 2)
         if len(out) == 0:
@@ -278,6 +301,18 @@ def min_enclosing_sphere(points: np.ndarray, seed: int = 0) -> tuple[np.ndarray,
         core = np.union1d(core, worst)
     r = float(np.sqrt(np.max(np.sum((pts - c) ** 2, axis=1))))
     return c, r
+
+
+_QUICK = [0, 1, 2, 9, 10, 11, 12]  # the axes and the body diagonals
+
+
+def _quick_sphere(points: np.ndarray, proj: np.ndarray) -> tuple[np.ndarray, float]:
+    """A sphere around ``points`` within a few per cent of the minimum: the minimum
+    sphere of the extremes along the axes and body diagonals, its radius grown to the
+    farthest point."""
+    ext = proj[:, _QUICK]
+    c, _ = _small_ball(points[np.unique(np.concatenate([ext.argmax(axis=0), ext.argmin(axis=0)]))])
+    return c, float(np.sqrt(np.max(np.sum((points - c) ** 2, axis=1))))
 
 
 # ---------------------------------------------------------------------------
@@ -329,53 +364,292 @@ def _kmeans_split(points: np.ndarray, k: int, seed: int) -> list[np.ndarray]:
     return [p for p in (np.flatnonzero(labels == j) for j in range(labels.max() + 1)) if len(p)]
 
 
-def _split(points: np.ndarray, k: int, seed: int) -> list[np.ndarray]:
-    """Split a part into up to ``k`` compact pieces (index arrays).
+def _grid_splits(points: np.ndarray, k: int) -> list[np.ndarray]:
+    """Label arrays cutting a part into ``k`` cells of equal width along its axes.
 
-    Each child sphere is the minimum sphere of its piece, so compact pieces mean small
-    spheres: k-means clusters, trimmed by the sphere-growing rounds of
-    :func:`_kmeans_split`.  (Repeated best plane cuts were tried as a second candidate
-    and chosen by total sphere volume: no better on the bench models, twice slower.)
+    Frames: the vehicle axes and the part's principal axes (when they differ).  In
+    each: ``k`` slabs along one axis, and ``a x b = k`` grids over two axes — so a
+    plate is cut along its length and width, a column of a room keeps its two facing
+    walls together, a barrel is cut into lengths.
     """
-    uniq = np.unique(points, axis=0)
-    k = min(k, len(uniq))
-    if k <= 1:
-        return [np.arange(len(points))]
-    return _kmeans_split(points, k, seed)
+    frames = [np.eye(3)]
+    if len(points) >= 3:
+        try:
+            _, _, vt = np.linalg.svd(points - points.mean(axis=0), full_matrices=False)
+            if vt.shape == (3, 3) and np.abs(vt).max(axis=1).min() < 0.999:
+                frames.append(vt)
+        except np.linalg.LinAlgError:
+            pass
+    out = []
+    for axes in frames:
+        x = points @ axes.T
+        lo, span = x.min(axis=0), np.ptp(x, axis=0)
+        cache: dict[tuple[int, int], np.ndarray] = {}
+
+        def cut(u: int, n: int) -> np.ndarray:
+            if (u, n) not in cache:
+                edges = lo[u] + span[u] * np.arange(1, n) / n
+                cache[(u, n)] = np.searchsorted(edges, x[:, u], side="right")
+            return cache[(u, n)]
+
+        for u in range(3):
+            if span[u] > 0:
+                out.append(cut(u, k))
+        for a in range(2, k // 2 + 1):
+            b = k // a
+            if a * b != k:
+                continue
+            for u in range(3):
+                for v in range(3):
+                    if u != v and span[u] > 0 and span[v] > 0 and not (a == b and u > v):
+                        out.append(cut(u, a) * b + cut(v, b))
+    return out
 
 
-def build_sphere_tree(points: np.ndarray, levels: int = 3, branching: int = 4, seed: int = 0) -> SphereTree:
+@dataclass
+class _Option:
+    """One way to split a part: its pieces (index arrays) and their quick spheres."""
+
+    pieces: list[np.ndarray]
+    centers: np.ndarray
+    radii: np.ndarray
+    mask: np.ndarray | None = None  # which volume samples the spheres cover
+
+
+def _options(points: np.ndarray, proj: np.ndarray, idx: np.ndarray, k: int, seed: int) -> list[_Option]:
+    """The candidate splits of part ``idx`` into ``k`` pieces (none if it cannot split).
+
+    Candidates: the equal-width grids and slabs of :func:`_grid_splits` and k-means
+    trimmed by sphere growth (:func:`_kmeans_split`); only those with the most
+    pieces are kept, duplicates once.
+    """
+    P = points[idx]
+    if k < 2 or len(idx) < 2 or not np.ptp(P, axis=0).any():
+        return []
+    labels = _grid_splits(P, k)
+    splits = [[p for p in (np.flatnonzero(lab == j) for j in range(k)) if len(p)] for lab in labels]
+    splits.append(_kmeans_split(P, min(k, len(idx)), seed))
+    most = max(len(s) for s in splits)
+    if most < 2:
+        return []
+    out, seen = [], set()
+    for s in splits:
+        if len(s) != most:
+            continue
+        key = frozenset(hash(p[:8].tobytes() + p[-8:].tobytes() + bytes(len(p))) for p in s)
+        if key in seen:
+            continue
+        seen.add(key)
+        parts = [idx[p] for p in s]
+        balls = [_quick_sphere(points[g], proj[g]) for g in parts]
+        out.append(_Option(parts, np.array([b[0] for b in balls]), np.array([b[1] for b in balls])))
+    return out
+
+
+def _samples(lo: np.ndarray, hi: np.ndarray, n: int) -> np.ndarray:
+    """``n`` evenly spread points in the box lo..hi (the R2 low-discrepancy sequence)."""
+    g = 1.2207440846057596  # the root of x^4 = x + 1: R2 in three dimensions
+    alpha = 1.0 / g ** np.arange(1, 4)
+    u = (0.5 + np.arange(1, n + 1)[:, None] * alpha[None]) % 1.0
+    return lo + u * (hi - lo)
+
+
+def _cover(samples: np.ndarray, centers: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """(n,) bool: samples inside any of the spheres."""
+    d2 = (np.sum(samples**2, axis=1)[:, None] - 2.0 * samples @ centers.T + np.sum(centers**2, axis=1)[None])
+    return (d2 <= radii[None] ** 2).any(axis=1)
+
+
+def _choose(samples: np.ndarray, options: list[list[_Option]], fixed: np.ndarray,
+            passes: int = 3) -> tuple[list[int], int]:
+    """Pick one option per part so the union of all the new spheres is smallest.
+
+    Coordinate descent: start from each part's own best, then let each part change
+    its choice while the others stay, until nothing improves.  The union is counted
+    on ``samples`` (plus ``fixed``: spheres that stay).  Returns the choices (-1 for
+    a part without options) and the covered sample count.
+    """
+    for opts in options:
+        for o in opts:
+            if o.mask is None:
+                o.mask = _cover(samples, o.centers, o.radii)
+    choice = [int(np.argmin([np.count_nonzero(o.mask) for o in opts])) if opts else -1 for opts in options]
+
+    def rest(skip: int) -> np.ndarray:
+        m = fixed.copy()
+        for j, opts in enumerate(options):
+            if j != skip and opts:
+                m |= opts[choice[j]].mask
+        return m
+
+    for _ in range(passes):
+        changed = False
+        for i, opts in enumerate(options):
+            if len(opts) < 2:
+                continue
+            others = rest(i)
+            counts = [np.count_nonzero(others | o.mask) for o in opts]
+            best = int(np.argmin(counts))
+            if counts[best] < counts[choice[i]]:
+                choice[i], changed = best, True
+        if not changed:
+            break
+    return choice, int(np.count_nonzero(rest(-1)))
+
+
+def _representatives(points: np.ndarray, most: int) -> tuple[np.ndarray, np.ndarray]:
+    """At most about ``most`` points standing for ``points``: the distinct points, or
+    when there are more, the means of the occupied cells of a grid.  Returns
+    (reps (m, 3), inverse (n,)) with points[i] represented by reps[inverse[i]]."""
+    lo = points.min(axis=0)
+    span = float(np.ptp(points, axis=0).max()) or 1.0
+    cells = 1024
+    while True:
+        q = np.floor((points - lo) / span * cells).astype(np.int64)
+        key = (q[:, 0] * (cells + 1) + q[:, 1]) * (cells + 1) + q[:, 2]
+        _, inverse, counts = np.unique(key, return_inverse=True, return_counts=True)
+        if len(counts) <= most or cells <= 4:
+            break
+        cells = max(4, int(cells * (most / len(counts)) ** 0.5 * 0.9))
+    inverse = inverse.reshape(-1)
+    reps = np.column_stack([np.bincount(inverse, points[:, j]) for j in range(3)]) / counts[:, None]
+    return reps, inverse
+
+
+_REPS = 2048  # decisions are made on at most about this many representative points
+
+
+def build_sphere_tree(points: np.ndarray, levels: int = 3, branching: int = 4, seed: int = 0,
+                      lookahead: int = 4, samples: int = 8192) -> SphereTree:
     """Top-down sphere tree over ``points`` (vertices plus surface samples).
 
     Each sphere is the minimum enclosing sphere of its part; its children split that
     part, so every point lies in a leaf and in every ancestor of that leaf by
     construction.  A part with fewer distinct points than ``branching`` gets fewer
     children; a single-point part is a leaf.
+
+    The splits are chosen for the volume the spheres claim, a level at a time: each
+    part has candidate splits (grids and slabs along its axes, k-means), and the
+    choice per part minimises the volume of the union of all the level's new spheres
+    (counted on low-discrepancy samples), so neighbouring parts' spheres may share
+    space — in a hollow model, columns spanning two facing walls beat plates cut in
+    halves.  The first split looks one level ahead: its ``lookahead`` best candidates
+    are each scored by the union of the best level below them.  Decisions are made
+    on representatives of the points (grid-cell means, see
+    :func:`_representatives`); the spheres themselves are exact over all points.
     """
     points = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if len(points) == 0:
         raise ValueError("no points to wrap")
     if levels < 1 or branching < 1:
         raise ValueError("levels and branching must be at least 1")
-    centers, radii, parent, level = [], [], [], []
-    c, r = min_enclosing_sphere(points, seed)
-    centers.append(c), radii.append(r), parent.append(-1), level.append(1)
-    frontier = [(0, np.arange(len(points)))]
+    reps, inverse = _representatives(points, _REPS)
+    proj = reps @ _DIRS.T
+    # the partition of the representatives, level by level: (parent node, rep indices)
+    parts: list[list[tuple[int, np.ndarray]]] = [[(-1, np.arange(len(reps)))]]
+    planned: list[_Option] | None = None  # the level below the root, chosen with lookahead
     for depth in range(2, levels + 1):
+        frontier = parts[-1]
+        if planned is None:
+            options_per = [_options(reps, proj, idx, branching, seed + j) for j, (_, idx) in enumerate(frontier)]
+        else:
+            options_per, planned = planned, None
+        balls = [(o.centers, o.radii) for opts in options_per for o in opts]
+        if not balls:
+            break
+        C = np.vstack([b[0] for b in balls])
+        R = np.concatenate([b[1] for b in balls])
+        U = _samples((C - R[:, None]).min(axis=0), (C + R[:, None]).max(axis=0), samples)
+        fixed = np.zeros(len(U), dtype=bool)
+        for (_, idx), opts in zip(frontier, options_per):
+            if not opts and len(idx):  # a part that stays a leaf keeps its sphere
+                c, r = _quick_sphere(reps[idx], proj[idx])
+                fixed |= _cover(U, c[None], np.array([r]))
+        if len(frontier) == 1 and depth < levels and len(options_per[0]) > 1:
+            # the first split: score the best few by the level below them
+            opts = options_per[0]
+            for o in opts:
+                o.mask = _cover(U, o.centers, o.radii)
+            best = None
+            for j in np.argsort([np.count_nonzero(o.mask) for o in opts], kind="stable")[:lookahead]:
+                below = [_options(reps, proj, g, branching, seed + 1 + t) for t, g in enumerate(opts[j].pieces)]
+                keep = fixed.copy()
+                for o2, c, r in zip(below, opts[j].centers, opts[j].radii):
+                    if not o2:
+                        keep |= _cover(U, c[None], np.array([r]))
+                choice_below, total = _choose(U, below, keep)
+                if best is None or total < best[0]:
+                    best = (total, int(j), below, choice_below)
+            choice = [best[1]]
+            planned = [[opts2[c2]] if c2 >= 0 else [] for opts2, c2 in zip(best[2], best[3])]
+            for opts2 in planned:
+                for o in opts2:
+                    o.mask = None
+        else:
+            choice, _ = _choose(U, options_per, fixed)
         nxt = []
-        for node, idx in frontier:
-            if branching < 2:
+        for j, ((_, idx), opts, c) in enumerate(zip(frontier, options_per, choice)):
+            if c >= 0:
+                nxt.extend((j, piece) for piece in opts[c].pieces)
+        if not nxt:
+            break
+        parts.append(nxt)
+    # the same partition of the points themselves
+    point_parts = [[(par, np.flatnonzero(np.isin(inverse, idx))) for par, idx in row] for row in parts]
+    tree = _exact_tree(points, point_parts, seed)
+    # the plain k-means tree (the previous construction) as a whole alternative: keep
+    # whichever claims less volume with the exact spheres
+    if levels > 1 and branching > 1:
+        other = _exact_tree(points, _kmeans_parts(points, levels, branching, seed), seed)
+        if len(other.leaves()) >= len(tree.leaves()) and _union_count(other) < _union_count(tree):
+            tree = other
+    return tree
+
+
+def _kmeans_parts(points: np.ndarray, levels: int, branching: int, seed: int) -> list[list[tuple[int, np.ndarray]]]:
+    """The partition of plain top-down k-means (:func:`_kmeans_split` at every part)."""
+    parts = [[(-1, np.arange(len(points)))]]
+    first = 0  # tree index of the first part of the level (the seed of each split as before)
+    for _ in range(2, levels + 1):
+        nxt = []
+        for j, (_, idx) in enumerate(parts[-1]):
+            if len(idx) < 2 or not np.ptp(points[idx], axis=0).any():
                 continue
-            pieces = _split(points[idx], branching, seed + node)
-            if len(pieces) < 2:
-                continue
-            for piece in pieces:
-                part = idx[piece]
-                c, r = min_enclosing_sphere(points[part], seed)
-                centers.append(c), radii.append(r), parent.append(node), level.append(depth)
-                nxt.append((len(radii) - 1, part))
-        frontier = nxt
+            k = min(branching, len(np.unique(points[idx], axis=0)))
+            pieces = _kmeans_split(points[idx], k, seed + first + j) if k > 1 else []
+            if len(pieces) >= 2:
+                nxt.extend((j, idx[p]) for p in pieces)
+        if not nxt:
+            break
+        first += len(parts[-1])
+        parts.append(nxt)
+    return parts
+
+
+def _exact_tree(points: np.ndarray, parts: list[list[tuple[int, np.ndarray]]], seed: int) -> SphereTree:
+    """The tree of exact minimum spheres over a partition given level by level as
+    (index of the parent in the level above, point indices), parents first."""
+    centers, radii, parent, level = [], [], [], []
+    ids: list[list[int]] = []
+    for depth, row in enumerate(parts, start=1):
+        here = []
+        for par, idx in row:
+            c, r = min_enclosing_sphere(points[idx], seed)
+            here.append(len(radii))
+            centers.append(c), radii.append(r), level.append(depth)
+            parent.append(-1 if depth == 1 else ids[-1][par])
+        ids.append(here)
     return SphereTree(np.array(centers), np.array(radii), np.array(parent), np.array(level))
+
+
+def _union_count(tree: SphereTree, samples: int = 65536) -> float:
+    """Volume of the union of the leaf spheres (low-discrepancy samples in their box)."""
+    leaves = tree.leaves()
+    C, R = tree.centers[leaves], tree.radii[leaves]
+    lo, hi = (C - R[:, None]).min(axis=0), (C + R[:, None]).max(axis=0)
+    U = _samples(lo, hi, samples)
+    covered = sum(np.count_nonzero(_cover(U[s:s + 16384], C, R)) for s in range(0, samples, 16384))
+    return covered / samples * float(np.prod(hi - lo))
 
 
 def octree_spheres(points: np.ndarray, leaves: int) -> tuple[np.ndarray, np.ndarray]:
@@ -434,7 +708,7 @@ def format_spheres(tree: SphereTree, header: str = "") -> str:
     lines.append("# id parent level cx cy cz r   (vehicle frame: +x forward, +y up, +z right; metres)")
     slack = 0.5e-4 * np.sqrt(3.0)
     for i in range(len(tree)):
-        cx, cy, cz = (float(v) for v in np.round(tree.centers[i], 4))
+        cx, cy, cz = (float(v) + 0.0 for v in np.round(tree.centers[i], 4))  # no "-0.0000"
         r = np.ceil((tree.radii[i] + slack) * 1e4) / 1e4
         lines.append(f"{i} {int(tree.parent[i])} {int(tree.level[i])} {cx:.4f} {cy:.4f} {cz:.4f} {r:.4f}")
     return "\n".join(lines) + "\n"
