@@ -41,6 +41,8 @@ import random
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ...nav.navgrid import nearest_valid_node
 from ...nav.steering import heading_from_angle
 from ..commands import IDLE, Command
@@ -56,7 +58,16 @@ if TYPE_CHECKING:  # pragma: no cover
 #: faster than 3 m/s through a bend gentler than a right angle [m/s]
 CORNER_BRAKE = 0.8
 CORNER_FAST = 6.0
-STATES = ("wander", "search", "attack", "evade")
+STATES = ("wander", "search", "attack", "evade", "hide")
+#: protecting a lead: also when ahead with this little of the match left [s]
+LATE = 15.0
+#: ... and fighting anyway when the enemy is this close [m]
+CORNERED = 20.0
+#: a sighting or a heard position older than this is no threat to hide from [s]
+THREAT_MEMORY = 10.0
+#: a hiding agent sweeps its cone this far either side of the way danger comes [rad]
+SWEEP = 0.4
+SWEEP_RATE = 0.35
 
 
 @dataclass(frozen=True)
@@ -69,15 +80,16 @@ class Difficulty:
     vision_range: float
     hearing_radius: float
     think_hz: float
+    engine_radius: float = 0.0
 
 
 DIFFICULTIES: dict[str, Difficulty] = {
     "easy": Difficulty("easy", reaction=0.6, aim_noise=math.radians(4.0), vision_range=60.0,
-                       hearing_radius=50.0, think_hz=8.0),
+                       hearing_radius=50.0, think_hz=8.0, engine_radius=25.0),
     "normal": Difficulty("normal", reaction=0.2, aim_noise=math.radians(1.5), vision_range=90.0,
-                         hearing_radius=80.0, think_hz=15.0),
+                         hearing_radius=80.0, think_hz=15.0, engine_radius=35.0),
     "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.5), vision_range=130.0,
-                       hearing_radius=120.0, think_hz=20.0),
+                       hearing_radius=120.0, think_hz=20.0, engine_radius=40.0),
 }
 
 
@@ -101,14 +113,19 @@ class Agent:
     half_angle : vision cone half-angle [rad] (60 degrees)
     cell : node spacing of its navigation grid [m]
     margin : grid clearance beyond the vehicle's footprint radius [m]
+    match_seconds : the match's length, as the HUD's clock shows it (None: unknown;
+        then only damage decides when to protect a lead)
     """
 
     def __init__(self, rng: random.Random, level: str | Difficulty = "normal", *,
-                 half_angle: float = math.radians(60.0), cell: float = 1.0, margin: float = 0.5) -> None:
+                 half_angle: float = math.radians(60.0), cell: float = 1.0, margin: float = 0.5,
+                 match_seconds: float | None = None) -> None:
         self.level = difficulty(level)
         self.rng = rng
+        self.match_seconds = match_seconds
         self.period = 1.0 / self.level.think_hz
-        self.senses = Senses(half_angle, self.level.vision_range, self.level.hearing_radius, 0.15, rng)
+        self.senses = Senses(half_angle, self.level.vision_range, self.level.hearing_radius, 0.15, rng,
+                             engine_radius=self.level.engine_radius)
         self.cell = cell
         self.margin = margin
         self.state = "wander"
@@ -141,6 +158,18 @@ class Agent:
         self.dodge = 1.0 if rng.random() < 0.5 else -1.0
         self.dodge_flip = 0.0
         self.hits: list[float] = []
+        # the score as the agent saw it: its own hits and kills, and the hits it saw land
+        # on each enemy since that enemy's last death at its hands
+        self.own_hits = 0
+        self.own_kills = 0
+        self.enemy_hits: dict[int, int] = {}
+        # hiding (protecting a lead)
+        self.hide_goal: tuple[float, float] | None = None
+        self.hide_path: list[tuple[float, float]] = []
+        self.hide_face = 0.0
+        self.hide_replan = -math.inf
+        self.hide_exposure = 1.0
+        self.threats: list[tuple[float, float]] = []
         # stuck recovery
         self.progress_at = (0.0, math.nan, math.nan)
         self.reverse_until = -math.inf
@@ -162,6 +191,7 @@ class Agent:
         self.route, self.walker, self.path, self.plan, self.goal = [], None, [], None, None
         self.target, self.acquired_at = None, math.inf
         self.hits = []
+        self.hide_goal, self.hide_replan, self.hide_path = None, -math.inf, []
         self.senses.hp = math.inf
         self.reverse_until = -math.inf
         self.next_think = -math.inf
@@ -191,9 +221,13 @@ class Agent:
         previous = self.senses.last_seen.get(self.target) if self.target is not None else None
         seen = self.senses.look(world, tank)
         heard = self.senses.listen(world, tank)
+        engine = self.senses.listen_engines(world, tank)
+        if heard is None:
+            heard = engine
         if self.senses.hit_taken(tank) > 0.0:
             self.hits.append(t)
         self.hits = [h for h in self.hits if t - h < 4.0]
+        self._score(tank)
 
         sight = self._pick_target(seen)
         if sight is not None:
@@ -212,6 +246,25 @@ class Agent:
                 return self._unstick(world, tank, cmd)
             self.evade_cooldown = t + 8.0
             self._start_search(self.threat or (tank.x, tank.z), t)
+
+        protect = self.protecting(world, tank)
+        if protect and sight is not None and t < self.acquired_at:
+            # seen, not reacted to yet: carry on (hiding as before, if it was)
+            sight = None if self.state == "hide" else sight
+        if protect and (sight is None or t >= self.acquired_at):
+            if sight is not None and self._cornered(tank, sight):
+                self._enter("attack", t)
+                return self._attack(world, tank, sight)
+            cmd = self._hide(world, tank, sight, heard)
+            if cmd is not None and self.hide_exposure < 0.5:
+                self._enter("hide", t)
+                return self._unstick(world, tank, cmd)
+            if sight is not None:                  # nowhere out of its sight: fight
+                self._enter("attack", t)
+                return self._attack(world, tank, sight)
+        if self.state == "hide":
+            est = self._estimate(t)
+            self._start_search(est if est is not None else (tank.x, tank.z), t)
 
         if sight is not None and t >= self.acquired_at:
             self._enter("attack", t)
@@ -233,6 +286,47 @@ class Agent:
                 return self._unstick(world, tank, cmd)
             self._enter("wander", t)
         return self._unstick(world, tank, self._wander(world, tank))
+
+    # ------------------------------------------------------------------ the score
+    def _score(self, tank: "Tank") -> None:
+        """Count the hits it saw its shells land (on the target it shot at) and forget
+        them when that enemy dies at its hands (its own kills go up)."""
+        if tank.hits > self.own_hits:
+            if self.target is not None:
+                self.enemy_hits[self.target] = self.enemy_hits.get(self.target, 0) + tank.hits - self.own_hits
+            self.own_hits = tank.hits
+        if tank.kills > self.own_kills:
+            if self.target is not None:
+                self.enemy_hits.pop(self.target, None)
+            self.own_kills = tank.kills
+
+    def protecting(self, world: "World", tank: "Tank") -> bool:
+        """Protect the lead?  What the HUD shows: its own kills against the best enemy
+        score on the scoreboard, the clock, its own hit points.  Ahead, and damaged or
+        with less than ``LATE`` s left, unless the enemy it fights is nearer death than
+        it is (counted from the hits it saw land)."""
+        lead = tank.kills - max((o.kills for o in world.tanks if o is not tank), default=0)
+        if lead <= 0:
+            return False
+        left = math.inf if self.match_seconds is None else self.match_seconds - world.t
+        full = tank.spec.hit_points
+        if tank.hp >= full and left >= LATE:
+            return False
+        dmg = tank.spec.shell_damage
+        mine = math.ceil(tank.hp / dmg)
+        if self.target is not None and self.target in self.enemy_hits:
+            theirs = math.ceil(full / dmg) - self.enemy_hits[self.target]
+            if theirs < mine:
+                return False
+        return True
+
+    def _cornered(self, tank: "Tank", s: Sighting) -> bool:
+        """Too close to get away, or the enemy's gun (its hull) points within 60° of us:
+        it sees us, and turning our back would give it free shots."""
+        if s.distance < CORNERED:
+            return True
+        back = math.atan2(tank.z - s.z, tank.x - s.x)
+        return abs(wrap(s.heading - back)) < math.radians(60.0)
 
     def _pick_target(self, seen: list[Sighting]) -> Sighting | None:
         """The current target if still in sight (no dithering), else the nearest."""
@@ -364,6 +458,83 @@ class Agent:
         if self._free(world, tank, angle, tank.spec.radius + 6.0, (0.0,)) < tank.spec.radius + 5.0:
             self.dodge = -self.dodge
         return self.dodge
+
+    # ------------------------------------------------------------------ hide
+    def _threats(self, world: "World", tank: "Tank", sight: Sighting | None) -> list[tuple[float, float]]:
+        """Where danger comes from: the enemy in sight, else where one was last seen
+        (moved on) or heard in the last ``THREAT_MEMORY`` s, else the spawn points
+        (the map: where a respawned enemy appears, and the open floor roamers head for)."""
+        t = world.t
+        if sight is not None:
+            return [(sight.x, sight.z)]
+        recent = [s for s in self.senses.last_seen.values() if t - s.t < THREAT_MEMORY]
+        h = self.senses.heard
+        if recent:
+            s = max(recent, key=lambda s: s.t)
+            if h is None or s.t >= h.t:
+                dt = min(t - s.t, 2.0)
+                return [(s.x + s.vx * dt, s.z + s.vz * dt)]
+        if h is not None and t - h.t < THREAT_MEMORY:
+            return [(h.x, h.z)]
+        return [(x, z) for x, z, _ in world.spawns if math.hypot(x - tank.x, z - tank.z) > 10.0]
+
+    def hide_spot(self, tank: "Tank", threats: list[tuple[float, float]]) -> tuple[float, float] | None:
+        """The block to hide in: out of the threats' line of sight (the blocks' table),
+        far from them, near by path: ``mean(min(distance, 70)) - 40 x exposure - 0.3 x path``
+        (exposure: the fraction of the threats that see it; mean over the threats)."""
+        views = self.views
+        cells = [c for c in (views.cell_at(x, z) for x, z in threats) if c >= 0]
+        me = views.cell_at(tank.x, tank.z)
+        if not cells or me < 0:
+            return None
+        path = views.path_distances(me)
+        exposure = views.visible[cells].mean(axis=0)
+        far = np.minimum(views.distance[cells], 70.0).mean(axis=0)
+        score = far - 40.0 * exposure - 0.3 * np.where(np.isfinite(path), path, 0.0)
+        score[~np.isfinite(path)] = -np.inf
+        b = int(np.argmax(score))
+        gx, gz = views.points[b]
+        self.hide_exposure = float(exposure[b])
+        return float(gx), float(gz)
+
+    def _hide(self, world: "World", tank: "Tank", sight: Sighting | None, heard) -> Command | None:
+        """Protect the lead: drive to a hiding block away from the threats and out of
+        their sight, chosen again every 3 s (every second while an enemy is in sight or
+        just heard); there, watch the way the nearest threat would come, sweeping the
+        cone ±0.6 rad.  None: nowhere to go."""
+        t = world.t
+        if self.state != "hide" and t >= self.hide_replan + 1.0:
+            self.hide_goal, self.hide_replan = None, -math.inf
+        if t >= self.hide_replan:
+            threats = self._threats(world, tank, sight)
+            self.threats = threats
+            goal = self.hide_spot(tank, threats)
+            self.hide_replan = t + (1.0 if sight is not None or heard is not None else 3.0)
+            if goal != self.hide_goal:
+                self.hide_goal = goal
+                self.hide_path = plan_path(self.grid, (tank.x, tank.z), goal) if goal is not None else []  # type: ignore[arg-type]
+            if goal is not None and threats:
+                cx = sum(p[0] for p in threats) / len(threats)
+                cz = sum(p[1] for p in threats) / len(threats)
+                self.hide_face = math.atan2(cz - goal[1], cx - goal[0])
+        if self.hide_goal is None:
+            return None
+        x, z = tank.x, tank.z
+        gx, gz = self.hide_goal
+        path = self.hide_path
+        if math.hypot(gx - x, gz - z) > 3.0:
+            while len(path) > 1 and math.hypot(path[0][0] - x, path[0][1] - z) < 3.0:
+                path.pop(0)
+            if not path:
+                path = self.hide_path = plan_path(self.grid, (x, z), self.hide_goal)  # type: ignore[arg-type]
+                if not path:
+                    return None
+            return self._follow(world, tank, path, speed=1.0, lookahead=4.0, corner=path[0])
+        # a triangle wave: the cone sweeps at a steady SWEEP_RATE, to and fro
+        phase = (t * SWEEP_RATE / (2.0 * SWEEP)) % 2.0
+        look = self.hide_face + SWEEP * (2.0 * abs(phase - 1.0) - 1.0)
+        err = wrap(look - tank.heading)
+        return self._drive(world, tank, 0.0, 0.0, self.controller.turn(err - PREDICT * tank.omega))  # type: ignore[union-attr]
 
     # ------------------------------------------------------------------ evade
     def _start_evade(self, world: "World", tank: "Tank", threat: tuple[float, float], t: float) -> None:
@@ -529,12 +700,14 @@ class Agent:
             self.reverse_until = t + 0.8
             self.reverse_turn = 1.0 if self.rng.random() < 0.5 else -1.0
             self.progress_at = (t + 0.8, math.nan, math.nan)
-            self.route, self.walker, self.path = [], None, []
+            self.route, self.walker, self.path, self.hide_path = [], None, [], []
             return self._drive(world, tank, -4.0, 0.0, self.reverse_turn)
         return cmd
 
 
-def make_agents(world: "World", level: str | Difficulty = "normal", which: range | list[int] | None = None) -> list[Agent]:
-    """One agent per tank (or per index in ``which``), each seeded from the world's generator."""
+def make_agents(world: "World", level: str | Difficulty = "normal", which: range | list[int] | None = None,
+                match_seconds: float | None = None) -> list[Agent]:
+    """One agent per tank (or per index in ``which``), each seeded from the world's generator;
+    ``match_seconds``: the match's length (the HUD's clock), if known."""
     idx = range(len(world.tanks)) if which is None else which
-    return [Agent(random.Random(world.rng.getrandbits(64)), level) for _ in idx]
+    return [Agent(random.Random(world.rng.getrandbits(64)), level, match_seconds=match_seconds) for _ in idx]

@@ -42,7 +42,6 @@ from __future__ import annotations
 import math
 import random
 import weakref
-from collections import deque
 from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
@@ -92,7 +91,6 @@ class Memory:
         self.nz = max(int(math.ceil((z1 - z0) / region)), 1)
         self.last = [-math.inf] * (self.nx * self.nz)
         self._goals: list[tuple[int, tuple[float, float]]] | None = None
-        self._flat: list[bool] | None = None
 
     def key(self, x: float, z: float) -> int:
         i = min(max(int((x - self.x0) // self.region), 0), self.nx - 1)
@@ -127,36 +125,6 @@ class Memory:
             self._goals = out
         return self._goals
 
-    def frontier(self, x: float, z: float, t: float, older: float) -> tuple[float, float] | None:
-        """The region not visited for ``older`` seconds nearest to (x, z) along the
-        grid (breadth-first over valid nodes, so a wall between does not fool it)."""
-        grid = self.grid
-        stale = {}
-        for key, g in self.goals():
-            if t - self.last[key] > older:
-                stale[grid.node_of(*g)] = g
-        if not stale:
-            return None
-        start = nearest_valid_node(grid.valid, grid.node_of(x, z), 6)
-        if start is None:
-            return None
-        if self._flat is None:
-            self._flat = grid.valid.ravel().tolist()
-        nx, ok = grid.nx, self._flat
-        s0 = start[0] * nx + start[1]
-        seen = {s0}
-        queue = deque([s0])
-        while queue:
-            n = queue.popleft()
-            g = stale.get(divmod(n, nx))
-            if g is not None:
-                return g
-            j = n % nx
-            for m in (n + 1 if j + 1 < nx else -1, n - 1 if j > 0 else -1, n + nx, n - nx):
-                if 0 <= m < len(ok) and ok[m] and m not in seen:
-                    seen.add(m)
-                    queue.append(m)
-        return None
 
 
 class Wanderer:

@@ -9,10 +9,14 @@
 * **Hearing**: a gunshot within the hearing radius reveals roughly where it came from:
   the shooter's position plus Gaussian noise growing with distance.  A shot is the
   shooter's shot counter going up (the same thing the world's ``shot`` event reports).
+* **Engines**: tanks are loud.  A moving enemy within the engine-hearing radius
+  (through walls) reveals roughly where it is, with the same noise.  The radius grows
+  with its speed: ``engine_radius * min(1, speed / ENGINE_FULL)``; below
+  ``ENGINE_QUIET`` m/s it is not heard at all (an idling engine is lost in the noise).
 * What a seen enemy shows: its position, velocity and the way its hull (and so its
   gun) points, as a player sees an enemy tank's hull.
 * **Memory**: where each enemy was last seen (and its velocity then) and where the
-  latest shot was heard, with times; nothing else about other tanks is kept.
+  latest shot or engine was heard, with times; nothing else about other tanks is kept.
 * **Own state**: hit points (so the agent knows it was hit), speed, reload.
 """
 
@@ -26,6 +30,14 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:  # pragma: no cover
     from ..body import Tank
     from ..world import World
+
+
+#: an engine is heard within the full engine radius from this speed up [m/s]
+ENGINE_FULL = 6.0
+#: and not at all below this speed [m/s]
+ENGINE_QUIET = 0.5
+#: the fraction of the radius an engine is heard over just above ENGINE_QUIET
+ENGINE_FLOOR = 0.5
 
 
 def wrap(a: float) -> float:
@@ -50,11 +62,13 @@ class Sighting:
 
 @dataclass(frozen=True)
 class Heard:
-    """A shot heard at time ``t`` from around (x, z) (noisy)."""
+    """A shot (or, ``engine`` True, a moving tank) heard at time ``t`` from around
+    (x, z) (noisy)."""
 
     x: float
     z: float
     t: float
+    engine: bool = False
 
 
 def in_cone(ox: float, oz: float, heading: float, tx: float, tz: float, half_angle: float, vision_range: float) -> bool:
@@ -87,10 +101,13 @@ class Senses:
     hearing_radius : how far a shot is heard [m]
     hearing_noise : standard deviation of the heard position, as a fraction of the distance
     rng : the agent's generator (noise)
+    engine_radius : how far a tank moving at ``ENGINE_FULL`` m/s or faster is heard [m]
+        (0: engines are not heard)
     """
 
     def __init__(self, half_angle: float, vision_range: float, hearing_radius: float,
-                 hearing_noise: float, rng: random.Random) -> None:
+                 hearing_noise: float, rng: random.Random, engine_radius: float = 0.0) -> None:
+        self.engine_radius = engine_radius
         self.half_angle = half_angle
         self.vision_range = vision_range
         self.hearing_radius = hearing_radius
@@ -132,6 +149,30 @@ class Senses:
         if best is not None:
             self.heard = best
         return best
+
+    def listen_engines(self, world: "World", me: "Tank") -> Heard | None:
+        """The nearest live enemy heard moving now (through walls): within
+        ``engine_radius * min(1, speed / ENGINE_FULL)``, not below ``ENGINE_QUIET`` m/s;
+        its position with Gaussian noise of ``hearing_noise`` x the distance."""
+        if self.engine_radius <= 0.0:
+            return None
+        best, best_d = None, math.inf
+        for o in world.tanks:
+            if o is me or not o.alive:
+                continue
+            speed = math.hypot(o.vx, o.vz)
+            if speed < ENGINE_QUIET:
+                continue
+            d = math.hypot(o.x - me.x, o.z - me.z)
+            loud = min(1.0, ENGINE_FLOOR + (1.0 - ENGINE_FLOOR) * speed / ENGINE_FULL)
+            if d <= self.engine_radius * loud and d < best_d:
+                best, best_d = o, d
+        if best is None:
+            return None
+        sd = self.hearing_noise * best_d
+        heard = Heard(best.x + self.rng.gauss(0.0, sd), best.z + self.rng.gauss(0.0, sd), world.t, True)
+        self.heard = heard
+        return heard
 
     def hit_taken(self, me: "Tank") -> float:
         """Damage taken since the last call (0 on the first call and after a respawn's refill)."""
