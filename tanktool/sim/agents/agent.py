@@ -1,7 +1,7 @@
 """The computer opponent: a small state machine over sensors and ``Command`` values.
 
-States (each a method ``_wander``, ``_search``, ``_attack``, ``_evade`` that returns
-the command for this think):
+States (each a method ``_wander``, ``_search``, ``_attack``, ``_evade``, ``_hide``
+that returns the command for this think):
 
 * **Wander** (start): explore.  A* to the block that sees the most of what was not
   seen in the last minute per metre of path (``navigation.Coverage.goal``: the sight
@@ -14,6 +14,12 @@ the command for this think):
 * **Evade** (hit twice within 4 s by an enemy it cannot see): drive to the nearest of
   a few sampled nodes out of the threat's line of sight, or, with no cover near,
   strafe hard.
+* **Hide** (protecting a lead: ahead on the scoreboard and damaged, or ahead with
+  less than ``LATE`` s on the clock): drive to a block out of the threats' line of
+  sight (the enemy seen, else where one was last seen or heard, else the spawn
+  points), far from them, and watch the way they would come, sweeping the cone.
+  Cornered (the enemy closer than ``CORNERED`` m, or its gun pointing within 60° of
+  us) or with no block out of its sight: Attack.  Level or behind: never hides.
 
 Transitions, checked every think (``think_hz`` times a second; the command is held in
 between, as a person holds a key)::
@@ -23,15 +29,23 @@ between, as a person holds a key)::
     Wander   --shot heard / hit taken-->          Search (from the shot / from behind us)
     Search   --all quadrants done, or 60 s-->     Wander
     any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
+    any      --protecting a lead, a block out of sight-->  Hide --not protecting--> Search
+    Hide     --enemy seen and cornered-->         Attack
 
-Everything the agent knows comes from ``perception.Senses`` (sight, hearing, memory,
-its own hit points) and the static map (walls and its navigation grid); it acts only
+Wander and Search also take a heard engine (a moving tank within the engine-hearing
+radius, through walls) as they take a heard shot.
+
+Everything the agent knows comes from ``perception.Senses`` (sight, hearing of shots
+and engines, memory, its own hit points), what a player's HUD shows (its own kills,
+hits landed and hit points, the scoreboard's kills, the match clock when told its
+length) and the static map (walls, spawn points and its navigation grid); it acts only
 through ``Command`` values.  Its randomness comes from its own ``random.Random``,
 seeded from the world's, so matches replay exactly.
 
 Difficulty sets the reaction time (delay between first seeing an enemy and acting on
 it), the aim noise (a Gaussian error on the aim, drawn anew after every shot), the
-vision range, the hearing radius and how often it thinks.
+vision range, the hearing radius (shots), the engine-hearing radius and how often it
+thinks.
 """
 
 from __future__ import annotations
