@@ -76,7 +76,7 @@ def measure(name: str, mesh, samples: int) -> dict:
 
     from tanktool.cli.import_vehicle import derive
     from tanktool.geometry.hull import hull_points
-    from tanktool.geometry.spheres import build_points, excess_volume, octree_spheres, solid_inside
+    from tanktool.geometry.sphere_build import build_points, excess_volume, octree_spheres, solid_inside
 
     v = np.asarray(mesh.vertices, dtype=np.float64)
     t0 = time.perf_counter()

@@ -5,9 +5,10 @@ import pytest
 import trimesh
 
 from tanktool.errors import FormatError
+from tanktool.geometry.min_sphere import min_enclosing_sphere
+from tanktool.geometry.sphere_build import build_points, build_sphere_tree, octree_spheres
 from tanktool.geometry.spheres import (
-    SphereTree, build_points, build_sphere_tree, contains_points, min_enclosing_sphere,
-    octree_spheres, point_query, read_spheres, segment_query, segment_sphere_hits, to_world,
+    SphereTree, contains_points, point_query, read_spheres, segment_query, segment_sphere_hits, to_world,
     tree_overlap, write_spheres,
 )
 
@@ -196,7 +197,7 @@ def test_thin_plate_leaves_tile_it_along_length_and_width():
 
 
 def test_hollow_room_leaves_claim_much_less_than_plain_kmeans():
-    from tanktool.geometry.spheres import _exact_tree, _kmeans_parts, _union_count
+    from tanktool.geometry.sphere_build import _exact_tree, _kmeans_parts, _union_count
 
     room = _room()
     pts = build_points(room.vertices, room.faces, 3000)
@@ -211,7 +212,7 @@ def test_hollow_room_leaves_claim_much_less_than_plain_kmeans():
 
 
 def test_tree_is_never_worse_than_plain_kmeans(tank_tree):
-    from tanktool.geometry.spheres import _exact_tree, _kmeans_parts, _union_count
+    from tanktool.geometry.sphere_build import _exact_tree, _kmeans_parts, _union_count
 
     pts, tree = tank_tree
     plain = _exact_tree(pts, _kmeans_parts(pts, 3, 4, 0), 0)

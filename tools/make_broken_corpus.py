@@ -28,7 +28,8 @@ from tanktool.formats.bundle import dumps_toml, sha256_file  # noqa: E402
 from tanktool.formats.vehicle_bundle import format_hull  # noqa: E402
 from tanktool.formats.walls_txt import WallList, aux_rectangle, format_walls  # noqa: E402
 from tanktool.geometry.mass import drive_defaults  # noqa: E402
-from tanktool.geometry.spheres import build_points, build_sphere_tree, format_spheres  # noqa: E402
+from tanktool.geometry.sphere_build import build_points, build_sphere_tree  # noqa: E402
+from tanktool.geometry.spheres import format_spheres  # noqa: E402
 
 BROKEN = ROOT / "tests" / "data" / "broken"
 CLEAN = ROOT / "tests" / "data" / "check_clean"

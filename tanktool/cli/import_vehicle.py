@@ -85,7 +85,7 @@ def derive(mesh, hull_points_n: int, levels: int, branching: int, mass: float | 
     """Hull, sphere tree and mass properties of a vehicle-frame mesh."""
     from ..geometry.hull import hull_points
     from ..geometry.mass import mass_properties
-    from ..geometry.spheres import build_points, build_sphere_tree
+    from ..geometry.sphere_build import build_points, build_sphere_tree
 
     v = np.asarray(mesh.vertices, dtype=np.float64)
     hull, fp = hull_points(v, hull_points_n)
