@@ -10,6 +10,7 @@ import numpy as np
 from tanktool.formats.bundle import write_toml
 from tanktool.formats.walls_txt import WallList, aux_rectangle, write_walls
 from tanktool.sim.body import TankSpec
+from tanktool.sim.world import World
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -26,6 +27,17 @@ def box_arena() -> tuple[WallList, np.ndarray]:
                        [30, 30, 0.5], [90, 30, 2.5], [30, 45, -0.5], [75, 85, math.pi],
                        [50, 10, 1.0], [70, 10, 2.0]], float)
     return wl, spawns
+
+
+def box_world(positions, headings=None, seed=1):
+    """The :func:`box_arena` (120 x 90, a thin wall x=60 from z=20 to 50) with box tanks
+    placed at ``positions`` [(x, z)] facing ``headings``."""
+    walls, spawns = box_arena()
+    n = len(positions)
+    w = World(walls, [TankSpec.box("t")] * n, spawns, seed=seed)
+    for t, (x, z), h in zip(w.tanks, positions, headings or [0.0] * n):
+        t.place(x, z, h)
+    return w
 
 
 def maze_arena() -> tuple[WallList, np.ndarray]:

@@ -7,26 +7,15 @@ import random
 import numpy as np
 import pytest
 
-from sim_fixtures import box_arena
+from sim_fixtures import box_world
 from tanktool.nav.navgrid import grid_from_mask
 from tanktool.nav.steering import choose_next, heading_of_move
 from tanktool.sim.agents import DIFFICULTIES, Agent, difficulty, make_agents
 from tanktool.sim.agents.navigation import Memory, SearchPlan, Wanderer, agent_grid, search_order
 from tanktool.sim.agents.perception import Senses, can_see, in_cone
-from tanktool.sim.body import TankSpec
 from tanktool.sim.commands import IDLE
 from tanktool.sim.match import load_match_arena, load_tank_spec, run_match
 from tanktool.sim.world import World
-
-
-def box_world(positions, headings=None, seed=1):
-    """The fixture box (120 x 90, a thin wall x=60 from z=20 to 50) with tanks placed."""
-    walls, spawns = box_arena()
-    n = len(positions)
-    w = World(walls, [TankSpec.box("t")] * n, spawns, seed=seed)
-    for t, (x, z), h in zip(w.tanks, positions, headings or [0.0] * n):
-        t.place(x, z, h)
-    return w
 
 
 # ------------------------------------------------------------------ perception

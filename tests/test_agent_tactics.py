@@ -6,23 +6,11 @@ import random
 
 import pytest
 
-from sim_fixtures import box_arena
+from sim_fixtures import box_world
 from tanktool.sim.agents import Agent
 from tanktool.sim.agents.agent import LATE
 from tanktool.sim.agents.perception import ENGINE_FULL, ENGINE_QUIET, Senses
-from tanktool.sim.body import TankSpec
 from tanktool.sim.commands import IDLE
-from tanktool.sim.world import World
-
-
-def box_world(positions, headings=None, seed=1):
-    """The fixture box (120 x 90, a thin wall x=60 from z=20 to 50) with tanks placed."""
-    walls, spawns = box_arena()
-    n = len(positions)
-    w = World(walls, [TankSpec.box("t")] * n, spawns, seed=seed)
-    for t, (x, z), h in zip(w.tanks, positions, headings or [0.0] * n):
-        t.place(x, z, h)
-    return w
 
 
 # ------------------------------------------------------------------ hearing engines
