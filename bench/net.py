@@ -24,7 +24,6 @@ import json
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -36,7 +35,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tanktool.errors import NetError  # noqa: E402
-from tanktool.net.peer import Peer  # noqa: E402
+from tanktool.net.peer import Peer, free_port  # noqa: E402
 
 LOOPBACK = "127.0.0.1"
 IP_UDP_HEADERS = 28
@@ -78,25 +77,9 @@ class Proc:
             self.p.wait(10)
 
 
-def _free_port() -> int:
-    for _ in range(50):
-        t, u = socket.socket(), socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        try:
-            t.bind((LOOPBACK, 0))
-            port = t.getsockname()[1]
-            u.bind((LOOPBACK, port))
-            return port
-        except OSError:
-            continue
-        finally:
-            t.close()
-            u.close()
-    raise RuntimeError("no free port")
-
-
 def start_session(tmp: Path, peers: int, tag: str) -> tuple[list[Proc], list[Path], dict[int, tuple[str, int]]]:
     """Host + joiners, everyone in; returns processes, report paths and player -> TCP address."""
-    port = _free_port()
+    port = free_port(LOOPBACK)
     procs, reports = [], []
     for i in range(1, peers + 1):
         rep = tmp / f"{tag}{i}.json"

@@ -23,6 +23,7 @@ from pathlib import Path
 import pytest
 
 from tanktool.net import protocol as P
+from tanktool.net.peer import free_port
 
 ROOT = Path(__file__).resolve().parent.parent
 LOOPBACK = "127.0.0.1"
@@ -69,23 +70,6 @@ class Proc:
         if self.p.poll() is None:
             self.p.kill()
         self.p.wait(10)
-
-
-def _free_port() -> int:
-    for _ in range(50):
-        t = socket.socket()
-        u = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        try:
-            t.bind((LOOPBACK, 0))
-            port = t.getsockname()[1]
-            u.bind((LOOPBACK, port))
-            return port
-        except OSError:
-            continue
-        finally:
-            t.close()
-            u.close()
-    raise RuntimeError("no free port")
 
 
 def _play(tmp: Path, tag: str, *args: str, seconds: float) -> tuple[list[str], Path]:
@@ -138,7 +122,7 @@ def run_scenario(tmp: Path, players: int = 8) -> dict:
     """The whole story; returns every report and what was sent where."""
     procs: list[Proc] = []
     try:
-        port = _free_port()
+        port = free_port(LOOPBACK)
         host_args, _ = _play(tmp, "host", "--host", f"{LOOPBACK}:{port}", seconds=300)
         host = Proc(host_args)
         procs.append(host)
@@ -265,7 +249,7 @@ def test_bots_run_on_the_host_and_survive_it(tmp_path):
     adopts the bots, which go on moving in everyone's view."""
     procs: list[Proc] = []
     try:
-        port = _free_port()
+        port = free_port(LOOPBACK)
         args, _ = _play(tmp_path, "host", "--host", f"{LOOPBACK}:{port}", "--bots", "2", seconds=300)
         host = Proc(args)
         procs.append(host)

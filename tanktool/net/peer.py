@@ -75,6 +75,24 @@ def parse_address(text: str, default_host: str = "127.0.0.1", need_host: bool = 
     return host, port
 
 
+def free_port(ip: str = "127.0.0.1") -> int:
+    """A port number free on ``ip`` for both TCP and UDP, as a host needs (for scripts
+    and tests that start a host in another process; another program may still take it)."""
+    for _ in range(50):
+        t, u = socket.socket(), socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            t.bind((ip, 0))
+            port = t.getsockname()[1]
+            u.bind((ip, port))
+            return port
+        except OSError:
+            continue
+        finally:
+            t.close()
+            u.close()
+    raise NetError(f"no port free for both TCP and UDP on {ip}")
+
+
 def join_mac(password: str, nonce: bytes, name: str) -> bytes:
     return hmac.new(password.encode(), b"join" + nonce + name.encode(), sha256).digest()
 
