@@ -19,3 +19,28 @@ def data_dir() -> Path:
 @pytest.fixture
 def root_dir() -> Path:
     return ROOT
+
+
+@pytest.fixture
+def make_app(tmp_path, monkeypatch):
+    """Game windows made on demand on SDL's dummy driver (box arena, top view, no sound,
+    bindings in a private config folder); all stopped at the end of the test."""
+    import pygame
+
+    from tanktool.game.app import App, Presenter
+
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "cfg"))
+    pygame.display.init()
+    pygame.font.init()
+    apps = []
+
+    def make(size=(320, 240), **kw):
+        presenter = Presenter(size, fullscreen=False, want_gl=False)
+        a = App(presenter, arena="box", view="top", size=size, sound=False, **kw)
+        apps.append(a)
+        return a
+
+    yield make
+    for a in apps:
+        a.stop()
+    pygame.display.quit()

@@ -8,20 +8,13 @@ from app_helpers import goto, key, press
 from click.testing import CliRunner
 
 from tanktool.cli.main import cli
-from tanktool.game.app import App, NoDisplay, Presenter, display_problem, run_window
+from tanktool.game.app import App, NoDisplay, display_problem, run_window
 from tanktool.game.input import load_bindings
 
 
 @pytest.fixture
-def app(tmp_path, monkeypatch):
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "cfg"))
-    pygame.display.init()
-    pygame.font.init()
-    presenter = Presenter((480, 320), fullscreen=False, want_gl=False)
-    a = App(presenter, arena="box", bots=2, view="top", size=(480, 320), sound=False)
-    yield a
-    a.stop()
-    pygame.display.quit()
+def app(make_app):
+    return make_app((480, 320), bots=2)
 
 
 def test_menu_choices_and_start(app):

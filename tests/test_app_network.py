@@ -12,7 +12,6 @@ import pygame
 import pytest
 from app_helpers import goto, key, press
 
-from tanktool.game.app import App, Presenter
 from tanktool.net.peer import Peer
 from tanktool.net.session import NetMatch
 from tanktool.sim.match import load_match_arena, load_tank_spec
@@ -31,15 +30,8 @@ def type_address(app, text):
 
 
 @pytest.fixture
-def app(tmp_path, monkeypatch):
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "cfg"))
-    pygame.display.init()
-    pygame.font.init()
-    presenter = Presenter((320, 240), fullscreen=False, want_gl=False)
-    a = App(presenter, arena="box", bots=0, view="top", size=(320, 240), sound=False)
-    yield a
-    a.stop()
-    pygame.display.quit()
+def app(make_app):
+    return make_app(bots=0)
 
 
 class Headless:

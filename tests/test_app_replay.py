@@ -11,28 +11,13 @@ from app_helpers import goto, key, press
 from click.testing import CliRunner
 
 from tanktool.cli.main import cli
-from tanktool.game.app import App, Presenter
 from tanktool.sim.match import load_match_arena, load_tank_spec
 from tanktool.sim.replay import play_replay, read_replay, state_digest
 
 
 @pytest.fixture
-def window(tmp_path, monkeypatch):
-    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "cfg"))
-    pygame.display.init()
-    pygame.font.init()
-    apps = []
-
-    def make(**kw):
-        presenter = Presenter((320, 240), fullscreen=False, want_gl=False)
-        a = App(presenter, arena="box", bots=2, view="top", size=(320, 240), sound=False, seed=3, **kw)
-        apps.append(a)
-        return a
-
-    yield make
-    for a in apps:
-        a.stop()
-    pygame.display.quit()
+def window(make_app):
+    return lambda **kw: make_app(bots=2, seed=3, **kw)
 
 
 def drive(app, script):
