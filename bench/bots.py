@@ -57,7 +57,7 @@ def duel(arena, spec, seed: int, level: str, seconds: float) -> dict:
     ours = seed % 2
     world = World(arena.walls, [spec, spec], arena.spawns, seed=seed, bounds=arena.bounds)
     drivers: list = [None, None]
-    drivers[ours] = Agent(random.Random(world.rng.getrandbits(64)), level, match_seconds=seconds)
+    drivers[ours] = Agent(random.Random(world.rng.getrandbits(64)), level)
     drivers[1 - ours] = ScriptedDriver(random.Random(world.rng.getrandbits(64)))
     agent, base = drivers[ours], drivers[1 - ours]
     every = int(round(SAMPLE / world.dt))

@@ -171,7 +171,7 @@ def test_hit_by_an_unseen_enemy_searches_where_the_shot_came_from():
     w = box_world([(30.0, 10.0), (30.0, 40.0)], headings=[0.0, -math.pi / 2])
     agent = Agent(random.Random(5), "normal")
     agent(w, w.tanks[0])
-    assert agent.state == "wander"
+    assert agent.state in ("wander", "watch")
     w.tanks[1].shots += 1                      # heard, 30 m away, 90 degrees to the left
     w.t += 0.2
     agent(w, w.tanks[0])
@@ -200,11 +200,11 @@ def test_hit_repeatedly_evades_to_cover_out_of_the_threats_sight():
 
 @pytest.mark.parametrize("name", ["box", "maze", "paper2002"])
 def test_long_wander_has_few_wall_bumps(name):
-    """One agent alone for two simulated minutes: at most one bump."""
+    """One agent alone wandering (not watching) for two simulated minutes: at most one bump."""
     arena = load_match_arena(name)
     spec = load_tank_spec("light")
     w = World(arena.walls, [spec], arena.spawns, seed=3, bounds=arena.bounds)
-    agent = Agent(random.Random(3), "normal")
+    agent = Agent(random.Random(3), "normal", watch=False)
     run(w, [agent], 120.0)
     assert w.tanks[0].wall_bumps <= 1
     assert w.tanks[0].distance > 300.0         # and it did drive around

@@ -80,7 +80,7 @@ def test_exploration_goal_heads_for_what_was_not_seen():
 def test_wandering_agent_drives_to_unseen_parts_and_sees_more_of_the_arena():
     walls, spawns = box_arena()
     w = World(walls, [TankSpec.box("t")], spawns, seed=1)     # alone
-    agent = Agent(random.Random(4), "normal")
+    agent = Agent(random.Random(4), "normal", watch=False)
     me = w.tanks[0]
     me.place(10.0, 10.0, 0.0)
     for _ in range(int(30.0 / w.dt)):

@@ -1,14 +1,18 @@
-"""Computer opponents (issue 7): hearing engines, protecting a lead (score, clock,
-hit points), the spawn points as where danger comes from, the hits seen land on an enemy."""
+"""Computer opponents (issue 7): hearing engines, watching from a vantage point in an
+open arena, and what the agent does after a kill."""
 
 import math
 import random
 
 import pytest
 
-from sim_fixtures import box_world
+from sim_fixtures import ROOT, box_world
 from tanktool.sim.agents import Agent
-from tanktool.sim.agents.agent import LATE
+from tanktool.sim.agents.agent import STALE, WATCH_COVER, WATCH_STINT
+from tanktool.sim.agents.navigation import vantages_for
+from tanktool.sim.agents.perception import Sighting, can_see
+from tanktool.sim.match import load_match_arena, load_tank_spec
+from tanktool.sim.world import World
 from tanktool.sim.agents.perception import ENGINE_FULL, ENGINE_QUIET, Senses
 from tanktool.sim.commands import IDLE
 
@@ -65,94 +69,117 @@ def test_an_agent_goes_towards_an_engine_it_hears():
     assert math.hypot(gx - o.x, gz - o.z) < 15.0
 
 
-# ------------------------------------------------------------------ protecting a lead
-def lead_world(agent_kills=1, enemy_kills=0, hp=50.0, enemy_heading=math.pi / 2):
-    """Me at (45, 30) looking +z at an enemy 50 m away in the open, between the thin
-    wall (x = 60) and the L (x = 40 from z = 60 to 75)."""
-    w = box_world([(45.0, 30.0), (45.0, 80.0)], headings=[math.pi / 2, enemy_heading])
+# ------------------------------------------------------------------ watching
+def bundled(name, n=1):
+    arena = load_match_arena(ROOT / "arenas" / name)
+    spec = load_tank_spec(ROOT / "vehicles" / "light")
+    return World(arena.walls, [spec] * n, arena.spawns, seed=3, bounds=arena.bounds)
+
+
+def set_up(w):
+    agent = Agent(random.Random(0), "normal")
+    agent._setup(w, w.tanks[0])
+    return agent
+
+
+def test_vantage_cover_counts_the_blocks_in_the_cone_and_in_sight():
+    w = bundled("paper2002")
+    agent = set_up(w)
+    views, v = agent.views, agent.vantages
+    assert v is vantages_for(views, agent.senses.half_angle, agent.senses.vision_range)    # cached
+    rng = random.Random(1)
+    for _ in range(20):
+        b, k = rng.randrange(len(views)), rng.randrange(len(v.headings))
+        bx, bz = views.points[b]
+        n = 0
+        for c, (cx, cz) in enumerate(views.points):
+            off = abs(math.remainder(math.atan2(cz - bz, cx - bx) - v.headings[k], 2 * math.pi))
+            if c == b or off <= agent.senses.half_angle - 0.1 and views.visible[b, c] \
+                    and math.hypot(cx - bx, cz - bz) <= agent.senses.vision_range:
+                n += 1
+        assert v.cover[b, k] == pytest.approx(n / len(views))
+
+
+def test_open_arenas_have_a_vantage_and_the_maze_has_none():
+    box, maze = set_up(bundled("box")), set_up(bundled("maze"))
+    assert box.vantages.top >= 0.7 > WATCH_COVER > maze.vantages.top
+    # in the open box the best place is a corner, facing along the diagonal
+    b, face = box.vantages.best(box.views.cell_at(30.0, 30.0), 0.0)
+    x, z = box.views.points[b]
+    assert min(x, 60 - x) < 10 and min(z, 60 - z) < 10
+    assert abs(math.remainder(face - math.atan2(30.0 - z, 30.0 - x), 2 * math.pi)) < 0.3
+
+
+def test_alone_in_the_box_an_agent_holds_a_vantage_and_sweeps_its_cone():
+    w = bundled("box", 2)
+    me, other = w.tanks
+    other.alive, other.respawn_at = False, math.inf
+    agent = Agent(random.Random(2), "normal")
+    headings = []
+    for k in range(int(20.0 / w.dt)):
+        w.step(None, [agent(w, me), IDLE])
+        if w.t > 12.0:
+            headings.append(me.heading)
+            assert agent.state == "watch"
+    gx, gz = agent.spot
+    assert math.hypot(me.x - gx, me.z - gz) < 3.0 and me.wall_bumps == 0
+    swing = max(headings) - min(headings)
+    assert 0.4 < swing < 2 * 0.35 + 0.2                  # it sweeps, about the vantage's way
+
+
+def test_an_enemy_coming_into_the_watched_box_is_seen_and_attacked():
+    w = bundled("box", 2)
     me, enemy = w.tanks
-    me.kills, enemy.kills = agent_kills, enemy_kills
-    me.hp = hp
-    return w
+    enemy.alive, enemy.respawn_at = False, math.inf
+    agent = Agent(random.Random(2), "normal")
+    for k in range(int(15.0 / w.dt)):
+        w.step(None, [agent(w, me), IDLE])
+    assert agent.state == "watch"
+    # the enemy appears far off, in the watched way (the cone less the sweep)
+    cone = agent.senses.half_angle - 0.35
+    far = [(math.hypot(x - me.x, z - me.z), x, z) for x in range(10, 56, 2) for z in range(10, 56, 2)
+           if can_see(w.walls, me.x, me.z, agent.spot_face, x, z, cone, 90.0)]
+    d, ex, ez = max(far)
+    assert d > 40.0
+    enemy.place(ex, ez, 0.0)
+    enemy.alive, enemy.hp = True, enemy.spec.hit_points
+    shots = me.shots
+    for k in range(int(4.0 / w.dt)):
+        w.step(None, [agent(w, me), IDLE])
+    assert agent.state == "attack" and me.shots > shots
 
 
-def run(agent, w, seconds):
-    me, enemy = w.tanks
-    states, fired = set(), False
-    for _ in range(int(round(seconds / w.dt))):
-        cmd = agent(w, me)
-        fired |= bool(cmd.fire)
-        states.add(agent.state)
-        w.step(None, [cmd, IDLE])
-    return states, fired
-
-
-def test_protecting_reads_the_score_the_clock_and_its_hit_points():
-    agent = Agent(random.Random(0), "normal", match_seconds=60.0)
-    w = lead_world(1, 0, hp=50.0)
+def test_the_watch_gives_way_to_exploring_what_has_gone_unseen():
+    w = bundled("paper2002")
+    agent = set_up(w)
     me = w.tanks[0]
-    assert agent.protecting(w, me)                       # ahead and damaged
-    me.hp = me.spec.hit_points
-    assert not agent.protecting(w, me)                   # ahead, unhurt, early
-    w.t = 60.0 - LATE + 1.0
-    assert agent.protecting(w, me)                       # ahead, unhurt, late
-    w.t = 0.0
-    me.hp = 50.0
-    w.tanks[1].kills = 1
-    assert not agent.protecting(w, me)                   # level: seek
-    w.tanks[1].kills = 2
-    assert not agent.protecting(w, me)                   # behind: seek
-    w.tanks[1].kills = 0
-    # the enemy it fights is nearer death than it is (it saw 3 of its 4 hits land)
-    agent.target, agent.enemy_hits = 1, {1: 3}
-    assert not agent.protecting(w, me)
-    # without a clock, only damage counts
-    w.t = 59.0
-    me.hp = me.spec.hit_points
-    assert not Agent(random.Random(0), "normal").protecting(w, me)
+    agent.state, agent.state_since = "watch", 0.0
+    agent.coverage.seen[:] = 0.0               # all seen at t=0
+    w.t = WATCH_STINT + 1.0                   # nothing stale yet: watch on
+    assert agent.coverage.stale_fraction(w.t) == 0.0 and agent._watch(w, me) is not None
+    w.t = 61.0                                 # all stale: explore, until seen again
+    assert agent.coverage.stale_fraction(w.t) > STALE
+    assert agent._watch(w, me) is None and agent.exploring
+    agent.coverage.seen[:] = w.t
+    assert agent._watch(w, me) is not None and not agent.exploring
 
 
-def test_a_damaged_agent_that_leads_retreats_out_of_sight_instead_of_attacking():
-    w = lead_world(1, 0, hp=50.0)                        # the enemy's gun points away (+z)
-    agent = Agent(random.Random(5), "normal", match_seconds=60.0)
-    enemy = w.tanks[1]
-    states, fired = run(agent, w, 6.0)
-    assert "hide" in states and "attack" not in states and not fired
-    me = w.tanks[0]
-    gx, gz = agent.hide_goal
-    assert w.walls.blocked(enemy.x, enemy.z, gx, gz)     # the spot is out of its sight
-    assert math.hypot(me.x - gx, me.z - gz) < math.hypot(45.0 - gx, 30.0 - gz) - 5.0  # on the way there
-
-
-def test_the_same_agent_attacks_when_level_or_cornered():
-    # level on the score: it fights
-    w = lead_world(1, 1, hp=50.0)
-    states, fired = run(Agent(random.Random(5), "normal", match_seconds=60.0), w, 3.0)
-    assert "attack" in states and fired
-    # leading, but the enemy's gun points at it: turning away would give free shots
-    w = lead_world(1, 0, hp=50.0, enemy_heading=-math.pi / 2)
-    states, fired = run(Agent(random.Random(5), "normal", match_seconds=60.0), w, 3.0)
-    assert "attack" in states and "hide" not in states and fired
-
-
-def test_hits_seen_land_are_counted_on_the_target_and_forgotten_at_its_death():
-    w = lead_world(0, 0, hp=100.0)
+# ------------------------------------------------------------------ after a kill
+def test_after_a_kill_it_forgets_the_dead_enemy_and_does_not_search_for_it():
+    w = box_world([(50.0, 35.0), (55.0, 70.0)])
     me = w.tanks[0]
     agent = Agent(random.Random(0), "normal")
-    agent.target = 1
-    me.hits = 2
-    agent._score(me)
-    assert agent.enemy_hits == {1: 2}
-    me.hits, me.kills = 4, 1
-    agent._score(me)
-    assert agent.enemy_hits == {}
-
-
-# ------------------------------------------------------------------ hiding
-def test_the_hide_spot_is_out_of_the_threats_sight():
-    w = box_world([(50.0, 35.0)])
-    agent = Agent(random.Random(0), "normal")
-    agent(w, w.tanks[0])
-    spot = agent.hide_spot(w.tanks[0], [(30.0, 35.0)])
-    assert spot is not None and agent.hide_exposure == pytest.approx(0.0)
-    assert w.walls.blocked(30.0, 35.0, spot[0], spot[1])
+    agent(w, me)
+    agent.target, agent.state = 1, "attack"
+    agent.senses.last_seen[1] = Sighting(1, 55.0, 70.0, 0.0, 0.0, w.t, 35.0)
+    me.kills = 1
+    w.tanks[1].alive = False
+    agent.next_think = -math.inf
+    agent(w, me)
+    assert 1 not in agent.senses.last_seen and agent.killed_at == w.t
+    assert agent.state in ("wander", "watch")
+    # a kill it did not see happen (its target seen long ago) changes nothing
+    agent.senses.last_seen[1] = Sighting(1, 55.0, 70.0, 0.0, 0.0, w.t - 5.0, 35.0)
+    me.kills = 2
+    agent._kills(me, w.t)
+    assert 1 in agent.senses.last_seen

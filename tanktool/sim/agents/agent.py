@@ -1,6 +1,6 @@
 """The computer opponent: a small state machine over sensors and ``Command`` values.
 
-States (each a method ``_wander``, ``_search``, ``_attack``, ``_evade``, ``_hide``
+States (each a method ``_wander``, ``_watch``, ``_search``, ``_attack``, ``_evade``
 that returns the command for this think):
 
 * **Wander** (start): explore.  A* to the block that sees the most of what was not
@@ -14,31 +14,31 @@ that returns the command for this think):
 * **Evade** (hit twice within 4 s by an enemy it cannot see): drive to the nearest of
   a few sampled nodes out of the threat's line of sight, or, with no cover near,
   strafe hard.
-* **Hide** (protecting a lead: ahead on the scoreboard and damaged, or ahead with
-  less than ``LATE`` s on the clock): drive to a block out of the threats' line of
-  sight (the enemy seen, else where one was last seen or heard, else the spawn
-  points), far from them, and watch the way they would come, sweeping the cone.
-  Cornered (the enemy closer than ``CORNERED`` m, or its gun pointing within 60° of
-  us) or with no block out of its sight: Attack.  Level or behind: never hides.
+* **Watch** (instead of Wander, in an arena with a vantage point: a block from which
+  the vision cone, pointed one way, sees at least ``WATCH_COVER`` of the arena's
+  blocks; ``navigation.Vantages``): drive to the nearest good vantage and hold it,
+  facing that way and sweeping the cone, so that an enemy coming in is seen first
+  and far off.  After ``WATCH_STINT`` s, if part of the arena has gone unseen for a
+  minute (more than ``STALE`` of it), Wander until it has been seen again, then back
+  to Watch.
 
 Transitions, checked every think (``think_hz`` times a second; the command is held in
 between, as a person holds a key)::
 
     any      --enemy seen, reaction time over-->  Attack
     Attack   --enemy lost-->                      Search (from where it was last seen, moved on)
+    Attack   --enemy killed-->                    Wander / Watch (it comes back at a spawn point)
     Wander   --shot heard / hit taken-->          Search (from the shot / from behind us)
     Search   --all quadrants done, or 60 s-->     Wander
     any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
-    any      --protecting a lead, a block out of sight-->  Hide --not protecting--> Search
-    Hide     --enemy seen and cornered-->         Attack
+    Wander  <--stint over, part unseen / all seen again-->  Watch   (arenas with a vantage)
 
-Wander and Search also take a heard engine (a moving tank within the engine-hearing
+Wander, Watch and Search also take a heard engine (a moving tank within the engine-hearing
 radius, through walls) as they take a heard shot.
 
 Everything the agent knows comes from ``perception.Senses`` (sight, hearing of shots
-and engines, memory, its own hit points), what a player's HUD shows (its own kills,
-hits landed and hit points, the scoreboard's kills, the match clock when told its
-length) and the static map (walls, spawn points and its navigation grid); it acts only
+and engines, memory, its own hit points), what a player's HUD shows (its own kills)
+and the static map (walls, spawn points and its navigation grid); it acts only
 through ``Command`` values.  Its randomness comes from its own ``random.Random``,
 seeded from the world's, so matches replay exactly.
 
@@ -55,13 +55,12 @@ import random
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from ...nav.navgrid import nearest_valid_node
 from ...nav.steering import heading_from_angle
 from ..commands import IDLE, Command
 from .fuzzy import PREDICT, AttackController, FIRE_THRESHOLD
-from .navigation import Coverage, Memory, SearchPlan, Wanderer, agent_grid, plan_path, views_for
+from .navigation import (Coverage, Memory, SearchPlan, Vantages, Wanderer, agent_grid, plan_path, vantages_for,
+                         views_for)
 from .perception import Senses, Sighting, wrap
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -72,15 +71,18 @@ if TYPE_CHECKING:  # pragma: no cover
 #: faster than 3 m/s through a bend gentler than a right angle [m/s]
 CORNER_BRAKE = 0.8
 CORNER_FAST = 6.0
-STATES = ("wander", "search", "attack", "evade", "hide")
-#: protecting a lead: also when ahead with this little of the match left [s]
-LATE = 15.0
-#: ... and fighting anyway when the enemy is this close [m]
-CORNERED = 20.0
-#: a sighting or a heard position older than this is no threat to hide from [s]
-THREAT_MEMORY = 10.0
-#: a hiding agent sweeps its cone this far either side of the way danger comes [rad]
-SWEEP = 0.4
+STATES = ("wander", "watch", "search", "attack", "evade")
+#: a vantage point sees at least this fraction of the arena's blocks in one cone
+WATCH_COVER = 0.4
+#: choosing a vantage: its cover less this much per metre of path to it
+WATCH_PER_M = 0.004
+#: watch this long [s] before going to look at what has not been seen for a minute
+WATCH_STINT = 30.0
+#: ... if more than this fraction of the arena's blocks has not been seen for a minute
+STALE = 0.2
+#: a watching agent sweeps its cone this far either side of the vantage's way [rad],
+#: at this rate [rad/s]
+SWEEP = 0.35
 SWEEP_RATE = 0.35
 
 
@@ -127,16 +129,14 @@ class Agent:
     half_angle : vision cone half-angle [rad] (60 degrees)
     cell : node spacing of its navigation grid [m]
     margin : grid clearance beyond the vehicle's footprint radius [m]
-    match_seconds : the match's length, as the HUD's clock shows it (None: unknown;
-        then only damage decides when to protect a lead)
+    watch : hold vantage points where the arena has them (False: always Wander)
     """
 
     def __init__(self, rng: random.Random, level: str | Difficulty = "normal", *,
                  half_angle: float = math.radians(60.0), cell: float = 1.0, margin: float = 0.5,
-                 match_seconds: float | None = None) -> None:
+                 watch: bool = True) -> None:
         self.level = difficulty(level)
         self.rng = rng
-        self.match_seconds = match_seconds
         self.period = 1.0 / self.level.think_hz
         self.senses = Senses(half_angle, self.level.vision_range, self.level.hearing_radius, 0.15, rng,
                              engine_radius=self.level.engine_radius)
@@ -172,18 +172,17 @@ class Agent:
         self.dodge = 1.0 if rng.random() < 0.5 else -1.0
         self.dodge_flip = 0.0
         self.hits: list[float] = []
-        # the score as the agent saw it: its own hits and kills, and the hits it saw land
-        # on each enemy since that enemy's last death at its hands
-        self.own_hits = 0
+        # its own kills (the HUD), and when the target last died at its hands
         self.own_kills = 0
-        self.enemy_hits: dict[int, int] = {}
-        # hiding (protecting a lead)
-        self.hide_goal: tuple[float, float] | None = None
-        self.hide_path: list[tuple[float, float]] = []
-        self.hide_face = 0.0
-        self.hide_replan = -math.inf
-        self.hide_exposure = 1.0
-        self.threats: list[tuple[float, float]] = []
+        self.killed_at = -math.inf
+        # watching: the vantage table, the spot chosen, the way it faces, the path there
+        self.watches = watch
+        self.vantages: Vantages | None = None
+        self.spot: tuple[float, float] | None = None
+        self.spot_face = 0.0
+        self.spot_path: list[tuple[float, float]] = []
+        self.spot_replan = -math.inf
+        self.exploring = False
         # stuck recovery
         self.progress_at = (0.0, math.nan, math.nan)
         self.reverse_until = -math.inf
@@ -205,7 +204,7 @@ class Agent:
         self.route, self.walker, self.path, self.plan, self.goal = [], None, [], None, None
         self.target, self.acquired_at = None, math.inf
         self.hits = []
-        self.hide_goal, self.hide_replan, self.hide_path = None, -math.inf, []
+        self.spot, self.spot_replan, self.spot_path, self.exploring = None, -math.inf, [], False
         self.senses.hp = math.inf
         self.reverse_until = -math.inf
         self.next_think = -math.inf
@@ -217,6 +216,7 @@ class Agent:
         self.controller = AttackController(tank.spec.shell_speed)
         self.views = views_for(world, self.grid)
         self.coverage = Coverage(self.views, self.senses.half_angle, self.senses.vision_range)
+        self.vantages = vantages_for(self.views, self.senses.half_angle, self.senses.vision_range)
 
     def _enter(self, state: str, t: float) -> None:
         if state != self.state:
@@ -241,7 +241,7 @@ class Agent:
         if self.senses.hit_taken(tank) > 0.0:
             self.hits.append(t)
         self.hits = [h for h in self.hits if t - h < 4.0]
-        self._score(tank)
+        self._kills(tank, t)
 
         sight = self._pick_target(seen)
         if sight is not None:
@@ -261,32 +261,17 @@ class Agent:
             self.evade_cooldown = t + 8.0
             self._start_search(self.threat or (tank.x, tank.z), t)
 
-        protect = self.protecting(world, tank)
-        if protect and sight is not None and t < self.acquired_at:
-            # seen, not reacted to yet: carry on (hiding as before, if it was)
-            sight = None if self.state == "hide" else sight
-        if protect and (sight is None or t >= self.acquired_at):
-            if sight is not None and self._cornered(tank, sight):
-                self._enter("attack", t)
-                return self._attack(world, tank, sight)
-            cmd = self._hide(world, tank, sight, heard)
-            if cmd is not None and self.hide_exposure < 0.5:
-                self._enter("hide", t)
-                return self._unstick(world, tank, cmd)
-            if sight is not None:                  # nowhere out of its sight: fight
-                self._enter("attack", t)
-                return self._attack(world, tank, sight)
-        if self.state == "hide":
-            est = self._estimate(t)
-            self._start_search(est if est is not None else (tank.x, tank.z), t)
-
         if sight is not None and t >= self.acquired_at:
             self._enter("attack", t)
             return self._attack(world, tank, sight)
         if sight is None and self.state == "attack":
-            est = self._estimate(t)
-            self._start_search(est if est is not None else (tank.x, tank.z), t)
-        elif sight is None and self.state == "wander":
+            if t - self.killed_at < 1.0:
+                # it died: it comes back at a spawn point, not where it was
+                self._enter("wander", t)
+            else:
+                est = self._estimate(t)
+                self._start_search(est if est is not None else (tank.x, tank.z), t)
+        elif sight is None and self.state in ("wander", "watch"):
             if heard is not None:
                 self._start_search((heard.x, heard.z), t)
             elif self.hits and self.hits[-1] == t:
@@ -299,48 +284,23 @@ class Agent:
             if cmd is not None:
                 return self._unstick(world, tank, cmd)
             self._enter("wander", t)
+        cmd = self._watch(world, tank)
+        if cmd is not None:
+            self._enter("watch", t)
+            return self._unstick(world, tank, cmd)
+        self._enter("wander", t)
         return self._unstick(world, tank, self._wander(world, tank))
 
-    # ------------------------------------------------------------------ the score
-    def _score(self, tank: "Tank") -> None:
-        """Count the hits it saw its shells land (on the target it shot at) and forget
-        them when that enemy dies at its hands (its own kills go up)."""
-        if tank.hits > self.own_hits:
-            if self.target is not None:
-                self.enemy_hits[self.target] = self.enemy_hits.get(self.target, 0) + tank.hits - self.own_hits
-            self.own_hits = tank.hits
+    # ------------------------------------------------------------------ kills
+    def _kills(self, tank: "Tank", t: float) -> None:
+        """Its kills (the HUD) went up while it was shooting at a target seen in the
+        last second: that target is dead, so forget where it was seen."""
         if tank.kills > self.own_kills:
-            if self.target is not None:
-                self.enemy_hits.pop(self.target, None)
             self.own_kills = tank.kills
-
-    def protecting(self, world: "World", tank: "Tank") -> bool:
-        """Protect the lead?  What the HUD shows: its own kills against the best enemy
-        score on the scoreboard, the clock, its own hit points.  Ahead, and damaged or
-        with less than ``LATE`` s left, unless the enemy it fights is nearer death than
-        it is (counted from the hits it saw land)."""
-        lead = tank.kills - max((o.kills for o in world.tanks if o is not tank), default=0)
-        if lead <= 0:
-            return False
-        left = math.inf if self.match_seconds is None else self.match_seconds - world.t
-        full = tank.spec.hit_points
-        if tank.hp >= full and left >= LATE:
-            return False
-        dmg = tank.spec.shell_damage
-        mine = math.ceil(tank.hp / dmg)
-        if self.target is not None and self.target in self.enemy_hits:
-            theirs = math.ceil(full / dmg) - self.enemy_hits[self.target]
-            if theirs < mine:
-                return False
-        return True
-
-    def _cornered(self, tank: "Tank", s: Sighting) -> bool:
-        """Too close to get away, or the enemy's gun (its hull) points within 60° of us:
-        it sees us, and turning our back would give it free shots."""
-        if s.distance < CORNERED:
-            return True
-        back = math.atan2(tank.z - s.z, tank.x - s.x)
-        return abs(wrap(s.heading - back)) < math.radians(60.0)
+            s = self.senses.last_seen.get(self.target) if self.target is not None else None
+            if s is not None and t - s.t < 1.0:
+                del self.senses.last_seen[self.target]
+                self.killed_at = t
 
     def _pick_target(self, seen: list[Sighting]) -> Sighting | None:
         """The current target if still in sight (no dithering), else the nearest."""
@@ -473,80 +433,43 @@ class Agent:
             self.dodge = -self.dodge
         return self.dodge
 
-    # ------------------------------------------------------------------ hide
-    def _threats(self, world: "World", tank: "Tank", sight: Sighting | None) -> list[tuple[float, float]]:
-        """Where danger comes from: the enemy in sight, else where one was last seen
-        (moved on) or heard in the last ``THREAT_MEMORY`` s, else the spawn points
-        (the map: where a respawned enemy appears, and the open floor roamers head for)."""
-        t = world.t
-        if sight is not None:
-            return [(sight.x, sight.z)]
-        recent = [s for s in self.senses.last_seen.values() if t - s.t < THREAT_MEMORY]
-        h = self.senses.heard
-        if recent:
-            s = max(recent, key=lambda s: s.t)
-            if h is None or s.t >= h.t:
-                dt = min(t - s.t, 2.0)
-                return [(s.x + s.vx * dt, s.z + s.vz * dt)]
-        if h is not None and t - h.t < THREAT_MEMORY:
-            return [(h.x, h.z)]
-        return [(x, z) for x, z, _ in world.spawns if math.hypot(x - tank.x, z - tank.z) > 10.0]
-
-    def hide_spot(self, tank: "Tank", threats: list[tuple[float, float]]) -> tuple[float, float] | None:
-        """The block to hide in: out of the threats' line of sight (the blocks' table),
-        far from them, near by path: ``mean(min(distance, 70)) - 40 x exposure - 0.3 x path``
-        (exposure: the fraction of the threats that see it; mean over the threats)."""
-        views = self.views
-        cells = [c for c in (views.cell_at(x, z) for x, z in threats) if c >= 0]
-        me = views.cell_at(tank.x, tank.z)
-        if not cells or me < 0:
+    # ------------------------------------------------------------------ watch
+    def _watch(self, world: "World", tank: "Tank") -> Command | None:
+        """Hold a vantage point: the nearest block (by path) whose cone sees the most of
+        the arena, chosen again every 5 s; there, face its best way and sweep the cone
+        ``SWEEP`` either side.  None: no vantage in this arena, or exploring (after
+        ``WATCH_STINT`` s of watching, while more than ``STALE`` of the blocks are stale:
+        not seen for a minute)."""
+        v = self.vantages
+        if not self.watches or v is None or v.top < WATCH_COVER:
             return None
-        path = views.path_distances(me)
-        exposure = views.visible[cells].mean(axis=0)
-        far = np.minimum(views.distance[cells], 70.0).mean(axis=0)
-        score = far - 40.0 * exposure - 0.3 * np.where(np.isfinite(path), path, 0.0)
-        score[~np.isfinite(path)] = -np.inf
-        b = int(np.argmax(score))
-        gx, gz = views.points[b]
-        self.hide_exposure = float(exposure[b])
-        return float(gx), float(gz)
-
-    def _hide(self, world: "World", tank: "Tank", sight: Sighting | None, heard) -> Command | None:
-        """Protect the lead: drive to a hiding block away from the threats and out of
-        their sight, chosen again every 3 s (every second while an enemy is in sight or
-        just heard); there, watch the way the nearest threat would come, sweeping the
-        cone ±0.6 rad.  None: nowhere to go."""
         t = world.t
-        if self.state != "hide" and t >= self.hide_replan + 1.0:
-            self.hide_goal, self.hide_replan = None, -math.inf
-        if t >= self.hide_replan:
-            threats = self._threats(world, tank, sight)
-            self.threats = threats
-            goal = self.hide_spot(tank, threats)
-            self.hide_replan = t + (1.0 if sight is not None or heard is not None else 3.0)
-            if goal != self.hide_goal:
-                self.hide_goal = goal
-                self.hide_path = plan_path(self.grid, (tank.x, tank.z), goal) if goal is not None else []  # type: ignore[arg-type]
-            if goal is not None and threats:
-                cx = sum(p[0] for p in threats) / len(threats)
-                cz = sum(p[1] for p in threats) / len(threats)
-                self.hide_face = math.atan2(cz - goal[1], cx - goal[0])
-        if self.hide_goal is None:
+        stale = self.coverage.stale_fraction(t) > STALE  # type: ignore[union-attr]
+        if self.exploring:
+            if stale:
+                return None
+            self.exploring = False
+        if self.state == "watch" and t - self.state_since > WATCH_STINT and stale:
+            self.exploring = True
             return None
         x, z = tank.x, tank.z
-        gx, gz = self.hide_goal
-        path = self.hide_path
-        if math.hypot(gx - x, gz - z) > 3.0:
+        if self.spot is None or t >= self.spot_replan:
+            self.spot_replan = t + 5.0
+            cell, face = v.best(self.views.cell_at(x, z), WATCH_PER_M)  # type: ignore[union-attr]
+            spot = tuple(float(c) for c in self.views.points[cell])  # type: ignore[union-attr]
+            self.spot_face = face
+            if spot != self.spot or not self.spot_path:
+                self.spot = spot  # type: ignore[assignment]
+                self.spot_path = plan_path(self.grid, (x, z), spot)  # type: ignore[arg-type]
+        gx, gz = self.spot  # type: ignore[misc]
+        path = self.spot_path
+        if math.hypot(gx - x, gz - z) > 2.5 and path:
             while len(path) > 1 and math.hypot(path[0][0] - x, path[0][1] - z) < 3.0:
                 path.pop(0)
-            if not path:
-                path = self.hide_path = plan_path(self.grid, (x, z), self.hide_goal)  # type: ignore[arg-type]
-                if not path:
-                    return None
-            return self._follow(world, tank, path, speed=1.0, lookahead=4.0, corner=path[0])
+            return self._follow(world, tank, path, speed=1.0, lookahead=4.0, corner=path[0], stop=True)
         # a triangle wave: the cone sweeps at a steady SWEEP_RATE, to and fro
         phase = (t * SWEEP_RATE / (2.0 * SWEEP)) % 2.0
-        look = self.hide_face + SWEEP * (2.0 * abs(phase - 1.0) - 1.0)
+        look = self.spot_face + SWEEP * (2.0 * abs(phase - 1.0) - 1.0)
         err = wrap(look - tank.heading)
         return self._drive(world, tank, 0.0, 0.0, self.controller.turn(err - PREDICT * tank.omega))  # type: ignore[union-attr]
 
@@ -599,10 +522,10 @@ class Agent:
 
     # ------------------------------------------------------------------ driving
     def _follow(self, world: "World", tank: "Tank", points: list[tuple[float, float]], speed: float,
-                lookahead: float, corner: tuple[float, float] | None = None) -> Command:
+                lookahead: float, corner: tuple[float, float] | None = None, stop: bool = False) -> Command:
         """Pure pursuit of the first point at least ``lookahead`` away (or the last),
         at up to ``speed`` x top speed, slowing to turn and for ``corner`` (the next
-        waypoint where the path bends)."""
+        waypoint where the path bends); ``stop``: braking to stand at the last point."""
         if not points:
             return self._drive(world, tank, 0.0, 0.0, 0.0)
         x, z = tank.x, tank.z
@@ -627,6 +550,10 @@ class Agent:
                 bend = abs(wrap(math.atan2(nz - corner[1], nx - corner[0]) - math.atan2(corner[1] - z, corner[0] - x)))
             vc = 3.0 + CORNER_FAST * max(0.0, 1.0 - bend / (math.pi / 2))
             v = min(v, vc + math.sqrt(2.0 * brake * math.hypot(corner[0] - x, corner[1] - z)))
+        if stop:
+            # planned at half the corner braking: the speed controller lags the wish
+            brake = 0.5 * CORNER_BRAKE * tank.spec.engine_force / tank.spec.mass
+            v = min(v, math.sqrt(2.0 * brake * math.hypot(points[-1][0] - x, points[-1][1] - z)))
         return self._drive(world, tank, v, 0.0, rotate)
 
     def _free(self, world: "World", tank: "Tank", angle: float, length: float, offsets: tuple[float, ...]) -> float:
@@ -714,14 +641,13 @@ class Agent:
             self.reverse_until = t + 0.8
             self.reverse_turn = 1.0 if self.rng.random() < 0.5 else -1.0
             self.progress_at = (t + 0.8, math.nan, math.nan)
-            self.route, self.walker, self.path, self.hide_path = [], None, [], []
+            self.route, self.walker, self.path, self.spot_path = [], None, [], []
             return self._drive(world, tank, -4.0, 0.0, self.reverse_turn)
         return cmd
 
 
-def make_agents(world: "World", level: str | Difficulty = "normal", which: range | list[int] | None = None,
-                match_seconds: float | None = None) -> list[Agent]:
-    """One agent per tank (or per index in ``which``), each seeded from the world's generator;
-    ``match_seconds``: the match's length (the HUD's clock), if known."""
+def make_agents(world: "World", level: str | Difficulty = "normal",
+                which: range | list[int] | None = None) -> list[Agent]:
+    """One agent per tank (or per index in ``which``), each seeded from the world's generator."""
     idx = range(len(world.tanks)) if which is None else which
-    return [Agent(random.Random(world.rng.getrandbits(64)), level, match_seconds=match_seconds) for _ in idx]
+    return [Agent(random.Random(world.rng.getrandbits(64)), level) for _ in idx]

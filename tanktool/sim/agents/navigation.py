@@ -427,6 +427,10 @@ class Coverage:
         age = t - self.seen
         return np.where(age < self.fresh, 0.0, np.minimum(age / self.forget, 1.0))
 
+    def stale_fraction(self, t: float) -> float:
+        """The fraction of the blocks not seen for ``fresh`` seconds (or never)."""
+        return float(np.mean(t - self.seen >= self.fresh))
+
     def since(self, x: float, z: float, t: float) -> float:
         """Seconds since the block of (x, z) was seen (inf: never)."""
         c = self.views.cell_at(x, z)
@@ -456,3 +460,49 @@ class Coverage:
         if score[best] <= 0.0:
             return None
         return best, float(gain[best])
+
+
+class Vantages:
+    """Where to watch from: for every block and each of ``headings`` ways to face, the
+    fraction of the arena's blocks in the vision cone from there (within the vision
+    range, in line of sight: ``Views.visible``; its own block counts).  The cone is taken ``margin`` narrower
+    than the agent's, so a block on its edge is still seen while it sweeps.  Static:
+    the map, built once per (views, cone) and cached.
+    """
+
+    def __init__(self, views: Views, half_angle: float, vision_range: float, headings: int = 24,
+                 margin: float = 0.1) -> None:
+        self.views = views
+        p = views.points
+        bearing = np.arctan2(p[None, :, 1] - p[:, None, 1], p[None, :, 0] - p[:, None, 0])
+        sees = views.visible & (views.distance <= vision_range)
+        self.headings = np.arange(headings) * (2.0 * math.pi / headings)
+        self.cover = np.empty((len(p), headings))
+        for k, h in enumerate(self.headings):
+            inside = np.abs(np.remainder(bearing - h + math.pi, 2.0 * math.pi) - math.pi) <= half_angle - margin
+            np.fill_diagonal(inside, True)         # the block it stands in
+            self.cover[:, k] = (sees & inside).sum(axis=1) / max(len(p), 1)
+        self.top = float(self.cover.max()) if self.cover.size else 0.0
+
+    def best(self, here: int, per_m: float) -> tuple[int, float]:
+        """(block, heading) of the best vantage from block ``here``: the most cover less
+        ``per_m`` per metre of path to it; unreachable blocks never."""
+        dist = self.views.path_distances(here)
+        score = np.where(np.isfinite(dist), self.cover.max(axis=1) - per_m * np.where(np.isfinite(dist), dist, 0.0),
+                         -np.inf)
+        b = int(np.argmax(score))
+        return b, float(self.headings[int(np.argmax(self.cover[b]))])
+
+
+_VANTAGES: dict[tuple, Vantages] = {}
+
+
+def vantages_for(views: Views, half_angle: float, vision_range: float) -> Vantages:
+    """The :class:`Vantages` of these views and this cone (cached)."""
+    key = (id(views), round(half_angle, 9), round(vision_range, 6))
+    v = _VANTAGES.get(key)
+    if v is None or v.views is not views:
+        if len(_VANTAGES) >= 16:
+            _VANTAGES.pop(next(iter(_VANTAGES)))
+        v = _VANTAGES[key] = Vantages(views, half_angle, vision_range)
+    return v
