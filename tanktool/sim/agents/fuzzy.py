@@ -114,7 +114,7 @@ def sugeno2(a: Variable, b: Variable, table: Sequence[Sequence[float]], x: float
 
 
 V_LAT = Variable("lateral speed", ("left-fast", "still", "right-fast"), (-10.0, 0.0, 10.0))
-ERROR = Variable("angle error", ("NB", "NS", "Z", "PS", "PB"), (-0.5, -0.15, 0.0, 0.15, 0.5))
+ERROR = Variable("angle error", ("NB", "NS", "Z", "PS", "PB"), (-0.3, -0.08, 0.0, 0.08, 0.3))
 AIM = Variable("|angle error| (aim)", ("on-target", "close", "off"), (0.0, 0.04, 0.1))
 ALIGN = Variable("|angle error| (move)", ("aligned", "off"), (0.1, 0.6))
 DIST = Variable("distance", ("near", "medium", "far"), (15.0, 45.0, 90.0))
@@ -126,7 +126,7 @@ STRAFE = ((1.0, 0.9, 0.6), (0.5, 0.4, 0.2))
 #: fire when the readiness reaches this
 FIRE_THRESHOLD = 0.5
 #: how far ahead the turn rules look [s] (anticipates the gun's swing)
-PREDICT = 0.35
+PREDICT = 0.2
 
 
 @dataclass(frozen=True)
