@@ -29,9 +29,9 @@ between, as a person holds a key)::
     Attack   --enemy lost-->                      Search (from where it was last seen, moved on)
     Attack   --enemy killed-->                    Wander / Watch (it comes back at a spawn point)
     Wander   --shot heard / hit taken-->          Search (from the shot / from behind us)
-    Search   --all quadrants done, or 60 s-->     Wander
+    Search   --all quadrants done, or 60 s-->     Wander / Watch
     any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
-    Wander  <--stint over, part unseen / all seen again-->  Watch   (arenas with a vantage)
+    Watch    --watched WATCH_STINT s, part unseen-->  Wander --all seen again--> Watch
 
 Wander, Watch and Search also take a heard engine (a moving tank within the engine-hearing
 radius, through walls) as they take a heard shot.

@@ -16,7 +16,7 @@ i.e. to the right):
 * ``V``  relative lateral speed [m/s]: the enemy's velocity minus our own (a shell
   inherits the shooter's velocity) across the line of sight.
 * ``e``  angle error [rad]: the aim bearing (bearing + lead + aim noise) minus our
-  heading.  The turn rule base reads the *predicted* error ``e - 0.35 s * omega`` (where
+  heading.  The turn rule base reads the *predicted* error ``e - 0.2 s * omega`` (where
   the gun will point a moment from now), which damps the tank's slow turn response.
 * ``|e|`` its size, and ``D`` the distance to the enemy [m].
 
@@ -26,7 +26,7 @@ Terms (breakpoints):
 input       terms                                               breakpoints
 ==========  ==================================================  ========================
 V           left-fast, still, right-fast                        -10, 0, +10 m/s
-e (turn)    NB, NS, Z, PS, PB                                   -0.5, -0.15, 0, 0.15, 0.5 rad
+e (turn)    NB, NS, Z, PS, PB                                   -0.3, -0.08, 0, 0.08, 0.3 rad
 |e| (fire)  on-target, close, off                               0, 0.04, 0.1 rad
 |e| (move)  aligned, off                                        0.1, 0.6 rad
 D           near, medium, far                                   15, 45, 90 m
