@@ -13,7 +13,7 @@ from tanktool.nav.steering import choose_next, heading_of_move
 from tanktool.sim.agents import DIFFICULTIES, Agent, difficulty, make_agents
 from tanktool.sim.agents.navigation import Memory, SearchPlan, Wanderer, agent_grid, search_order
 from tanktool.sim.agents.perception import Senses, can_see, in_cone
-from tanktool.sim.commands import IDLE
+from tanktool.sim.commands import IDLE, Command
 from tanktool.sim.match import load_match_arena, load_tank_spec, run_match
 from tanktool.sim.world import World
 
@@ -252,3 +252,26 @@ def test_play_cli_difficulty_and_bot_driver(tmp_path):
     assert json.loads(out.read_text())["bots"] == "scripted"
     r = CliRunner().invoke(cli, ["play", "--headless", "--difficulty", "insane"])
     assert r.exit_code == 2 and "insane" in r.output and "Traceback" not in r.output
+
+
+def test_held_still_on_a_path_it_backs_out_and_replans():
+    """A wall feeler can hold the tank still facing its next waypoint past a corner
+    (no push, no turn): after a second of that it backs out and plans again."""
+    w = box_world([(30.0, 30.0)])
+    me = w.tanks[0]
+    agent = Agent(random.Random(0), "normal")
+    agent(w, me)
+    agent.path = [(40.0, 30.0), (50.0, 30.0)]
+    held = Command(advance=0.0, rotate=0.0)
+    assert agent._unstick(w, me, held) is held
+    w.t += 1.2
+    out = agent._unstick(w, me, held)
+    assert out is not held and agent.reverse_until > w.t and agent.path == []
+    # turning in place towards the path is not being stuck
+    agent = Agent(random.Random(0), "normal")
+    agent(w, me)
+    agent.path = [(40.0, 30.0)]
+    turning = Command(advance=0.0, rotate=1.0)
+    agent._unstick(w, me, turning)
+    w.t += 1.2
+    assert agent._unstick(w, me, turning) is turning

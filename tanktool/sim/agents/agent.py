@@ -626,14 +626,19 @@ class Agent:
         return Command(advance=-0.3, rotate=self.reverse_turn)
 
     def _unstick(self, world: "World", tank: "Tank", cmd: Command) -> Command:
-        """Pushing but not moving for a second: reverse and turn for 0.8 s, then replan."""
+        """Pushing (or held still on a path) but not moving for a second: reverse and
+        turn for 0.8 s, then replan."""
         t = world.t
         if t < self.reverse_until:
             back = self._free(world, tank, tank.heading + math.pi, 8.0, (0.0,))
             ahead = self._free(world, tank, tank.heading, 8.0, (0.0,))
             return self._drive(world, tank, -4.0 if back >= ahead else 4.0, 0.0, self.reverse_turn)
         t0, x0, z0 = self.progress_at
-        if abs(cmd.advance) < 0.3 or not math.isfinite(x0) or math.hypot(tank.x - x0, tank.z - z0) > 0.5:
+        # pushing, or on a path and neither driving nor turning (a wall feeler holding
+        # it still, facing the next waypoint past a corner)
+        pushing = abs(cmd.advance) >= 0.3 or (bool(self.path or self.route) and abs(cmd.rotate) < 0.1
+                                               and abs(tank.omega) < 0.1)
+        if not pushing or not math.isfinite(x0) or math.hypot(tank.x - x0, tank.z - z0) > 0.5:
             self.progress_at = (t, tank.x, tank.z)
             return cmd
         if t - t0 > 1.0:

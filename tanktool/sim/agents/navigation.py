@@ -441,10 +441,13 @@ class Coverage:
         return float(self.sees[cell] @ self.staleness(t))
 
     def goal(self, x: float, z: float, t: float, weight: np.ndarray | None = None,
-             least: float = 1.0, d0: float = 10.0) -> tuple[int, float] | None:
+             least: float = 1.0, d0: float = 60.0) -> tuple[int, float] | None:
         """(block, its gain) of the best block to go and look from; None when nothing in
-        sight of any reachable block has at least ``least`` staleness.  ``weight``
-        multiplies each block's staleness (a prior of where enemies are likely)."""
+        sight of any reachable block has at least ``least`` staleness.  The score is the
+        gain over (path metres + ``d0``): a large ``d0`` favours the blocks that see much
+        over the ones near by (against the roaming baseline in the maze, 60 m left
+        30 % of duels without a meeting where 10 m left 36 %).  ``weight`` multiplies each block's staleness (a prior of where
+        enemies are likely)."""
         v = self.views
         c = v.cell_at(x, z)
         if c < 0:
