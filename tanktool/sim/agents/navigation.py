@@ -445,9 +445,9 @@ class Coverage:
         """(block, its gain) of the best block to go and look from; None when nothing in
         sight of any reachable block has at least ``least`` staleness.  The score is the
         gain over (path metres + ``d0``): a large ``d0`` favours the blocks that see much
-        over the ones near by (against the roaming baseline in the maze, 60 m left
-        30 % of duels without a meeting where 10 m left 36 %).  ``weight`` multiplies each block's staleness (a prior of where
-        enemies are likely)."""
+        over the ones near by (against the roaming baseline in the maze, 60 m left 30 %
+        of duels without a meeting where 10 m left 36 %).  ``weight`` multiplies each
+        block's staleness (a prior of where enemies are likely)."""
         v = self.views
         c = v.cell_at(x, z)
         if c < 0:
@@ -468,9 +468,9 @@ class Coverage:
 class Vantages:
     """Where to watch from: for every block and each of ``headings`` ways to face, the
     fraction of the arena's blocks in the vision cone from there (within the vision
-    range, in line of sight: ``Views.visible``; its own block counts).  The cone is taken ``margin`` narrower
-    than the agent's, so a block on its edge is still seen while it sweeps.  Static:
-    the map, built once per (views, cone) and cached.
+    range, in line of sight: ``Views.visible``; its own block counts).  The cone is
+    taken ``margin`` narrower than the agent's, so a block on its edge is still seen
+    while it sweeps.  Static: the map, built once per (views, cone) and cached.
     """
 
     def __init__(self, views: Views, half_angle: float, vision_range: float, headings: int = 24,
@@ -485,16 +485,17 @@ class Vantages:
             inside = np.abs(np.remainder(bearing - h + math.pi, 2.0 * math.pi) - math.pi) <= half_angle - margin
             np.fill_diagonal(inside, True)         # the block it stands in
             self.cover[:, k] = (sees & inside).sum(axis=1) / max(len(p), 1)
-        self.top = float(self.cover.max()) if self.cover.size else 0.0
+        # each block's cover facing its best way, and that way
+        self.block_cover = self.cover.max(axis=1) if self.cover.size else np.zeros(len(p))
+        self.block_face = self.headings[self.cover.argmax(axis=1)] if self.cover.size else np.zeros(len(p))
+        self.top = float(self.block_cover.max()) if len(p) else 0.0
 
     def best(self, here: int, per_m: float) -> tuple[int, float]:
         """(block, heading) of the best vantage from block ``here``: the most cover less
         ``per_m`` per metre of path to it; unreachable blocks never."""
-        dist = self.views.path_distances(here)
-        score = np.where(np.isfinite(dist), self.cover.max(axis=1) - per_m * np.where(np.isfinite(dist), dist, 0.0),
-                         -np.inf)
+        score = self.block_cover - per_m * self.views.path_distances(here)    # unreachable: -inf
         b = int(np.argmax(score))
-        return b, float(self.headings[int(np.argmax(self.cover[b]))])
+        return b, float(self.block_face[b])
 
 
 _VANTAGES: dict[tuple, Vantages] = {}
