@@ -1,5 +1,5 @@
 """Computer opponents (issue 7): hearing engines, watching from a vantage point in an
-open arena, and what the agent does after a kill."""
+open arena, what the agent does after a kill, ambushing while it leads, returning fire."""
 
 import math
 import random
@@ -8,7 +8,7 @@ import pytest
 
 from sim_fixtures import ROOT, box_world
 from tanktool.sim.agents import Agent
-from tanktool.sim.agents.agent import STALE, SWEEP, WATCH_COVER, WATCH_STINT
+from tanktool.sim.agents.agent import RETURN_FIRE, STALE, SWEEP, WATCH_COVER, WATCH_STINT
 from tanktool.sim.agents.navigation import vantages_for
 from tanktool.sim.agents.perception import Sighting, can_see
 from tanktool.sim.match import load_match_arena, load_tank_spec
@@ -76,6 +76,19 @@ def bundled(name, n=1):
     return World(arena.walls, [spec] * n, arena.spawns, seed=3, bounds=arena.bounds)
 
 
+def alone(name, seed):
+    """A bundled arena, our agent's tank and an enemy dead for good (until placed)."""
+    w = bundled(name, 2)
+    me, enemy = w.tanks
+    enemy.alive, enemy.respawn_at = False, math.inf
+    return w, me, enemy, Agent(random.Random(seed), "normal")
+
+
+def drive(w, agent, me, seconds):
+    for _ in range(int(seconds / w.dt)):
+        w.step(None, [agent(w, me), IDLE])
+
+
 def set_up(w):
     agent = Agent(random.Random(0), "normal")
     agent._setup(w, w.tanks[0])
@@ -111,10 +124,7 @@ def test_open_arenas_have_a_vantage_and_the_maze_has_none():
 
 
 def test_alone_in_the_box_an_agent_holds_a_vantage_and_sweeps_its_cone():
-    w = bundled("box", 2)
-    me, other = w.tanks
-    other.alive, other.respawn_at = False, math.inf
-    agent = Agent(random.Random(2), "normal")
+    w, me, _, agent = alone("box", 2)
     headings = []
     for k in range(int(20.0 / w.dt)):
         w.step(None, [agent(w, me), IDLE])
@@ -128,12 +138,8 @@ def test_alone_in_the_box_an_agent_holds_a_vantage_and_sweeps_its_cone():
 
 
 def test_an_enemy_coming_into_the_watched_box_is_seen_and_attacked():
-    w = bundled("box", 2)
-    me, enemy = w.tanks
-    enemy.alive, enemy.respawn_at = False, math.inf
-    agent = Agent(random.Random(2), "normal")
-    for k in range(int(15.0 / w.dt)):
-        w.step(None, [agent(w, me), IDLE])
+    w, me, enemy, agent = alone("box", 2)
+    drive(w, agent, me, 15.0)
     assert agent.state == "watch"
     # the enemy appears far off, in the watched way (the cone less the sweep)
     cone = agent.senses.half_angle - 0.35
@@ -178,9 +184,95 @@ def test_after_a_kill_it_forgets_the_dead_enemy_and_does_not_search_for_it():
     agent.next_think = -math.inf
     agent(w, me)
     assert 1 not in agent.senses.last_seen and agent.killed_at == w.t
-    assert agent.state in ("wander", "watch")
+    assert agent.state == "ambush"                 # 1 kill, 0 deaths: it leads
     # a kill it did not see happen (its target seen long ago) changes nothing
     agent.senses.last_seen[1] = Sighting(1, 55.0, 70.0, 0.0, 0.0, w.t - 5.0, 35.0)
     me.kills = 2
     agent._kills(me, w.t)
     assert 1 in agent.senses.last_seen
+
+
+# ------------------------------------------------------------------ ambush while leading
+def test_safety_is_the_share_of_the_blocks_seeing_a_block_that_its_cone_sees():
+    w = bundled("maze")
+    agent = set_up(w)
+    views, v = agent.views, agent.vantages
+    half, rng_ = agent.senses.half_angle, agent.senses.vision_range
+    rng = random.Random(3)
+    for _ in range(15):
+        b = rng.randrange(len(views))
+        bx, bz = views.points[b]
+        watchers = [c for c in range(len(views)) if views.visible[b, c]]
+        best = 0.0
+        for h in v.headings:
+            n = sum(1 for c in watchers
+                    if c == b or abs(math.remainder(math.atan2(views.points[c][1] - bz, views.points[c][0] - bx) - h,
+                                                    2 * math.pi)) <= half - 0.1
+                    and math.hypot(views.points[c][0] - bx, views.points[c][1] - bz) <= rng_)
+            best = max(best, n / len(watchers))
+        assert v.safety[b] == pytest.approx(best)
+    # the maze has dead ends that nothing sees into without being seen; a corridor
+    # crossing is seen from several ways at once
+    assert (v.safety >= 0.95).sum() >= 10
+    assert v.safety[views.cell_at(52.0, 59.0)] < 0.8
+
+
+def test_a_leading_agent_ambushes_from_a_safe_place_even_in_the_maze():
+    w, me, enemy, agent = alone("maze", 4)
+    drive(w, agent, me, 5.0)
+    assert agent.state == "wander"             # no vantage in the maze, and not leading
+    me.kills = 1                               # now it leads (1 kill, 0 deaths)
+    drive(w, agent, me, 25.0)
+    assert agent.state == "ambush" and me.wall_bumps == 0
+    spot = agent.views.cell_at(*agent.spot)
+    assert agent.vantages.safety[spot] >= 0.9
+    assert math.hypot(me.x - agent.spot[0], me.z - agent.spot[1]) < 3.0
+    # an engine heard: it does not go looking, it moves away from the noise and turns
+    # to face the way the noise would come in
+    here = agent.views.cell_at(me.x, me.z)
+    ex, ez = next((float(x), float(z)) for x, z in agent.views.points
+                  if 12.0 < math.hypot(x - me.x, z - me.z) < 20.0
+                  and w.walls.blocked(me.x, me.z, float(x), float(z)))
+    enemy.place(ex, ez, 0.0)
+    enemy.alive, enemy.vx = True, 8.0
+    heard_block = agent.views.cell_at(ex, ez)
+    agent.spot_chosen = -math.inf
+    for k in range(int(1.0 / w.dt)):
+        enemy.vx, enemy.vz = 8.0, 0.0
+        w.step(None, [agent(w, me), IDLE])
+        assert agent.state == "ambush"
+    assert agent.faced is not None
+    far = agent.views.path_distances(heard_block)
+    assert far[agent.views.cell_at(*agent.spot)] >= min(far[here], 80.0)
+
+
+def test_hit_by_a_tank_it_cannot_see_it_turns_to_face_the_shot():
+    # the shooter 30 m behind, in the open: heard, not seen
+    w = box_world([(75.0, 82.0), (45.0, 82.0)], headings=[0.0, 0.0])
+    me, shooter = w.tanks
+    agent = Agent(random.Random(7), "normal", watch=False)
+    agent(w, me)
+    assert 1 not in agent.senses.last_seen
+    w.t += 0.1
+    me.hp -= 25.0
+    shooter.shots += 1
+    agent.next_think = -math.inf
+    agent(w, me)
+    face, until = agent.return_to
+    assert until == pytest.approx(w.t + RETURN_FIRE)
+    assert abs(math.remainder(face - math.pi, 2 * math.pi)) < 0.3
+    states = set()
+    for k in range(int(RETURN_FIRE / w.dt)):
+        w.step(None, [agent(w, me), IDLE])
+        states.add(agent.state)
+    assert "attack" in states and 1 in agent.senses.last_seen
+    # a shot heard from behind a wall is not returned
+    w2 = box_world([(70.0, 35.0), (45.0, 35.0)], headings=[0.0, 0.0])
+    a2 = Agent(random.Random(7), "normal", watch=False)
+    a2(w2, w2.tanks[0])
+    w2.t += 0.1
+    w2.tanks[0].hp -= 25.0
+    w2.tanks[1].shots += 1
+    a2.next_think = -math.inf
+    a2(w2, w2.tanks[0])
+    assert a2.return_to[1] == -math.inf

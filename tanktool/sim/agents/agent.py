@@ -1,7 +1,7 @@
 """The computer opponent: a small state machine over sensors and ``Command`` values.
 
 States (each a method ``_wander``, ``_watch``, ``_search``, ``_attack``, ``_evade``
-that returns the command for this think):
+that returns the command for this think; ``_watch`` plays Watch and Ambush):
 
 * **Wander** (start): explore.  A* to the block that sees the most of what was not
   seen in the last minute per metre of path (``navigation.Coverage.goal``: the sight
@@ -21,6 +21,16 @@ that returns the command for this think):
   and far off.  After ``WATCH_STINT`` s, if part of the arena has gone unseen for a
   minute (more than ``STALE`` of it), Wander until it has been seen again, then back
   to Watch.
+* **Ambush** (instead of Wander, Watch or a search for what it hears, while it leads:
+  its kills, on the HUD, above its deaths): hold the safest place near by (a block
+  that nothing can see without being in its cone: a dead end, a corner facing out;
+  ``Vantages.safest``), facing out and sweeping; a tank heard (engine or shot) moves
+  it to a place farther from the noise, and turns it to face the way the noise would
+  come in.  A
+  lead is kept by not being found, and, when found, by seeing first.
+
+And, in any state but Attack, *return fire*: hit by a tank it cannot see whose shot
+it heard from a place in the open, it turns to face that place (at most ``RETURN_FIRE`` s).
 
 Transitions, checked every think (``think_hz`` times a second; the command is held in
 between, as a person holds a key)::
@@ -32,9 +42,10 @@ between, as a person holds a key)::
     Search   --all quadrants done, or 60 s-->     Wander / Watch
     any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
     Watch    --watched WATCH_STINT s, part unseen-->  Wander --all seen again--> Watch
+    Wander / Watch  --kills above deaths-->       Ambush --not leading any more--> Wander / Watch
 
-Wander, Watch and Search also take a heard engine (a moving tank within the engine-hearing
-radius, through walls) as they take a heard shot.
+Wander, Watch and Search (not Ambush) also take a heard engine (a moving tank within
+the engine-hearing radius, through walls) as they take a heard shot.
 
 Everything the agent knows comes from ``perception.Senses`` (sight, hearing of shots
 and engines, memory, its own hit points), what a player's HUD shows (its own kills)
@@ -71,7 +82,7 @@ if TYPE_CHECKING:  # pragma: no cover
 #: faster than 3 m/s through a bend gentler than a right angle [m/s]
 CORNER_BRAKE = 0.8
 CORNER_FAST = 6.0
-STATES = ("wander", "watch", "search", "attack", "evade")
+STATES = ("wander", "watch", "ambush", "search", "attack", "evade")
 #: a vantage point sees at least this fraction of the arena's blocks in one cone
 WATCH_COVER = 0.4
 #: choosing a vantage: its cover less this much per metre of path to it
@@ -84,6 +95,15 @@ STALE = 0.2
 #: at this rate [rad/s]
 SWEEP = 0.35
 SWEEP_RATE = 0.35
+#: choosing a hiding place to ambush from: its safety less this much per metre of path
+#: to it, plus AMBUSH_AWAY per metre of path (up to AMBUSH_AWAY_CAP) from an engine
+#: heard in the last 2 s
+AMBUSH_PER_M = 0.004
+AMBUSH_AWAY = 0.01
+AMBUSH_AWAY_CAP = 80.0
+#: hit by a tank it cannot see, shot heard in the open: turn to face it, for at most
+#: this long [s] (a half turn takes a light tank about 2.5 s from rest)
+RETURN_FIRE = 3.0
 
 
 @dataclass(frozen=True)
@@ -129,7 +149,8 @@ class Agent:
     half_angle : vision cone half-angle [rad] (60 degrees)
     cell : node spacing of its navigation grid [m]
     margin : grid clearance beyond the vehicle's footprint radius [m]
-    watch : hold vantage points where the arena has them (False: always Wander)
+    watch : hold vantage points where the arena has them, and hiding places while it
+        leads (False: always Wander)
     """
 
     def __init__(self, rng: random.Random, level: str | Difficulty = "normal", *,
@@ -182,7 +203,13 @@ class Agent:
         self.spot_face = 0.0
         self.spot_path: list[tuple[float, float]] = []
         self.spot_replan = -math.inf
+        self.spot_chosen = -math.inf
+        self.spot_ambush = False
         self.exploring = False
+        # ambush: the heard engine it last turned to face, and that way
+        self.faced: tuple[object, float] | None = None
+        # return fire: the way to face, until when
+        self.return_to = (0.0, -math.inf)
         # stuck recovery
         self.progress_at = (0.0, math.nan, math.nan)
         self.reverse_until = -math.inf
@@ -205,6 +232,7 @@ class Agent:
         self.target, self.acquired_at = None, math.inf
         self.hits = []
         self.spot, self.spot_replan, self.spot_path, self.exploring = None, -math.inf, [], False
+        self.return_to = (0.0, -math.inf)
         self.senses.hp = math.inf
         self.reverse_until = -math.inf
         self.next_think = -math.inf
@@ -260,6 +288,10 @@ class Agent:
                 return self._unstick(world, tank, cmd)
             self.evade_cooldown = t + 8.0
             self._start_search(self.threat or (tank.x, tank.z), t)
+        if sight is None and self.state != "attack":
+            cmd = self._return_fire(world, tank)
+            if cmd is not None:
+                return self._unstick(world, tank, cmd)
 
         if sight is not None and t >= self.acquired_at:
             self._enter("attack", t)
@@ -286,12 +318,17 @@ class Agent:
             self._enter("wander", t)
         cmd = self._watch(world, tank)
         if cmd is not None:
-            self._enter("watch", t)
+            self._enter("ambush" if self._leading(tank) else "watch", t)
             return self._unstick(world, tank, cmd)
         self._enter("wander", t)
         return self._unstick(world, tank, self._wander(world, tank))
 
     # ------------------------------------------------------------------ kills
+    @staticmethod
+    def _leading(tank: "Tank") -> bool:
+        """Ahead on the HUD's score: more kills than deaths."""
+        return tank.kills > tank.deaths
+
     def _kills(self, tank: "Tank", t: float) -> None:
         """Its kills (the HUD) went up while it was shooting at a target seen in the
         last second: that target is dead, so forget where it was seen."""
@@ -439,23 +476,39 @@ class Agent:
         the arena, chosen again every 5 s; there, face its best way and sweep the cone
         ``SWEEP`` either side.  None: no vantage in this arena, or exploring (after
         ``WATCH_STINT`` s of watching, while more than ``STALE`` of the blocks are stale:
-        not seen for a minute)."""
+        not seen for a minute).
+
+        Leading, in any arena and without exploring: the same at the safest place near
+        by, chosen again (away from the noise) at most every 2 s while a tank is heard;
+        facing the way the heard tank would come in (the first leg of the path towards
+        it)."""
         v = self.vantages
-        if not self.watches or v is None or v.top < WATCH_COVER:
+        lead = self._leading(tank)
+        if not self.watches or v is None or (v.top < WATCH_COVER and not lead):
             return None
         t = world.t
-        stale = self.coverage.stale_fraction(t) > STALE  # type: ignore[union-attr]
-        if self.exploring:
-            if stale:
+        if not lead:
+            stale = self.coverage.stale_fraction(t) > STALE  # type: ignore[union-attr]
+            if self.exploring:
+                if stale:
+                    return None
+                self.exploring = False
+            if self.state == "watch" and t - self.state_since > WATCH_STINT and stale:
+                self.exploring = True
                 return None
-            self.exploring = False
-        if self.state == "watch" and t - self.state_since > WATCH_STINT and stale:
-            self.exploring = True
-            return None
         x, z = tank.x, tank.z
-        if self.spot is None or t >= self.spot_replan:
-            self.spot_replan = t + 5.0
-            cell, face = v.best(self.views.cell_at(x, z), WATCH_PER_M)  # type: ignore[union-attr]
+        h = self.senses.heard
+        noise = h if (lead and h is not None and t - h.t < 2.0) else None
+        if noise is not None and noise.t == t:
+            self.spot_replan = min(self.spot_replan, self.spot_chosen + 2.0)
+        if self.spot is None or t >= self.spot_replan or lead != self.spot_ambush:
+            self.spot_replan, self.spot_chosen, self.spot_ambush = t + 5.0, t, lead
+            here = self.views.cell_at(x, z)  # type: ignore[union-attr]
+            if lead:
+                away = self.views.cell_at(noise.x, noise.z) if noise is not None else -1  # type: ignore[union-attr]
+                cell, face = v.safest(here, AMBUSH_PER_M, away, AMBUSH_AWAY, AMBUSH_AWAY_CAP)
+            else:
+                cell, face = v.best(here, WATCH_PER_M)
             spot = tuple(float(c) for c in self.views.points[cell])  # type: ignore[union-attr]
             self.spot_face = face
             if spot != self.spot or not self.spot_path:
@@ -470,7 +523,31 @@ class Agent:
         # a triangle wave: the cone sweeps at a steady SWEEP_RATE, to and fro
         phase = (t * SWEEP_RATE / (2.0 * SWEEP)) % 2.0
         look = self.spot_face + SWEEP * (2.0 * abs(phase - 1.0) - 1.0)
+        if lead and h is not None and t - h.t < 3.0:
+            if self.faced is None or self.faced[0] is not h:
+                path = plan_path(self.grid, (x, z), (h.x, h.z))  # type: ignore[arg-type]
+                q = next((q for q in path if math.hypot(q[0] - x, q[1] - z) >= 6.0), path[-1] if path else (h.x, h.z))
+                self.faced = (h, math.atan2(q[1] - z, q[0] - x))
+            look = self.faced[1]
         err = wrap(look - tank.heading)
+        return self._drive(world, tank, 0.0, 0.0, self.controller.turn(err - PREDICT * tank.omega))  # type: ignore[union-attr]
+
+    # ------------------------------------------------------------------ return fire
+    def _return_fire(self, world: "World", tank: "Tank") -> Command | None:
+        """Hit just now by a tank it cannot see, whose shot it heard from a place in its
+        line of sight: turn on the spot to face there, until facing it (then it is seen
+        and attacked, or was not there), for at most ``RETURN_FIRE`` s.  None: nothing
+        to return."""
+        t = world.t
+        h = self.senses.heard            # the shot: fired up to half a second before the hit
+        if self.hits and self.hits[-1] == t and h is not None and not h.engine and t - h.t < 0.5 \
+                and not world.walls.blocked(tank.x, tank.z, h.x, h.z):
+            self.return_to = (math.atan2(h.z - tank.z, h.x - tank.x), t + RETURN_FIRE)
+        face, until = self.return_to
+        err = wrap(face - tank.heading)
+        if t >= until or abs(err) < 0.15:
+            self.return_to = (face, -math.inf)
+            return None
         return self._drive(world, tank, 0.0, 0.0, self.controller.turn(err - PREDICT * tank.omega))  # type: ignore[union-attr]
 
     # ------------------------------------------------------------------ evade

@@ -470,7 +470,12 @@ class Vantages:
     fraction of the arena's blocks in the vision cone from there (within the vision
     range, in line of sight: ``Views.visible``; its own block counts).  The cone is
     taken ``margin`` narrower than the agent's, so a block on its edge is still seen
-    while it sweeps.  Static: the map, built once per (views, cone) and cached.
+    while it sweeps.
+
+    Also each block's *safety*: of the blocks that can see it (line of sight, any
+    range), the fraction inside its cone facing its safest way, within the vision
+    range.  1 at a dead end or a corner facing out: nobody can look at a tank there
+    without it looking back.  Static: the map, built once per (views, cone) and cached.
     """
 
     def __init__(self, views: Views, half_angle: float, vision_range: float, headings: int = 24,
@@ -479,12 +484,18 @@ class Vantages:
         p = views.points
         bearing = np.arctan2(p[None, :, 1] - p[:, None, 1], p[None, :, 0] - p[:, None, 0])
         sees = views.visible & (views.distance <= vision_range)
+        seen_by = np.maximum(views.visible.sum(axis=1), 1)
         self.headings = np.arange(headings) * (2.0 * math.pi / headings)
         self.cover = np.empty((len(p), headings))
+        safety = np.empty((len(p), headings))
         for k, h in enumerate(self.headings):
             inside = np.abs(np.remainder(bearing - h + math.pi, 2.0 * math.pi) - math.pi) <= half_angle - margin
             np.fill_diagonal(inside, True)         # the block it stands in
-            self.cover[:, k] = (sees & inside).sum(axis=1) / max(len(p), 1)
+            in_cone = (sees & inside).sum(axis=1)
+            self.cover[:, k] = in_cone / max(len(p), 1)
+            safety[:, k] = in_cone / seen_by
+        self.safety = safety.max(axis=1) if safety.size else np.zeros(len(p))
+        self.safe_face = self.headings[safety.argmax(axis=1)] if safety.size else np.zeros(len(p))
         # each block's cover facing its best way, and that way
         self.block_cover = self.cover.max(axis=1) if self.cover.size else np.zeros(len(p))
         self.block_face = self.headings[self.cover.argmax(axis=1)] if self.cover.size else np.zeros(len(p))
@@ -496,6 +507,18 @@ class Vantages:
         score = self.block_cover - per_m * self.views.path_distances(here)    # unreachable: -inf
         b = int(np.argmax(score))
         return b, float(self.block_face[b])
+
+    def safest(self, here: int, per_m: float, away: int = -1, per_m_away: float = 0.0,
+               cap: float = 80.0) -> tuple[int, float]:
+        """(block, heading) of the best hiding place from block ``here``: the most safety
+        less ``per_m`` per metre of path to it, plus ``per_m_away`` per metre of path
+        (up to ``cap``) from block ``away`` (where an enemy was heard; -1: none)."""
+        score = self.safety - per_m * self.views.path_distances(here)
+        if away >= 0:
+            d = self.views.path_distances(away)
+            score = score + per_m_away * np.minimum(d, cap)        # unreachable from there: cap
+        b = int(np.argmax(score))
+        return b, float(self.safe_face[b])
 
 
 _VANTAGES: dict[tuple, Vantages] = {}
