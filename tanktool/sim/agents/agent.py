@@ -522,13 +522,14 @@ class Agent:
             return self._follow(world, tank, path, speed=1.0, lookahead=4.0, corner=path[0], stop=True)
         # a triangle wave: the cone sweeps at a steady SWEEP_RATE, to and fro
         phase = (t * SWEEP_RATE / (2.0 * SWEEP)) % 2.0
-        look = self.spot_face + SWEEP * (2.0 * abs(phase - 1.0) - 1.0)
+        face = self.spot_face
         if lead and h is not None and t - h.t < 3.0:
             if self.faced is None or self.faced[0] is not h:
                 path = plan_path(self.grid, (x, z), (h.x, h.z))  # type: ignore[arg-type]
                 q = next((q for q in path if math.hypot(q[0] - x, q[1] - z) >= 6.0), path[-1] if path else (h.x, h.z))
                 self.faced = (h, math.atan2(q[1] - z, q[0] - x))
-            look = self.faced[1]
+            face = self.faced[1]
+        look = face + SWEEP * (2.0 * abs(phase - 1.0) - 1.0)
         err = wrap(look - tank.heading)
         return self._drive(world, tank, 0.0, 0.0, self.controller.turn(err - PREDICT * tank.omega))  # type: ignore[union-attr]
 
