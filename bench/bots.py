@@ -45,6 +45,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tanktool.sim.agents import DIFFICULTIES, Agent  # noqa: E402
+from tanktool.sim.agents.agent import trim  # noqa: E402
 from tanktool.sim.agents.navigation import plan_path  # noqa: E402
 from tanktool.sim.commands import IDLE  # noqa: E402
 from tanktool.sim.driver import ScriptedDriver  # noqa: E402
@@ -75,8 +76,7 @@ class Omniscient(Agent):
         if world.t >= self.hunt_at + 1.0:
             self.hunt_at = world.t
             self.hunt = plan_path(self.grid, (tank.x, tank.z), (enemy.x, enemy.z))
-        while len(self.hunt) > 1 and math.hypot(self.hunt[0][0] - tank.x, self.hunt[0][1] - tank.z) < 3.0:
-            self.hunt.pop(0)
+        trim(self.hunt, tank.x, tank.z)
         if not self.hunt:
             return cmd
         return self._unstick(world, tank, self._follow(world, tank, self.hunt, speed=1.0, lookahead=4.0,

@@ -26,8 +26,7 @@ that returns the command for this think; ``_watch`` plays Watch and Ambush):
   that nothing can see without being in its cone: a dead end, a corner facing out;
   ``Vantages.safest``), facing out and sweeping; a tank heard (engine or shot) moves
   it to a place farther from the noise, and turns it to face the way the noise would
-  come in.  A
-  lead is kept by not being found, and, when found, by seeing first.
+  come in.  A lead is kept by not being found, and, when found, by seeing first.
 
 And, in any state but Attack, *return fire*: hit by a tank it cannot see whose shot
 it heard from a place in the open, it turns to face that place (at most ``RETURN_FIRE`` s).
@@ -366,8 +365,7 @@ class Agent:
         t, x, z = world.t, tank.x, tank.z
         cov = self.coverage
         if self.path:
-            while len(self.path) > 1 and math.hypot(self.path[0][0] - x, self.path[0][1] - z) < 3.0:
-                self.path.pop(0)
+            trim(self.path, x, z)
             arrived = math.hypot(self.path[-1][0] - x, self.path[-1][1] - z) < 4.0
             if not arrived and t >= self.recheck:
                 self.recheck = t + 1.0
@@ -437,8 +435,7 @@ class Agent:
             if self.goal is None:
                 return None
             self.path = plan_path(self.grid, (x, z), self.goal)  # type: ignore[arg-type]
-        while len(self.path) > 1 and math.hypot(self.path[0][0] - x, self.path[0][1] - z) < 3.0:
-            self.path.pop(0)
+        trim(self.path, x, z)
         return self._follow(world, tank, self.path, speed=0.9, lookahead=4.0, corner=self._corner(tank))
 
     # ------------------------------------------------------------------ attack
@@ -517,8 +514,7 @@ class Agent:
         gx, gz = self.spot  # type: ignore[misc]
         path = self.spot_path
         if math.hypot(gx - x, gz - z) > 2.5 and path:
-            while len(path) > 1 and math.hypot(path[0][0] - x, path[0][1] - z) < 3.0:
-                path.pop(0)
+            trim(path, x, z)
             return self._follow(world, tank, path, speed=1.0, lookahead=4.0, corner=path[0], stop=True)
         # a triangle wave: the cone sweeps at a steady SWEEP_RATE, to and fro
         phase = (t * SWEEP_RATE / (2.0 * SWEEP)) % 2.0
@@ -531,7 +527,7 @@ class Agent:
             face = self.faced[1]
         look = face + SWEEP * (2.0 * abs(phase - 1.0) - 1.0)
         err = wrap(look - tank.heading)
-        return self._drive(world, tank, 0.0, 0.0, self.controller.turn(err - PREDICT * tank.omega))  # type: ignore[union-attr]
+        return self._drive(world, tank, 0.0, 0.0, self._turn(tank, err))
 
     # ------------------------------------------------------------------ return fire
     def _return_fire(self, world: "World", tank: "Tank") -> Command | None:
@@ -549,7 +545,7 @@ class Agent:
         if t >= until or abs(err) < 0.15:
             self.return_to = (face, -math.inf)
             return None
-        return self._drive(world, tank, 0.0, 0.0, self.controller.turn(err - PREDICT * tank.omega))  # type: ignore[union-attr]
+        return self._drive(world, tank, 0.0, 0.0, self._turn(tank, err))
 
     # ------------------------------------------------------------------ evade
     def _start_evade(self, world: "World", tank: "Tank", threat: tuple[float, float], t: float) -> None:
@@ -586,8 +582,7 @@ class Agent:
         if t >= self.evade_until:
             return None
         x, z = tank.x, tank.z
-        while len(self.path) > 1 and math.hypot(self.path[0][0] - x, self.path[0][1] - z) < 3.0:
-            self.path.pop(0)
+        trim(self.path, x, z)
         if self.path:
             if math.hypot(self.path[-1][0] - x, self.path[-1][1] - z) < 3.0:
                 return None
@@ -613,7 +608,7 @@ class Agent:
                 tx, tz = p
                 break
         err = wrap(math.atan2(tz - z, tx - x) - tank.heading)
-        rotate = self.controller.turn(err - PREDICT * tank.omega)  # type: ignore[union-attr]
+        rotate = self._turn(tank, err)
         top = tank.spec.top_speed
         # turn first, then drive: full speed only when pointing the right way
         v = speed * top * max(0.0, 1.0 - abs(err) / 1.2)
@@ -633,6 +628,11 @@ class Agent:
             brake = 0.5 * CORNER_BRAKE * tank.spec.engine_force / tank.spec.mass
             v = min(v, math.sqrt(2.0 * brake * math.hypot(points[-1][0] - x, points[-1][1] - z)))
         return self._drive(world, tank, v, 0.0, rotate)
+
+    def _turn(self, tank: "Tank", err: float) -> float:
+        """The turn command for a heading error, read where the gun will point
+        ``PREDICT`` s from now (the fuzzy turn rules)."""
+        return self.controller.turn(err - PREDICT * tank.omega)  # type: ignore[union-attr]
 
     def _free(self, world: "World", tank: "Tank", angle: float, length: float, offsets: tuple[float, ...]) -> float:
         """Free distance along ``angle`` from points beside the centre, up to ``length``."""
@@ -727,6 +727,12 @@ class Agent:
             self.route, self.walker, self.path, self.spot_path = [], None, [], []
             return self._drive(world, tank, -4.0, 0.0, self.reverse_turn)
         return cmd
+
+
+def trim(path: list[tuple[float, float]], x: float, z: float, reach: float = 3.0) -> None:
+    """Drop the waypoints of ``path`` already within ``reach`` m of (x, z), keeping the last."""
+    while len(path) > 1 and math.hypot(path[0][0] - x, path[0][1] - z) < reach:
+        path.pop(0)
 
 
 def make_agents(world: "World", level: str | Difficulty = "normal",
