@@ -35,7 +35,8 @@ class ArenaBundle:
 
     walls : the wall list (auxiliary rectangle in ``walls.aux``)
     bounds : (2, 2) ``[[xmin, zmin], [xmax, zmax]]``
-    spawns : (k, 3) ``[x, z, heading_rad]``
+    spawns : (k, 3) ``[x, z, heading_rad]``, or (k, 4) with the height y of the
+             surface under each (arenas of several levels or with relief)
     toml : the whole manifest
     """
 
@@ -74,9 +75,14 @@ def load_arena(path: str | os.PathLike) -> ArenaBundle:
         raise ArenaError(f"{manifest}: [walls] file must be a file name in the bundle, got {walls_name!r}")
     walls = read_walls(path / walls_name)
     try:
-        spawns = np.asarray(doc.get("spawns", []), dtype=np.float64).reshape(-1, 3)
+        raw = doc.get("spawns", [])
+        width = len(raw[0]) if isinstance(raw, list) and raw and isinstance(raw[0], list) else 3
+        if width not in (3, 4) or any(not isinstance(r, list) or len(r) != width for r in raw):
+            raise ValueError
+        spawns = np.asarray(raw, dtype=np.float64).reshape(-1, width)
     except (TypeError, ValueError):
-        raise ArenaError(f"{manifest}: 'spawns' must be a list of [x, z, heading] triples") from None
+        raise ArenaError(f"{manifest}: 'spawns' must be a list of [x, z, heading] or [x, z, heading, y] "
+                         "lists, all of one length") from None
     if not np.isfinite(spawns).all():
         raise ArenaError(f"{manifest}: 'spawns' must be finite numbers")
     raw_bounds = doc.get("bounds")
@@ -113,6 +119,9 @@ class ImportResult:
     thin_walls: int
     seconds: float
     warnings: list[str] = field(default_factory=list)   # non-fatal remarks (a .bzw's unknown objects)
+    levels: Any = None  # nav.arena_levels.ArenaLevels: levels, what was left out, the tank grid
+    params: Any = None  # the WalkableParams used
+    defaults: dict[str, str] = field(default_factory=dict)  # where each default came from
 
 
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
@@ -136,6 +145,40 @@ def _companion_files(model: Path) -> list[Path]:
     return out
 
 
+def walkable_params(cell: float | None = None, max_slope: float | None = None, climb: float | None = None,
+                    headroom: float | None = None, fleet: Any = None,
+                    recorded: dict[str, Any] | None = None) -> tuple[Any, dict[str, str]]:
+    """The walkable-surface parameters: each given value, else the one ``recorded`` in
+    an arena.toml, else the default (headroom: the tallest bundled vehicle).  Returns
+    (params, where each value came from)."""
+    from .nav.walkable import CELL_HEIGHT, CLIMB, MAX_SLOPE, WalkableParams
+
+    rec = recorded or {}
+    where: dict[str, str] = {}
+
+    def pick(name: str, given: float | None, default: float, default_src: str) -> float:
+        if given is not None:
+            where[name] = "option"
+            return float(given)
+        v = rec.get(name)
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v):
+            where[name] = "arena.toml"
+            return float(v)
+        where[name] = default_src
+        return float(default)
+
+    height_default = fleet.height if fleet is not None else 2.0
+    height_src = f"height of vehicle '{fleet.height_of}'" if fleet is not None else "built-in default"
+    params = WalkableParams(
+        cell=pick("cell", cell, NAVGRID_DEFAULTS["cell"], "default"),
+        cell_height=pick("cell_height", None, CELL_HEIGHT, "default"),
+        max_slope=pick("max_slope", max_slope, MAX_SLOPE, "default"),
+        climb=pick("climb", climb, CLIMB, "default"),
+        headroom=pick("headroom", headroom, height_default, height_src),
+    )
+    return params.check(), where
+
+
 def import_arena(
     model: str | os.PathLike,
     out: str | os.PathLike | None = None,
@@ -150,23 +193,30 @@ def import_arena(
     warn: Callable[[str], None] | None = None,
     wall_height: float | None = None,
     wall_thickness: float | None = None,
+    max_slope: float | None = None,
+    climb: float | None = None,
+    headroom: float | None = None,
+    cell: float | None = None,
+    walkable: dict[str, Any] | None = None,
 ) -> ImportResult:
-    """Read ``model``, extract walls and spawns and write the arena bundle ``out``.
+    """Read ``model``, find its walkable levels, walls and spawns and write the arena
+    bundle ``out``.
 
     ``out`` defaults to ``./<name>``; ``name`` to the model's file stem.  ``navgrid``
-    overrides the [navgrid] defaults (used when rebuilding a bundled arena).
-    ``warn`` also receives the non-fatal remarks collected in ``ImportResult.warnings``.
-    ``wall_height`` / ``wall_thickness`` shape a .dxf/.svg floor plan's walls.
-    Everything is written into a temporary folder renamed into place at the end,
-    so a failure leaves nothing behind.
+    overrides the [navgrid] defaults and ``walkable`` the [walkable] ones (used when
+    rebuilding a bundled arena); ``max_slope``, ``climb``, ``headroom`` and ``cell``
+    are the command's options.  ``warn`` also receives the non-fatal remarks collected
+    in ``ImportResult.warnings``.  ``wall_height`` / ``wall_thickness`` shape a .dxf/.svg
+    floor plan's walls.  Everything is written into a temporary folder renamed into
+    place at the end, so a failure leaves nothing behind.
     """
     import trimesh
 
+    from .fleet import bundled_fleet
     from .formats.bundle import sha256_file, staged_dir, write_toml
     from .formats.models import default_up, detect_format, load_scene
     from .formats.walls_txt import write_walls
-    from .geometry.spawns import place_spawns
-    from .geometry.walls import extract_walls
+    from .nav.arena_levels import analyse_arena, spawn_y_needed
     from .plots.arena import save_preview
 
     t0 = time.perf_counter()
@@ -193,59 +243,75 @@ def import_arena(
         if warn is not None:
             warn(message)
 
+    fleet = bundled_fleet(warn=remark)
+    nav = dict(NAVGRID_DEFAULTS)
+    nav.update(navgrid or {})
+    params, where = walkable_params(cell if cell is not None else nav.get("cell"), max_slope, climb, headroom,
+                                    fleet, walkable)
+    if params.climb >= height:
+        raise ArenaError(f"--climb ({params.climb:g} m) must be below the cut --height ({height:g} m): "
+                         "what a tank climbs cannot also be a wall")
     if wall_height is not None and not wall_height > height:
         raise ArenaError(f"--wall-height ({wall_height:g}) must be above the cut --height ({height:g}), "
                          f"or the walls would not be cut")
     scene = load_scene(model, up=up, scale=scale, warn=remark, wall_height=wall_height,
                        wall_thickness=wall_thickness)
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    if not meshes:
+        raise ArenaError(f"{model}: the model has no triangles")
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
     try:
-        ex = extract_walls(mesh.vertices, mesh.faces, height=height, tolerance=tolerance, progress=progress)
+        result = analyse_arena(mesh.vertices, mesh.faces, params, fleet, cut_height=height, tolerance=tolerance,
+                               progress=progress)
     except ArenaError as e:
         raise ArenaError(f"{model}: {e}") from None
-    try:
-        spawns = place_spawns(ex.free, ex.walls.bounds)
-    except ArenaError as e:
-        raise ArenaError(f"{model}: {e}") from None
-    if progress:
-        progress("spawns")
+    walls = result.walls.walls
+    spawns = result.spawns
+    if len(spawns) < MIN_SPAWNS:
+        remark(f"{model}: room for only {len(spawns)} spawn point(s) where the largest bundled tank "
+               f"({fleet.radius_of}) fits, at least {fleet.length:.1f} m apart")
 
     src_up = up or default_up(fmt)
-    nav = dict(NAVGRID_DEFAULTS)
-    nav.update(navgrid or {})
-    bounds = ex.walls.bounds
+    nav["cell"] = float(params.cell)
+    bounds = walls.bounds
+    with_y = spawn_y_needed(result)
     with staged_dir(target, force=force) as tmp:
         copied = [model, *_companion_files(model)]
         for f in copied:
             shutil.copyfile(f, tmp / f.name)
         glb = scene.export(file_type="glb")
         (tmp / "model.glb").write_bytes(glb)
-        header = (f"arena {name}: walls of {model.name} cut {height:g} m above the floor (y={ex.floor_y:.4g})\n"
+        header = (f"arena {name}: walls of {model.name}, the boundaries of its walkable surface "
+                  f"(flat floors: cut {height:g} m above them)\n"
                   f"made by tanktool {__version__} import-arena; normals point into free space")
-        write_walls(tmp / "walls.txt", ex.walls, header=header)
-        title = (f"{name}: {len(ex.walls)} walls + 4 auxiliary, {len(spawns)} spawns, "
-                 f"{bounds[1, 0] - bounds[0, 0]:.0f} x {bounds[1, 1] - bounds[0, 1]:.0f} m")
-        save_preview(tmp / "preview.png", ex.walls, spawns, title, ex.free)
+        write_walls(tmp / "walls.txt", walls, header=header)
+        lv = result.levels
+        title = (f"{name}: {len(lv)} level{'s' if len(lv) != 1 else ''}, {len(walls)} walls + 4 auxiliary, "
+                 f"{len(spawns)} spawns, {bounds[1, 0] - bounds[0, 0]:.0f} x {bounds[1, 1] - bounds[0, 1]:.0f} m")
+        save_preview(tmp / "preview.png", walls, spawns, title, result.free, levels=result)
         if progress:
             progress("files")
         doc = {
             "name": name,
             "tool_version": __version__,
             "bounds": [[_r(bounds[0, 0]), _r(bounds[0, 1])], [_r(bounds[1, 0]), _r(bounds[1, 1])]],
-            "floor_y": _r(ex.floor_y),
-            "spawns": [[_r(x), _r(z), _r(h, 6)] for x, z, h in spawns],
+            "floor_y": _r(result.floor_y),
+            "spawns": [[_r(x), _r(z), _r(h, 6), _r(y)] if with_y else [_r(x), _r(z), _r(h, 6)]
+                       for x, z, h, y in spawns],
             "source": {"file": model.name, "sha256": sha256_file(model), "up": src_up, "scale": float(scale),
                        **_plan_source(fmt, wall_height, wall_thickness)},
             "model": {"file": "model.glb"},
             "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
-                      "count": len(ex.walls)},
+                      "count": len(walls)},
+            "walkable": params.as_toml(),
+            "levels": [{"level": x.level, "area": _r(x.area, 1), "y": [_r(x.y_lo, 3), _r(x.y_hi, 3)],
+                        "regions": x.regions} for x in lv],
             "navgrid": nav,
             "derived": {f: sha256_file(tmp / f) for f in ("walls.txt", "model.glb", "preview.png")},
         }
         write_toml(tmp / MANIFEST, doc)
-    return ImportResult(target, name, ex.walls, spawns, ex.floor_y, len(mesh.faces), ex.thin_walls,
-                        time.perf_counter() - t0, warnings)
+    return ImportResult(target, name, walls, spawns, result.floor_y, len(mesh.faces), result.walls.thin_walls,
+                        time.perf_counter() - t0, warnings, result, params, where)
 
 
 def _plan_source(fmt: str, wall_height: float | None, wall_thickness: float | None) -> dict[str, float]:

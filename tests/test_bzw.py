@@ -199,7 +199,7 @@ def test_cli_imports_a_world_and_prints_warnings(tmp_path):
     out = tmp_path / "u"
     res = CliRunner().invoke(cli, ["import-arena", str(BZW / "unknown.bzw"), "-o", str(out)])
     assert res.exit_code == 0, res.output
-    assert "arena 'unknown': 18 walls (2 from thin walls) + 4 auxiliary" in res.output
+    assert "arena 'unknown': 1 level, 18 walls (2 from thin walls) + 4 auxiliary" in res.output
     assert f"warning: {BZW / 'unknown.bzw'}:23: unknown or unsupported object 'mesh' skipped" in res.output
     assert res.output.count("warning:") == 6
     assert load_arena(out).toml["walls"]["count"] == 18

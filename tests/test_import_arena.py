@@ -40,7 +40,7 @@ def test_import_writes_a_complete_bundle(tmp_path):
     out = tmp_path / "arenas" / "room"
     r = run("import-arena", str(model), "-o", str(out))
     assert r.exit_code == 0, r.output
-    assert "8 walls" in r.output and "8 spawns" in r.output
+    assert "1 level, 8 walls" in r.output and "level 0: " in r.output and "left out:" in r.output
     for f in ("arena.toml", "room.obj", "model.glb", "walls.txt", "preview.png"):
         assert (out / f).is_file(), f
     doc = read_toml(out / "arena.toml")
@@ -50,8 +50,19 @@ def test_import_writes_a_complete_bundle(tmp_path):
     assert doc["navgrid"] == {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
     for f, digest in doc["derived"].items():
         assert sha256_file(out / f) == digest
-    assert len(doc["spawns"]) >= 8
+    assert doc["walkable"]["headroom"] > 0 and doc["levels"][0]["level"] == 0
+    # spawns only where the largest bundled tank fits, a tank's length apart
+    from tanktool.fleet import bundled_fleet
+    from tanktool.geometry.segments import point_segment_distance
+
+    fleet = bundled_fleet()
+    sp = np.asarray(doc["spawns"])[:, :2]
+    assert 2 <= len(sp) <= 8
     walls = read_walls(out / "walls.txt")
+    d = point_segment_distance(sp[:, None], walls.segments[None, :, 0], walls.segments[None, :, 1]).min(axis=1)
+    assert (d >= fleet.radius).all()
+    gaps = np.hypot(*(sp[:, None] - sp[None]).transpose(2, 0, 1))[np.triu_indices(len(sp), 1)]
+    assert (gaps >= fleet.length).all()
     assert walls.aux is not None and len(walls) == 8
     assert np.allclose(doc["bounds"], walls.bounds)
     # the glb is in the world frame: its floor top is at y = 0
@@ -115,8 +126,8 @@ def _bad_inputs(tmp_path: Path) -> dict[str, tuple[Path, str]]:
         "not a model": (text, "no triangles"),
         "nan": (nan, "not finite"),
         "empty 3ds": (empty3ds, "empty"),
-        "no free space": (block, "no free space"),
-        "no floor": (wall, "horizontal surface"),
+        "no free space": (block, "no place where the largest bundled tank fits"),
+        "no floor": (wall, "no surface a tank can stand on"),
         "unknown kind": (tmp_path / "notes.txt", "no such file"),
     }
 
@@ -163,7 +174,12 @@ def test_dungeon_imports(tmp_path):
     assert r.exit_code == 0, r.output
     a = load_arena(out)
     assert a.floor_y == pytest.approx(10.0, abs=0.05)
-    assert len(a.walls) > 100 and len(a.spawns) == 8
+    # its floors joined by ramps are all in (about 1,700 m^2 at tank headroom), and it
+    # is built for people: the heavy tank fits in few places, which import-arena says
+    assert a.toml["levels"][0]["area"] > 1500
+    assert a.toml["levels"][0]["y"][1] - a.toml["levels"][0]["y"][0] > 15
+    assert len(a.walls) > 100 and 1 <= len(a.spawns) < 8
+    assert "room for only" in r.output
 
 
 def test_load_arena_rejects_broken_manifests(tmp_path):

@@ -4,7 +4,7 @@
 
 For each ``arenas/<name>/arena.toml`` the source model named in its ``[source]``
 table is run through import-arena again with the parameters the manifest records
-(up axis, scale, wall height, tolerance, the [navgrid] table), replacing the bundle
+(up axis, scale, wall height, tolerance, the [walkable] and [navgrid] tables), replacing the bundle
 atomically; then, when the ``build-navgrid`` command exists, it is run on the
 bundle so that ``navgrid.npz`` and ``quadtree.npz`` follow the new walls.
 tools/make_arena_models.py authors the source models themselves.
@@ -33,7 +33,8 @@ def rebuild(folder: Path, out: Path | None = None, navgrid: bool = True) -> None
     r = import_arena(folder / src["file"], target, name=doc.get("name", folder.name), up=src.get("up"),
                      scale=float(src.get("scale", 1.0)), height=float(walls.get("height", 1.0)),
                      tolerance=float(walls.get("tolerance", 0.01)), force=True, navgrid=doc.get("navgrid"),
-                     wall_height=src.get("wall_height"), wall_thickness=src.get("wall_thickness"))
+                     wall_height=src.get("wall_height"), wall_thickness=src.get("wall_thickness"),
+                     walkable=doc.get("walkable"))
     print(f"{folder.name}: {len(r.walls)} walls, {len(r.spawns)} spawns ({r.seconds:.2f} s)")
     if navgrid and importlib.util.find_spec("tanktool.cli.build_navgrid") is not None:
         subprocess.run([sys.executable, "-m", "tanktool", "build-navgrid", str(target)], check=True)

@@ -38,6 +38,7 @@ class Target:
     manifest: Path | None = None
     toml: dict[str, Any] = field(default_factory=dict)
     prefix: str = ""  # output names are prefix + navgrid.npz, ...
+    model: Path | None = None  # the bundle's model.glb: its walkable surface decides the levels
 
     def output(self, name: str) -> Path:
         return self.out_dir / f"{self.prefix}{name}"
@@ -53,6 +54,9 @@ def open_target(path: Path) -> Target:
     if not path.exists():
         raise ArenaError(f"{path}: no such arena folder or walls file")
     if path.is_file():
+        if (path.parent / "arena.toml").is_file():
+            raise ArenaError(f"{path} belongs to the arena bundle {path.parent}: run build-navgrid on the bundle "
+                             f"folder (its grid then follows the model and arena.toml stays current)")
         walls = read_walls(path)
         if len(walls) == 0:
             raise ArenaError(f"{path}: no walls")
@@ -63,7 +67,36 @@ def open_target(path: Path) -> Target:
     if len(arena.walls) == 0:
         raise ArenaError(f"{arena.file('walls')}: no walls")
     spawns = arena.spawns if len(arena.spawns) else None
-    return Target(arena.walls, arena.path, arena.name, arena.bounds, spawns, arena.path / "arena.toml", arena.toml)
+    model = arena.file("model")
+    return Target(arena.walls, arena.path, arena.name, arena.bounds, spawns, arena.path / "arena.toml", arena.toml,
+                  model=model if model.is_file() and model.suffix.lower() == ".glb" else None)
+
+
+def _layered(target: Target, params, clearance: float, bounds, shape):
+    """The layered grid of a bundle: its model's walkable surface on the grid over the
+    bounds, valid where a node keeps ``clearance`` from the walls of its level.
+    Returns (grid, mask of nodes that exist, for the picture)."""
+    import numpy as np
+
+    from ..formats.models import load_model
+    from ..nav.arena_levels import walls_too_close
+    from ..nav.walkable import grid_from_surface, walkable_surface
+
+    mesh = load_model(target.model, up="y")
+    origin = np.asarray(bounds, dtype=np.float64)[0]
+    seeds = None if target.spawns is None else np.asarray(target.spawns)[:, :2]
+    surface = walkable_surface(mesh.vertices, mesh.faces, params, clearance, origin_xz=origin, shape=shape,
+                               seeds=seeds)
+    if not surface.main.any():
+        raise ArenaError(f"{target.model}: no walkable surface (max slope {params.max_slope:g} deg, "
+                         f"headroom {params.headroom:g} m)")
+    levels = max(surface.levels, 1)
+    tc = walls_too_close(target.walls, origin, params.cell, shape, levels, clearance)
+    grid = grid_from_surface(surface, clearance, origin, seeds=target.spawns, too_close=tc)
+    from ..nav.walkable import surface_layers
+
+    exists = surface_layers(surface)[0]
+    return grid, (exists[0] if grid.levels == 1 else None)
 
 
 def default_clearance(target: Target) -> tuple[float, str]:
@@ -125,6 +158,12 @@ def _number_option(name: str, value: float | None, lo: float, lo_open: bool) -> 
 @click.option("--cell", type=float, default=None, help="Node spacing in metres (default: arena.toml [navgrid] cell, else 0.5).")
 @click.option("--clearance", type=float, default=None,
               help="Minimum distance from a valid node to every wall, metres (default: the largest bundled vehicle's footprint radius).")
+@click.option("--max-slope", type=float, default=None, metavar="DEG",
+              help="Steepest walkable slope in degrees (default: arena.toml [walkable], else 35).")
+@click.option("--climb", type=float, default=None, metavar="M",
+              help="Highest step between neighbouring nodes, metres (default: arena.toml [walkable], else 0.9).")
+@click.option("--headroom", type=float, default=None, metavar="M",
+              help="Free height a node needs, metres (default: arena.toml [walkable], else the tallest bundled vehicle).")
 @click.option("--quadtree-depth", type=int, default=None, help="Levels below the root (default 3: 64 leaves).")
 @click.option("--plot", "plot_path", type=click.Path(path_type=Path), default=None,
               help="Picture to write, .png or .svg (default: navgrid.png in the bundle, or NAME.navgrid.png beside a walls file).")
@@ -133,11 +172,16 @@ def _number_option(name: str, value: float | None, lo: float, lo_open: bool) -> 
 @click.option("--region", default=None, metavar="X0,Z0,X1,Z1", help="Zoom the picture (and --table) to this rectangle.")
 @click.option("--table", "table_path", type=click.Path(path_type=Path), default=None,
               help="Also write the 2002-style text table, one node a line.")
-def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quadtree_depth: int | None,
+def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_slope: float | None,
+                  climb: float | None, headroom: float | None, quadtree_depth: int | None,
                   plot_path: Path | None, annotate: str, region: str | None, table_path: Path | None) -> None:
     """Build ARENA's wall quadtree and AI navigation grid, save them, and plot them.
 
-    ARENA is an arena bundle folder or a bare walls.txt file.
+    ARENA is an arena bundle folder or a bare walls.txt file.  In a bundle the grid
+    follows the model's walkable surface: nodes on every level (a deck over a passage
+    has two), each with its height, linked to its neighbours across ramps and steps
+    within --climb; a node is valid where it keeps --clearance from the walls of its
+    level.  A bare walls file gives the flat 2002 grid of its walls.
     """
     import time
 
@@ -168,6 +212,21 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quad
         clearance, source = default_clearance(target)
     bounds = target.bounds
     shape = grid_shape(bounds, cell)  # refuses absurd grids before any work
+    ext = bounds[1] - bounds[0]
+    if min(shape) < 3:
+        raise ArenaError(f"--cell {cell:g} m leaves {shape[1]} x {shape[0]} nodes over the {ext[0]:g} x {ext[1]:g} m "
+                         f"arena: use a cell of at most {min(ext) / 3:g} m")
+    params = None
+    if target.model is not None:
+        from ..arena import walkable_params
+        from ..fleet import bundled_fleet
+
+        wk = target.toml.get("walkable", {})
+        fleet = bundled_fleet(warn=lambda m: click.echo(f"warning: {m}", err=True))
+        params, _ = walkable_params(cell, max_slope, climb, headroom, fleet, wk if isinstance(wk, dict) else {})
+    elif any(v is not None for v in (max_slope, climb, headroom)):
+        raise ArenaError(f"{arena}: --max-slope, --climb and --headroom need an arena bundle with its model "
+                         "(a bare walls file has no surface)")
     reg = parse_region(region, bounds)
     plot_path = plot_path or target.output("navgrid.png")
     fmt = plot_path.suffix.lower().lstrip(".")
@@ -189,7 +248,9 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quad
 
     t0 = time.perf_counter()
     nodes = shape[0] * shape[1]
-    if nodes >= PROGRESS_NODES:
+    if params is not None:
+        grid, free = _layered(target, params, clearance, bounds, shape)
+    elif nodes >= PROGRESS_NODES:
         with progress(length=shape[0], label=f"classifying {nodes:,} nodes") as bar:
             grid = build(target.walls, cell, clearance, spawns=target.spawns, bounds=bounds, progress=bar.update)
     else:
@@ -198,7 +259,8 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quad
     t_build = time.perf_counter() - t0
 
     # everything rendered in memory first: a failure here writes nothing
-    free = free_space(target.walls, grid.origin, cell, shape)
+    if params is None:
+        free = free_space(target.walls, grid.origin, cell, shape)
     picture = render_navgrid(
         grid, target.walls, fmt=fmt, quadtree=tree, free=free, spawns=target.spawns,
         annotate=annotate, region=reg, title=target.name,
@@ -216,6 +278,8 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quad
         doc = dict(target.toml)
         doc["navgrid"] = {**doc.get("navgrid", {}), "cell": float(cell), "clearance": float(clearance),
                           "quadtree_depth": int(quadtree_depth)}
+        if params is not None:  # the surface this grid was built from
+            doc["walkable"] = params.as_toml()
         derived = dict(doc.get("derived", {}))
         derived["navgrid.npz"] = sha256_file(grid_path)
         derived["quadtree.npz"] = sha256_file(tree_path)
@@ -226,11 +290,21 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, quad
 
     n_valid = int(grid.valid.sum())
     n_reach = int((grid.valid & grid.reachable).sum())
+    levels = f" on {grid.levels} levels" if grid.levels > 1 else ""
     echo(
-        f"{target.name}: {shape[0]} x {shape[1]} nodes at {cell:g} m, clearance {clearance:g} m ({source}): "
+        f"{target.name}: {shape[0]} x {shape[1]} nodes{levels} at {cell:g} m, clearance {clearance:g} m ({source}): "
         f"{n_valid:,} valid, {n_reach:,} reachable, {n_valid - n_reach:,} unreachable "
         f"({t_build * 1000:.0f} ms)"
     )
+    if params is not None:
+        hv = grid.heights()[grid.layered("valid")]
+        if grid.levels > 1:
+            per = ", ".join(f"level {k}: {int(v.sum()):,}" for k, v in enumerate(grid.layered("valid")))
+            echo(f"  {per}")
+        if len(hv):
+            echo(f"  heights y {hv.min():.2f} .. {hv.max():.2f}; walkable: {params.describe()}")
+    if n_valid == 0 and not is_quiet():
+        click.echo(f"warning: {target.name}: no valid node: no tank of clearance {clearance:g} m fits anywhere", err=True)
     if target.spawns is not None and len(grid.spawn_nodes) < len(target.spawns) and not is_quiet():
         click.echo(f"warning: {len(target.spawns) - len(grid.spawn_nodes)} spawn point(s) have no valid node nearby", err=True)
     wrote = [str(grid_path), f"{tree_path} ({len(tree.leaves)} leaves, depth {tree.max_depth})", str(plot_path)]

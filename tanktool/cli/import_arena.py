@@ -10,8 +10,8 @@ from .options import force_option, name_option, out_option, progress, scale_opti
 
 #: models with more faces than this get a progress bar
 PROGRESS_FACES = 100_000
-#: the stages import_arena reports
-STAGES = ("floor", "cut", "sections", "free", "spawns", "files")
+#: the stages import_arena reports (nav.arena_levels.STAGES, then the files)
+STAGES = ("surface", "walls", "grid", "spawns", "report", "files")
 
 
 def _face_count_guess(model: Path) -> int:
@@ -31,7 +31,15 @@ def _face_count_guess(model: Path) -> int:
 @up_option
 @scale_option
 @click.option("--height", type=float, default=1.0, show_default=True,
-              help="Cut height above the floor, in metres: what crosses it is a wall.")
+              help="Cut height above a flat floor, in metres: what crosses it is a wall.")
+@click.option("--cell", type=float, default=None, metavar="M",
+              help="Voxel and navigation-grid cell size in metres (default 0.5).")
+@click.option("--max-slope", type=float, default=None, metavar="DEG",
+              help="Steepest walkable slope in degrees (default 35).")
+@click.option("--climb", type=float, default=None, metavar="M",
+              help="Highest step a tank drives up or down, in metres (default 0.9).")
+@click.option("--headroom", type=float, default=None, metavar="M",
+              help="Free height a tank needs above the surface, in metres (default: the tallest bundled vehicle).")
 @click.option("--tolerance", type=float, default=0.01, show_default=True,
               help="Shortest wall kept and snapping grid, in metres.")
 @click.option("--wall-height", type=float, default=None, metavar="H",
@@ -40,14 +48,22 @@ def _face_count_guess(model: Path) -> int:
               help="Floor plans (.dxf .svg): wall thickness in metres (default 0.5).")
 @force_option
 def import_arena(model: Path, out: Path | None, name: str | None, up: str | None, scale: float,
-                 height: float, tolerance: float, wall_height: float | None, wall_thickness: float | None,
+                 height: float, cell: float | None, max_slope: float | None, climb: float | None,
+                 headroom: float | None, tolerance: float, wall_height: float | None, wall_thickness: float | None,
                  force: bool) -> None:
     """Turn an arena MODEL (.3ds .obj .glb .stl .ply .off, BZFlag .bzw, floor plan
     .dxf .svg) into an arena bundle.
 
+    Finds where a tank can stand as Recast does (a voxel heightfield: faces no steeper
+    than --max-slope, --headroom free above, neighbours within --climb), stacks it into
+    levels (a deck over a passage is level 1), draws each level's walls (exact on flat
+    floors) and places spawns where the largest bundled tank fits.  Prints each
+    level's area and height range and what was left out and why.
+
     \b
     Writes arena.toml, the model, model.glb, walls.txt, preview.png:
       tanktool import-arena castle.3ds -o arenas/castle --height 1.2
+      tanktool import-arena hills.obj --max-slope 30 --climb 0.5
       tanktool import-arena plan.dxf --wall-height 3 --wall-thickness 0.4
     """
     from ..arena import import_arena as run
@@ -57,16 +73,37 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
         # non-fatal remarks (a .bzw's unknown objects) go to stderr, even under -q
         click.echo(f"warning: {message}", err=True)
 
+    from ..nav.arena_levels import describe_levels
+
+    kw = dict(warn=warn, wall_height=wall_height, wall_thickness=wall_thickness, max_slope=max_slope,
+              climb=climb, headroom=headroom, cell=cell)
     if _face_count_guess(model) > PROGRESS_FACES:
         with progress(length=len(STAGES), label=f"importing {model.name}") as bar:
             result = run(model, out, name, up, scale, height, tolerance, force, progress=lambda _s: bar.update(1),
-                         warn=warn, wall_height=wall_height, wall_thickness=wall_thickness)
+                         **kw)
     else:
-        result = run(model, out, name, up, scale, height, tolerance, force, warn=warn,
-                     wall_height=wall_height, wall_thickness=wall_thickness)
+        result = run(model, out, name, up, scale, height, tolerance, force, **kw)
     (x0, z0), (x1, z1) = result.walls.bounds
     thin = f" ({result.thin_walls} from thin walls)" if result.thin_walls else ""
-    echo(f"arena {result.name!r}: {len(result.walls)} walls{thin} + 4 auxiliary, {len(result.spawns)} spawns")
+    nlev = len(result.levels.levels)
+    echo(f"arena {result.name!r}: {nlev} level{'s' if nlev != 1 else ''}, {len(result.walls)} walls{thin} "
+         f"+ 4 auxiliary, {len(result.spawns)} spawns")
+    for line in describe_levels(result.levels):
+        echo(line)
+    echo(f"  walkable: {_describe_params(result.params, result.defaults)}")
     echo(f"  bounds x {x0:g}..{x1:g}, z {z0:g}..{z1:g} m ({x1 - x0:.1f} x {z1 - z0:.1f} m), "
          f"floor y={result.floor_y:.3f}, {result.faces} faces")
     echo(f"  wrote {result.path} in {result.seconds:.2f} s")
+
+
+def _describe_params(params, where: dict[str, str]) -> str:
+    """The walkable parameters, each default saying where it came from."""
+    def one(label: str, key: str, value: float, unit: str) -> str:
+        src = where.get(key, "default")
+        note = "" if src == "option" else f" ({src})" if src not in ("default",) else ""
+        return f"{label} {value:g}{unit}{note}"
+    return ", ".join([
+        one("cell", "cell", params.cell, " m"), one("cell height", "cell_height", params.cell_height, " m"),
+        one("max slope", "max_slope", params.max_slope, " deg"), one("climb", "climb", params.climb, " m"),
+        one("headroom", "headroom", params.headroom, " m"),
+    ])

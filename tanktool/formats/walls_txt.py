@@ -6,12 +6,24 @@ comment.  Direction (+1 or -1) picks the normal
 four walls are the auxiliary bounding rectangle, written after a ``# auxiliary`` line;
 files without the marker are accepted when their last four walls form an
 axis-aligned rectangle enclosing the rest.
+
+On an arena of several levels (or of several separate surfaces on one level) the
+walls come in blocks, each after a marker comment::
+
+    # level 1 region 4 y 3.00 3.00
+    12.5 4 20 4 1
+
+``level`` is the navigation grid's level, ``region`` numbers the connected surface
+the block's walls bound (unique over the file), ``y`` the lowest and highest floor
+height along them.  Markers are comments, so tools that know only the five columns
+read the same walls; a file without markers is one block on level 0.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -20,6 +32,9 @@ from ..errors import FormatError
 from .bundle import atomic_write_text, read_input_text
 
 AUX_MARKER = "# auxiliary"
+LEVEL_MARKER = "# level"
+#: a level marker: "# level" and a number (other comments may start with "# level ...")
+_MARKER_RE = re.compile(r"^#\s*level\s+[-+]?\d", re.IGNORECASE)
 
 
 @dataclass
@@ -31,6 +46,8 @@ class WallList:
     aux : (4, 2, 2) float64, the auxiliary bounding rectangle (may be None when
           the file has none; :attr:`bounds` then falls back to the walls' extent)
     lines : (n,) int, the 1-based line of each wall in the file it came from (0 if made in memory)
+    level, region : (n,) int, each wall's level and region (0 and 0 without markers)
+    regions : region -> (level, y_lo, y_hi) of every marked block
     """
 
     segments: np.ndarray
@@ -38,12 +55,20 @@ class WallList:
     aux: np.ndarray | None = None
     lines: np.ndarray | None = None
     path: str | None = None
+    level: np.ndarray | None = None
+    region: np.ndarray | None = None
+    regions: dict | None = None
 
     def __post_init__(self) -> None:
         self.segments = np.asarray(self.segments, dtype=np.float64).reshape(-1, 2, 2)
         self.direction = np.asarray(self.direction, dtype=np.int8).reshape(-1)
         if self.lines is None:
             self.lines = np.zeros(len(self.segments), dtype=np.int64)
+        n = len(self.segments)
+        self.level = np.zeros(n, dtype=np.int64) if self.level is None else np.asarray(self.level, dtype=np.int64).reshape(-1)
+        self.region = np.zeros(n, dtype=np.int64) if self.region is None else np.asarray(self.region, dtype=np.int64).reshape(-1)
+        if self.regions is None:
+            self.regions = {}
         if self.aux is not None:
             self.aux = np.asarray(self.aux, dtype=np.float64).reshape(4, 2, 2)
 
@@ -67,6 +92,25 @@ class WallList:
         if len(pts) == 0:
             return np.zeros((2, 2))
         return np.array([pts.min(axis=0), pts.max(axis=0)])
+
+    @property
+    def levels(self) -> int:
+        """Number of levels the walls are marked with (1 without markers)."""
+        return int(self.level.max()) + 1 if len(self.level) else 1
+
+    @property
+    def layered(self) -> bool:
+        """True when the file has level/region markers (more than one block)."""
+        return bool(self.regions) and (len(self.regions) > 1 or self.levels > 1)
+
+    def select(self, mask: np.ndarray) -> "WallList":
+        """The walls where ``mask`` holds (the same auxiliary rectangle and regions)."""
+        m = np.asarray(mask, dtype=bool)
+        return WallList(self.segments[m], self.direction[m], self.aux, self.lines[m], self.path,
+                        self.level[m], self.region[m], dict(self.regions))
+
+    def on_level(self, level: int) -> "WallList":
+        return self.select(self.level == level)
 
     def all_segments(self) -> np.ndarray:
         """Walls followed by the auxiliary walls, (n + 4, 2, 2)."""
@@ -117,6 +161,10 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
     segs: list[list[float]] = []
     dirs: list[int] = []
     lines: list[int] = []
+    levels: list[int] = []
+    region_of: list[int] = []
+    regions: dict[int, tuple[int, float, float]] = {}
+    current = (0, 0)
     aux_start: int | None = None
     for lineno, raw in enumerate(text.splitlines(), start=1):
         stripped = raw.strip()
@@ -124,6 +172,9 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
             if aux_start is not None:
                 raise FormatError(f"{path}:{lineno}: second '{AUX_MARKER}' marker")
             aux_start = len(segs)
+            continue
+        if _MARKER_RE.match(stripped) and aux_start is None:
+            current = _parse_marker(stripped, f"{path}:{lineno}", regions)
             continue
         body = raw.split("#", 1)[0].split()
         if not body:
@@ -147,9 +198,13 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
         segs.append(vals)
         dirs.append(int(d))
         lines.append(lineno)
+        levels.append(current[0])
+        region_of.append(current[1])
     seg = np.array(segs, dtype=np.float64).reshape(-1, 2, 2)
     direction = np.array(dirs, dtype=np.int8)
     line_arr = np.array(lines, dtype=np.int64)
+    lev = np.array(levels, dtype=np.int64)
+    reg = np.array(region_of, dtype=np.int64)
     if aux_start is not None:
         if len(seg) - aux_start != 4:
             raise FormatError(
@@ -161,10 +216,43 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
                 f"{path}:{lines[aux_start]}: auxiliary walls must form an axis-aligned "
                 "rectangle enclosing every wall"
             )
-        return WallList(seg[:aux_start], direction[:aux_start], aux, line_arr[:aux_start], path)
+        return WallList(seg[:aux_start], direction[:aux_start], aux, line_arr[:aux_start], path,
+                        lev[:aux_start], reg[:aux_start], regions)
     if len(seg) >= 4 and _is_enclosing_rectangle(seg[-4:], seg[:-4]):
-        return WallList(seg[:-4], direction[:-4], seg[-4:], line_arr[:-4], path)
-    return WallList(seg, direction, None, line_arr, path)
+        return WallList(seg[:-4], direction[:-4], seg[-4:], line_arr[:-4], path, lev[:-4], reg[:-4], regions)
+    return WallList(seg, direction, None, line_arr, path, lev, reg, regions)
+
+
+#: the most levels a wall list may name
+MAX_LEVEL = 63
+
+
+def _parse_marker(text: str, where: str, regions: dict) -> tuple[int, int]:
+    """``# level L [region R] [y LO HI]`` -> (L, R); records R's level and heights."""
+    words = text[1:].split()
+    fields: dict[str, list[str]] = {}
+    k = 0
+    try:
+        while k < len(words):
+            key = words[k].lower()
+            n = 2 if key == "y" else 1
+            if key not in ("level", "region", "y") or key in fields:
+                raise ValueError
+            fields[key] = words[k + 1:k + 1 + n]
+            if len(fields[key]) != n:
+                raise ValueError
+            k += 1 + n
+        level = int(fields["level"][0])
+        region = int(fields["region"][0]) if "region" in fields else len(regions)
+        y = [float(v) for v in fields["y"]] if "y" in fields else [math.nan, math.nan]
+    except (ValueError, KeyError):
+        raise FormatError(f"{where}: expected a level marker '# level L region R y LO HI', got {text!r}") from None
+    if not 0 <= level <= MAX_LEVEL or region < 0:
+        raise FormatError(f"{where}: level must be 0..{MAX_LEVEL} and region >= 0, got {text!r}")
+    if region in regions and regions[region][0] != level:
+        raise FormatError(f"{where}: region {region} was marked on level {regions[region][0]} before")
+    regions[region] = (level, y[0], y[1])
+    return level, region
 
 
 def read_walls(path: str | os.PathLike) -> WallList:
@@ -183,7 +271,16 @@ def format_walls(walls: WallList, header: str | None = None) -> str:
         s = f"{v:.4f}".rstrip("0").rstrip(".")
         return "0" if s in ("-0", "") else s
 
-    for (p, q), d in zip(walls.segments, walls.direction):
+    marked = walls.layered
+    order = np.lexsort((np.arange(len(walls)), walls.region, walls.level)) if marked else np.arange(len(walls))
+    block = None
+    for k in order:
+        (p, q), d = walls.segments[k], walls.direction[k]
+        if marked and (walls.level[k], walls.region[k]) != block:
+            block = (int(walls.level[k]), int(walls.region[k]))
+            lv, lo, hi = walls.regions.get(block[1], (block[0], math.nan, math.nan))
+            ys = f" y {lo:.2f} {hi:.2f}" if math.isfinite(lo) and math.isfinite(hi) else ""
+            out.append(f"{LEVEL_MARKER} {block[0]} region {block[1]}{ys}")
         out.append(f"{fmt(p[0])} {fmt(p[1])} {fmt(q[0])} {fmt(q[1])} {int(d)}")
     if walls.aux is not None:
         out.append(AUX_MARKER)

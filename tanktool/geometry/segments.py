@@ -155,3 +155,55 @@ def segment_lengths(segments: np.ndarray) -> np.ndarray:
     """Lengths of segments ``(n, 2, 2) -> (n,)``."""
     d = np.asarray(segments, dtype=np.float64)[:, 1] - np.asarray(segments, dtype=np.float64)[:, 0]
     return np.hypot(d[:, 0], d[:, 1])
+
+
+def faces_above(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, bucket: float = 8.0) -> np.ndarray:
+    """For each point (k, 3) ``[x, y, z]``: how many faces a vertical ray from it
+    upwards crosses (odd: the point lies inside a closed solid).
+
+    A face counts when the point's (x, z) lies inside its projection (half-open
+    edges, so a ray through a shared edge counts once) and the face is above the point
+    there.  Vertical faces are never crossed.  Faces are sorted into square buckets of
+    ``bucket`` metres by their extent, so each point tests only the faces over it.
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]
+    out = np.zeros(len(p), dtype=np.int64)
+    if len(p) == 0 or len(tri) == 0:
+        return out
+    ax, ay, az = tri[:, 0, 0], tri[:, 0, 1], tri[:, 0, 2]
+    bx, by, bz = tri[:, 1, 0], tri[:, 1, 1], tri[:, 1, 2]
+    cx, cy, cz = tri[:, 2, 0], tri[:, 2, 1], tri[:, 2, 2]
+    det = (bx - ax) * (cz - az) - (cx - ax) * (bz - az)
+    lo = np.minimum(np.minimum(tri[:, 0], tri[:, 1]), tri[:, 2])[:, [0, 2]]
+    hi = np.maximum(np.maximum(tri[:, 0], tri[:, 1]), tri[:, 2])[:, [0, 2]]
+    origin = lo.min(axis=0)
+    b0 = np.floor((lo - origin) / bucket).astype(np.int64)
+    b1 = np.floor((hi - origin) / bucket).astype(np.int64)
+    n = (b1 - b0 + 1)
+    keep = (det != 0) & (n[:, 0] * n[:, 1] <= 4096)  # a face over 4096 buckets is tested by every point
+    big = np.flatnonzero((det != 0) & ~keep)
+    f = np.flatnonzero(keep)
+    cnt = n[f, 0] * n[f, 1]
+    owner = np.repeat(f, cnt)
+    k = np.arange(len(owner)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    bi = b0[owner, 0] + k % n[owner, 0]
+    bj = b0[owner, 1] + k // n[owner, 0]
+    width = int(b1[:, 0].max()) + 2 if len(b1) else 1
+    key = bj * width + bi
+    order = np.argsort(key, kind="stable")
+    key, owner = key[order], owner[order]
+    pb = np.floor((p[:, [0, 2]] - origin) / bucket).astype(np.int64)
+    for m, (x, y, z) in enumerate(p):
+        kk = pb[m, 1] * width + pb[m, 0]
+        a, b = np.searchsorted(key, kk), np.searchsorted(key, kk, side="right")
+        cand = np.concatenate([owner[a:b], big]) if (pb[m] >= 0).all() and pb[m, 0] < width else big
+        if len(cand) == 0:
+            continue
+        dd = det[cand]
+        u = ((x - ax[cand]) * (cz[cand] - az[cand]) - (cx[cand] - ax[cand]) * (z - az[cand])) / dd
+        v = ((bx[cand] - ax[cand]) * (z - az[cand]) - (x - ax[cand]) * (bz[cand] - az[cand])) / dd
+        inside = (u >= 0) & (v >= 0) & (u + v < 1)
+        h = ay[cand] + u * (by[cand] - ay[cand]) + v * (cy[cand] - ay[cand])
+        out[m] = int(np.count_nonzero(inside & (h > y)))
+    return out

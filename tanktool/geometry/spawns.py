@@ -49,33 +49,53 @@ def spawn_candidates(free, clearance: float) -> np.ndarray:
     return pts
 
 
-def place_spawns(free, bounds: np.ndarray, count: int = SPAWN_COUNT, clearance: float = SPAWN_CLEARANCE) -> np.ndarray:
+def spread(pts: np.ndarray, count: int, min_separation: float = 0.0, start: np.ndarray | None = None) -> np.ndarray:
+    """Indices of up to ``count`` candidates by farthest-point sampling: the first is the
+    candidate nearest ``start`` (default their centroid), each next the one farthest
+    from all chosen so far, while that is at least ``min_separation`` away."""
+    if len(pts) == 0:
+        return np.zeros(0, dtype=np.int64)
+    centre = pts.mean(axis=0) if start is None else np.asarray(start, dtype=np.float64)
+    chosen = [int(np.argmin(((pts - centre) ** 2).sum(axis=1)))]
+    dist = ((pts - pts[chosen[0]]) ** 2).sum(axis=1)
+    for _ in range(count - 1):
+        k = int(np.argmax(dist))
+        if dist[k] < min_separation * min_separation:
+            break
+        chosen.append(k)
+        dist = np.minimum(dist, ((pts - pts[k]) ** 2).sum(axis=1))
+    return np.array(chosen, dtype=np.int64)
+
+
+def facing_centre(p: np.ndarray, bounds: np.ndarray) -> np.ndarray:
+    """Headings from points (k, 2) to the centre of ``bounds``; +x within 1 m of it."""
+    centre = np.asarray(bounds, dtype=np.float64).mean(axis=0)
+    heading = np.arctan2(centre[1] - p[:, 1], centre[0] - p[:, 0])
+    # a spawn on the centre itself has no direction to face: it faces +x
+    return np.where(np.hypot(*(centre - p).T) < 1.0, 0.0, heading)
+
+
+def place_spawns(free, bounds: np.ndarray, count: int = SPAWN_COUNT, clearance: float = SPAWN_CLEARANCE,
+                 min_clearance: float = 0.5, min_separation: float = 0.0) -> np.ndarray:
     """``count`` spawn points ``[x, z, heading]`` (k, 3) over the free space.
 
-    When fewer than ``count`` candidates keep the clearance, the clearance is
-    halved (down to 0.5 m) before giving up with an ArenaError.
+    When fewer than ``count`` candidates keep the clearance, the clearance is halved
+    (down to ``min_clearance``) before giving up with an ArenaError; spawns keep
+    ``min_separation`` from each other (fewer than ``count`` when the space is small).
     """
     c = clearance
     while True:
         pts = spawn_candidates(free, c)
         if len(pts) >= count:
             break
-        if c <= 0.5:
+        if c <= min_clearance:
+            if len(pts) and min_separation > 0:
+                break  # fewer spawns, but where a tank fits
             raise ArenaError(
                 f"the free space is too small for {count} spawn points "
                 f"(found {len(pts)} places at least {c:g} m from every wall)"
             )
-        c = max(0.5, c / 2)
+        c = max(min_clearance, c / 2)
     centre_region = np.asarray(shapely.get_coordinates(shapely.centroid(free))[0])
-    chosen = [int(np.argmin(((pts - centre_region) ** 2).sum(axis=1)))]
-    dist = ((pts - pts[chosen[0]]) ** 2).sum(axis=1)
-    for _ in range(count - 1):
-        k = int(np.argmax(dist))
-        chosen.append(k)
-        dist = np.minimum(dist, ((pts - pts[k]) ** 2).sum(axis=1))
-    p = pts[chosen]
-    centre = np.asarray(bounds, dtype=np.float64).mean(axis=0)
-    heading = np.arctan2(centre[1] - p[:, 1], centre[0] - p[:, 0])
-    # a spawn on the centre itself has no direction to face: it faces +x
-    heading = np.where(np.hypot(*(centre - p).T) < 1.0, 0.0, heading)
-    return np.column_stack([p, heading])
+    p = pts[spread(pts, count, min_separation, centre_region)]
+    return np.column_stack([p, facing_centre(p, bounds)])

@@ -47,6 +47,8 @@ from ..geometry.segments import point_segment_dist2
 
 #: refuse grids larger than this (nodes); 25 M nodes is ~300 MB of arrays
 MAX_NODES = 25_000_000
+#: refuse grids of more levels than this
+MAX_LEVELS = 64
 _FIELDS = ("valid", "row_index", "row_total", "col_index", "col_total", "reachable")
 
 Node = tuple[int, int]
@@ -56,10 +58,17 @@ STEPS: dict[str, Node] = {"+x": (0, 1), "+z": (1, 0), "-x": (0, -1), "-z": (-1, 
 
 @dataclass
 class NavGrid:
-    """A navigation grid.  Per-node arrays have shape ``(nz, nx)``.
+    """A navigation grid.  Per-node arrays have shape ``(nz, nx)`` on a one-level
+    arena and ``(L, nz, nx)`` on an arena of L levels (node ``(level, i, j)``).
 
     row_index / row_total: 1-based position of the node in its row run of valid
     nodes, and that run's length (0 for invalid nodes); col_* the same for columns.
+    Runs are counted per level and break where two neighbours are not linked.
+    height: world y of the surface at each node (NaN where there is no node).
+    link: ``valid.shape + (4,)`` int8, the level of the node reached by each step of
+    STEPS (+x, +z, -x, -z), -1 where the step is blocked (a wall, a drop-off, a slope
+    too steep, another level out of the climb).  None on grids made from walls alone:
+    then neighbours on the same level are linked whenever both are valid.
     """
 
     origin: np.ndarray
@@ -73,6 +82,32 @@ class NavGrid:
     reachable: np.ndarray
     clearance: float = float("nan")  # how it was built; kept in arena.toml, not in the npz
     spawn_nodes: list[Node] = field(default_factory=list)
+    height: np.ndarray | None = None
+    link: np.ndarray | None = None
+
+    # ------------------------------------------------------------ levels
+    @property
+    def levels(self) -> int:
+        """Number of levels (1 for a flat grid with 2-D arrays)."""
+        return 1 if self.valid.ndim == 2 else int(self.valid.shape[0])
+
+    def layered(self, name: str) -> np.ndarray:
+        """A per-node array as ``(L, nz, nx)`` (a view: a one-level grid gains an axis)."""
+        a = getattr(self, name)
+        return a[None] if self.valid.ndim == 2 else a
+
+    def links(self) -> np.ndarray:
+        """``(L, nz, nx, 4)`` levels reached by each step (-1: blocked), derived from
+        validity when the grid has no ``link`` array."""
+        if self.link is not None:
+            return self.link[None] if self.valid.ndim == 2 else self.link
+        return links_from_valid(self.layered("valid"))
+
+    def heights(self) -> np.ndarray:
+        """``(L, nz, nx)`` surface heights (0 at valid nodes of a grid without heights)."""
+        if self.height is not None:
+            return self.layered("height")
+        return np.where(self.layered("valid"), 0.0, np.nan)
 
     # ------------------------------------------------------------ geometry
     @property
@@ -144,41 +179,75 @@ class NavGrid:
 
     def to_bytes(self) -> bytes:
         buf = io.BytesIO()
+        extra = {}
+        extra["height"] = np.asarray(self.heights() if self.valid.ndim == 3 else self.heights()[0], dtype=np.float32)
+        if self.link is not None:
+            extra["link"] = np.asarray(self.link, dtype=np.int8)
         np.savez_compressed(
             buf, origin=np.asarray(self.origin, dtype=np.float64),
             cell=np.array(float(self.cell)), shape=np.array(self.shape, dtype=np.int64),
             valid=self.valid, row_index=self.row_index, row_total=self.row_total,
-            col_index=self.col_index, col_total=self.col_total, reachable=self.reachable,
+            col_index=self.col_index, col_total=self.col_total, reachable=self.reachable, **extra,
         )
         return buf.getvalue()
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "NavGrid":
         """Read a ``navgrid.npz``; anything malformed raises FormatError naming the file."""
+        import zipfile
+        import zlib
+
         try:
             with np.load(path, allow_pickle=False) as z:
                 missing = [k for k in ("origin", "cell", "shape", *_FIELDS[:-1]) if k not in z.files]
                 if missing:
                     raise FormatError(f"{path}: not a navgrid file (missing {', '.join(missing)})")
-                shape = tuple(int(v) for v in z["shape"])
-                arrays = {k: z[k] for k in _FIELDS if k in z.files}
+                raw_shape = z["shape"]
+                if raw_shape.shape != (2,) or raw_shape.dtype.kind not in "iu":
+                    raise FormatError(f"{path}: 'shape' must be two integers (nz, nx)")
+                shape = (int(raw_shape[0]), int(raw_shape[1]))
+                if min(shape) < 1 or shape[0] * shape[1] > MAX_NODES:
+                    raise FormatError(f"{path}: shape {shape} is not a grid of 1 to {MAX_NODES:,} nodes")
+                arrays = {}
+                for k in (*_FIELDS, "height", "link"):
+                    if k in z.files:
+                        a = z[k]
+                        if a.size > 16 * MAX_NODES * 4:
+                            raise FormatError(f"{path}: {k} is too large ({a.size:,} values)")
+                        arrays[k] = a
                 origin = z["origin"].astype(np.float64)
                 cell = float(z["cell"])
         except FileNotFoundError:
             raise FormatError(f"{path}: no such file") from None
-        except (OSError, ValueError, KeyError) as e:
+        except FormatError:
+            raise
+        except (OSError, ValueError, KeyError, TypeError, EOFError, zipfile.BadZipFile, zlib.error) as e:
             raise FormatError(f"{path}: cannot read navgrid: {e}") from None
-        if len(shape) != 2 or origin.shape != (2,) or not cell > 0:
+        if origin.shape != (2,) or not np.isfinite(origin).all() or not (math.isfinite(cell) and cell > 0):
             raise FormatError(f"{path}: bad origin/cell/shape")
+        v = arrays["valid"]
+        if v.ndim == 3 and v.shape[1:] == shape and 1 <= v.shape[0] <= MAX_LEVELS:
+            full = v.shape
+        elif v.shape == shape:
+            full = shape
+        else:
+            raise FormatError(f"{path}: valid has shape {v.shape}, expected {shape} or (levels, {shape[0]}, {shape[1]})")
         for k, a in arrays.items():
-            if a.shape != shape:
-                raise FormatError(f"{path}: {k} has shape {a.shape}, expected {shape}")
+            want = full + (4,) if k == "link" else full
+            if a.shape != want:
+                raise FormatError(f"{path}: {k} has shape {a.shape}, expected {want}")
         if "reachable" not in arrays:  # files written before regions existed
             arrays["reachable"] = arrays["valid"].copy()
+        height = arrays.get("height")
+        link = arrays.get("link")
+        if link is not None and ((link < -1) | (link >= (1 if v.ndim == 2 else v.shape[0]))).any():
+            raise FormatError(f"{path}: link holds levels outside -1 .. {(1 if v.ndim == 2 else v.shape[0]) - 1}")
         return cls(
             origin, cell, shape, arrays["valid"].astype(bool),
             *(arrays[k].astype(np.int32) for k in ("row_index", "row_total", "col_index", "col_total")),
             arrays["reachable"].astype(bool),
+            height=None if height is None else height.astype(np.float64),
+            link=None if link is None else link.astype(np.int8),
         )
 
 
@@ -450,6 +519,110 @@ def runs(valid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
     ri, rt = _runs_along_last_axis(valid)
     ci, ct = _runs_along_last_axis(valid.T)
     return ri, rt, np.ascontiguousarray(ci.T), np.ascontiguousarray(ct.T)
+
+
+def links_from_valid(valid: np.ndarray) -> np.ndarray:
+    """``(L, nz, nx, 4)`` links of a grid without heights: a step joins two valid
+    nodes of the same level."""
+    v = np.asarray(valid, dtype=bool)
+    L, nz, nx = v.shape
+    pad = np.zeros((L, nz + 2, nx + 2), dtype=bool)
+    pad[:, 1:-1, 1:-1] = v
+    out = np.full((L, nz, nx, 4), -1, dtype=np.int8)
+    lev = np.arange(L, dtype=np.int8)[:, None, None]
+    for d, (di, dj) in enumerate(STEPS.values()):
+        nb = pad[:, 1 + di:1 + di + nz, 1 + dj:1 + dj + nx]
+        out[..., d] = np.where(v & nb, lev, -1)
+    return out
+
+
+def layered_runs(valid: np.ndarray, link: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(row_index, row_total, col_index, col_total) of a layered grid, per level: a row
+    run goes along +x over valid nodes of one level each linked to the next on the same
+    level; a column run likewise along +z."""
+    L = valid.shape[0]
+    lev = np.arange(L)[:, None, None]
+    out = []
+    for axis, d in ((2, 0), (1, 1)):  # rows along +x (step 0), columns along +z (step 1)
+        joined = valid & (link[..., d] == lev)  # node continues its run to the next one
+        v = valid if axis == 2 else valid.transpose(0, 2, 1)
+        jn = joined if axis == 2 else joined.transpose(0, 2, 1)
+        idx, tot = _runs_joined(v.reshape(-1, v.shape[2]), jn.reshape(-1, v.shape[2]))
+        idx, tot = idx.reshape(v.shape), tot.reshape(v.shape)
+        if axis == 1:
+            idx, tot = idx.transpose(0, 2, 1), tot.transpose(0, 2, 1)
+        out += [np.ascontiguousarray(idx), np.ascontiguousarray(tot)]
+    return out[0], out[1], out[2], out[3]
+
+
+def _runs_joined(valid: np.ndarray, joined: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Runs along the last axis where each node's run continues to the next node only
+    when ``joined`` (and that node is valid)."""
+    m, n = valid.shape
+    cont = np.zeros((m, n), dtype=bool)
+    cont[:, :-1] = joined[:, :-1] & valid[:, 1:]
+    start = valid.copy()
+    start[:, 1:] &= ~cont[:, :-1]
+    flat_v = valid.ravel()
+    flat_s = start.ravel()
+    run_id = np.cumsum(flat_s) - 1
+    lengths = np.bincount(run_id[flat_v], minlength=int(flat_s.sum())) if flat_v.any() else np.zeros(0, dtype=np.int64)
+    first = np.flatnonzero(flat_s)
+    pos = np.arange(flat_v.size)
+    index = np.zeros(flat_v.size, dtype=np.int32)
+    total = np.zeros(flat_v.size, dtype=np.int32)
+    index[flat_v] = (pos[flat_v] - first[run_id[flat_v]] + 1)
+    total[flat_v] = lengths[run_id[flat_v]]
+    return index.reshape(m, n), total.reshape(m, n)
+
+
+def layered_reachable(valid: np.ndarray, link: np.ndarray, seeds: list) -> np.ndarray:
+    """Valid nodes connected through links to any seed node ``(level, i, j)``."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    L, nz, nx = valid.shape
+    n = valid.size
+    if not seeds:
+        return valid.copy()
+    src, dst = [], []
+    base = np.arange(n).reshape(L, nz, nx)
+    for d, (di, dj) in enumerate(STEPS.values()):
+        lv = link[..., d]
+        ok = valid & (lv >= 0)
+        l_, i_, j_ = np.nonzero(ok)
+        ii, jj = i_ + di, j_ + dj
+        inside = (ii >= 0) & (ii < nz) & (jj >= 0) & (jj < nx)
+        l_, i_, j_, ii, jj = l_[inside], i_[inside], j_[inside], ii[inside], jj[inside]
+        tl = lv[l_, i_, j_].astype(np.int64)
+        good = valid[tl, ii, jj]
+        src.append(base[l_, i_, j_][good])
+        dst.append(base[tl, ii, jj][good])
+    src_a = np.concatenate(src) if src else np.zeros(0, dtype=np.int64)
+    dst_a = np.concatenate(dst) if dst else np.zeros(0, dtype=np.int64)
+    g = coo_matrix((np.ones(len(src_a), dtype=np.int8), (src_a, dst_a)), shape=(n, n))
+    _, label = connected_components(g, directed=True, connection="weak")
+    label = label.reshape(L, nz, nx)
+    keep = np.unique([label[s] for s in seeds])
+    return valid & np.isin(label, keep)
+
+
+def nearest_valid_node3(valid: np.ndarray, height: np.ndarray, x_node: tuple[int, int], y: float | None,
+                        max_steps: int) -> tuple[int, int, int] | None:
+    """The valid node ``(level, i, j)`` nearest to column ``x_node`` within ``max_steps``
+    (ties and, when ``y`` is given, the level by the smallest height difference)."""
+    L = valid.shape[0]
+    best = None
+    for lv in range(L):
+        n = nearest_valid_node(valid[lv], x_node, max_steps)
+        if n is None:
+            continue
+        d = (n[0] - x_node[0]) ** 2 + (n[1] - x_node[1]) ** 2
+        dy = abs(float(height[lv, n[0], n[1]]) - y) if y is not None and np.isfinite(height[lv, n[0], n[1]]) else 0.0
+        key = (d, dy)
+        if best is None or key < best[0]:
+            best = (key, (lv, n[0], n[1]))
+    return None if best is None else best[1]
 
 
 # =================================================================== regions

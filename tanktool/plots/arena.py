@@ -58,7 +58,8 @@ def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = 
     if walls.aux is not None:
         ax.add_collection(LineCollection(walls.aux, colors="#4060c0", linewidths=0.9,
                                          linestyles="dashed", zorder=1))
-    spawns = np.asarray(spawns, dtype=np.float64).reshape(-1, 3)
+    spawns = np.asarray(spawns, dtype=np.float64)
+    spawns = spawns.reshape(len(spawns), -1)[:, :3] if spawns.size else np.zeros((0, 3))
     arrow = 0.03 * max(w, h)
     for k, (x, z, th) in enumerate(spawns, start=1):
         ax.annotate("", xy=(x + arrow * np.cos(th), z + arrow * np.sin(th)), xytext=(x, z),
@@ -79,8 +80,176 @@ def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = 
     return buf.getvalue()
 
 
-def save_preview(path: str | os.PathLike, walls: WallList, spawns: np.ndarray, title: str, free: Any = None) -> None:
-    """Write :func:`render_preview` to ``path`` atomically."""
+def save_preview(path: str | os.PathLike, walls: WallList, spawns: np.ndarray, title: str, free: Any = None,
+                 levels: Any = None) -> None:
+    """Write :func:`render_preview` (or, given an ArenaLevels, :func:`render_levels`)
+    to ``path`` atomically."""
     from ..formats.bundle import atomic_write_bytes
 
-    atomic_write_bytes(path, render_preview(walls, spawns, title, free))
+    if levels is not None:
+        atomic_write_bytes(path, render_levels(levels, title))
+    else:
+        atomic_write_bytes(path, render_preview(walls, spawns, title, free))
+
+
+#: colours of what the walkable surface left out
+LEFT_OUT_COLOURS = {"unreachable": "#9a9a9a", "headroom": "#f0a030", "small": "#b060c0", "steep": "#d03030"}
+
+
+def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
+    """PNG bytes of an arena's levels: a panel per level (one on a one-level arena),
+    walkable cells coloured by height (a flat floor in light green), that level's walls
+    with their normals and its spawns; the first panel also shows what was left out
+    (unreachable surfaces, too little headroom, too small for a tank, too steep faces),
+    with a legend of their areas."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Patch
+
+    from ..nav.surface_report import low_headroom, steep_faces, too_small, unreachable
+    from ..nav.walkable import surface_layers
+
+    surface = result.surface
+    hf = surface.hf
+    walls = result.walls.walls
+    (xmin, zmin), (xmax, zmax) = walls.bounds
+    L = max(len(result.levels), 1)
+    cols = 1 if L == 1 else 2
+    rows = (L + cols - 1) // cols
+    w = max(xmax - xmin, 1e-6)
+    h = max(zmax - zmin, 1e-6)
+    panel_w = 9.0 if cols == 1 else 6.0
+    fig_h = float(np.clip(rows * (panel_w * h / w + 0.9) + 0.6, 3.5, 22.0))
+    fig = Figure(figsize=(panel_w * cols + 1.2, fig_h), dpi=size_px / (panel_w * cols + 1.2))
+    exists, height, _, _ = surface_layers(surface)
+    nz, nx = hf.shape
+    extent = (hf.origin[0], hf.origin[0] + nx * hf.cs, hf.origin[2], hf.origin[2] + nz * hf.cs)
+    ys = height[exists]
+    lo, hi = (float(ys.min()), float(ys.max())) if len(ys) else (0.0, 1.0)
+    flat = hi - lo <= 2 * hf.ch
+    cmap = matplotlib.colormaps["viridis"]
+    image = None
+    spawns = np.asarray(result.spawns, dtype=np.float64)
+    for lv in range(L):
+        ax = fig.add_subplot(rows, cols, lv + 1)
+        ax.set_aspect("equal")
+        if flat:
+            for poly in shapely_parts(result.walls.free(lv)):
+                ax.fill(*poly.exterior.xy, color="#e8efe6", zorder=0, lw=0)
+                for hole in poly.interiors:
+                    ax.fill(*hole.xy, color="white", zorder=0, lw=0)
+        else:
+            img = np.where(exists[lv], height[lv], np.nan)
+            image = ax.imshow(img, origin="lower", extent=extent, cmap=cmap, vmin=lo, vmax=max(hi, lo + 1e-6),
+                              interpolation="nearest", zorder=0)
+        handles = []
+        if lv == 0:
+            handles = _left_out_layers(ax, result, hf, surface, extent, PolyCollection, Patch, steep_faces, too_small,
+                                       low_headroom, unreachable)
+        sel = walls.level == lv
+        seg = walls.segments[sel]
+        ax.add_collection(LineCollection(seg, colors="#202020", linewidths=1.2, zorder=3))
+        if len(seg):
+            mid = seg.mean(axis=1)
+            tick = 0.012 * max(w, h)
+            ax.add_collection(LineCollection(np.stack([mid, mid + walls.normals[sel] * tick], axis=1),
+                                             colors="#d04020", linewidths=0.7, zorder=3))
+        if walls.aux is not None:
+            ax.add_collection(LineCollection(walls.aux, colors="#4060c0", linewidths=0.9, linestyles="dashed",
+                                             zorder=1))
+        on = _spawns_on_level(result, lv)
+        arrow = 0.03 * max(w, h)
+        for k in np.flatnonzero(on):
+            x, z, th = spawns[k, :3]
+            ax.annotate("", xy=(x + arrow * np.cos(th), z + arrow * np.sin(th)), xytext=(x, z),
+                        arrowprops=dict(arrowstyle="-|>", color="#1a7a1a", lw=1.5), zorder=5)
+            ax.plot([x], [z], "o", color="#1a7a1a", ms=4, zorder=5)
+            ax.text(x - 0.45 * arrow * np.cos(th), z - 0.45 * arrow * np.sin(th), str(k + 1), color="#1a7a1a",
+                    fontsize=8, ha="center", va="center", zorder=6)
+        pad = 0.03 * max(w, h)
+        ax.set_xlim(xmin - pad, xmax + pad)
+        ax.set_ylim(zmin - pad, zmax + pad)
+        ax.set_xlabel("x (m)")
+        ax.set_ylabel("z (m)")
+        info = result.levels[lv] if lv < len(result.levels) else None
+        sub = f"level {lv}" + (f": {info.area:,.0f} m^2, y {info.y_lo:.2f}..{info.y_hi:.2f}" if info else "")
+        ax.set_title(sub if L > 1 else f"{title}\n{sub}", fontsize=9)
+        ax.grid(True, lw=0.3, alpha=0.5)
+        if handles:
+            ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.85)
+    if image is not None:
+        fig.colorbar(image, ax=fig.axes, shrink=0.8, label="surface height y (m)")
+    if L > 1:
+        fig.suptitle(title, fontsize=10)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", metadata={"Software": None})
+    return buf.getvalue()
+
+
+def shapely_parts(geom: Any) -> list:
+    import shapely
+
+    return [] if geom is None or geom.is_empty else list(shapely.get_parts(geom))
+
+
+def _spawns_on_level(result: Any, level: int) -> np.ndarray:
+    """Which spawns stand on ``level`` (by the tank grid's node under them)."""
+    sp = np.asarray(result.spawns, dtype=np.float64)
+    if len(sp) == 0:
+        return np.zeros(0, dtype=bool)
+    grid = result.grid
+    if grid.levels == 1:
+        return np.full(len(sp), level == 0)
+    node = grid.nodes_of(sp[:, :2])
+    hts = grid.heights()[:, node[:, 0], node[:, 1]]  # (L, k)
+    y = sp[:, 3]
+    best = np.nanargmin(np.where(np.isfinite(hts), np.abs(hts - y[None]), np.inf), axis=0)
+    return best == level
+
+
+def _left_out_layers(ax, result, hf, surface, extent, PolyCollection, Patch, steep_faces, too_small, low_headroom,
+                     unreachable) -> list:
+    """Draw what the surface left out on ``ax``; returns legend handles."""
+    nz, nx = hf.shape
+    handles = []
+    rgba = np.zeros((nz, nx, 4))
+
+    def paint(cols, colour, label, area):
+        if len(cols) == 0:
+            return
+        i, j = np.divmod(cols, nx)
+        c = matplotlib_rgba(colour)
+        rgba[i, j] = (*c[:3], 0.75)
+        handles.append(Patch(color=colour, label=f"{label}: {area:,.0f} m^2"))
+
+    cell2 = hf.cs ** 2
+    other = unreachable(surface, result.grid.clearance, result.vertices, result.faces)
+    paint(surface.col[other], LEFT_OUT_COLOURS["unreachable"], "unreachable", other.sum() * cell2)
+    low = low_headroom(surface, result.vertices, result.faces)
+    paint(hf.col[low], LEFT_OUT_COLOURS["headroom"], "too little headroom", low.sum() * cell2)
+    small = too_small(surface, result.grid.clearance)
+    paint(surface.col[small], LEFT_OUT_COLOURS["small"], "too small for a tank", small.sum() * cell2)
+    if handles:
+        ax.imshow(rgba, origin="lower", extent=extent, interpolation="nearest", zorder=1)
+    for x in result.left_out:
+        if x.reason.startswith("too steep"):
+            break
+    else:
+        return handles
+    vertices = result.vertices
+    if vertices is not None:
+        sel, area = steep_faces(vertices, result.faces, result.params.max_slope)
+        tri = vertices[result.faces[sel]][:, :, [0, 2]]
+        ax.add_collection(PolyCollection(tri, facecolors=LEFT_OUT_COLOURS["steep"], edgecolors="none", alpha=0.6,
+                                         zorder=2))
+        handles.append(Patch(color=LEFT_OUT_COLOURS["steep"], label=f"too steep: {area.sum():,.0f} m^2"))
+    return handles
+
+
+def matplotlib_rgba(colour: str) -> tuple[float, float, float, float]:
+    from matplotlib.colors import to_rgba
+
+    return to_rgba(colour)

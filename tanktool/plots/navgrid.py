@@ -23,8 +23,22 @@ STATE_COLOURS = {
 WALL_COLOUR = "#1b1b1b"
 QUADTREE_COLOUR = "#2f6db5"
 SPAWN_COLOUR = "#d62728"
+#: shades of valid nodes on a grid with relief
+HEIGHT_CMAP = "summer"
 #: annotate nodes only when a node is at least this many points wide
 MIN_LABEL_PT = {"rows": 15.0, "cols": 15.0, "both": 20.0}
+
+
+def level_view(grid: Any, level: int) -> Any:
+    """One level of a grid as a one-level NavGrid (its 2-D arrays)."""
+    from ..nav.navgrid import NavGrid
+
+    if grid.levels == 1:
+        return grid
+    arrays = [grid.layered(k)[level] for k in ("valid", "row_index", "row_total", "col_index", "col_total",
+                                                "reachable")]
+    return NavGrid(grid.origin, grid.cell, grid.shape, *arrays, grid.clearance,
+                   height=grid.heights()[level], link=grid.links()[level])
 
 
 def node_states(grid: Any, free: np.ndarray | None = None) -> np.ndarray:
@@ -39,67 +53,23 @@ def node_states(grid: Any, free: np.ndarray | None = None) -> np.ndarray:
     return s
 
 
-def render_navgrid(
-    grid: Any,
-    walls: Any,
-    *,
-    fmt: str = "png",
-    quadtree: Any = None,
-    free: np.ndarray | None = None,
-    spawns: np.ndarray | None = None,
-    annotate: str = "both",
-    region: np.ndarray | None = None,
-    title: str | None = None,
-    dpi: int = 120,
-) -> bytes:
-    """The picture as PNG or SVG bytes (``fmt``).
-
-    grid : NavGrid; walls : WallList; quadtree : WallQuadtree (its leaves are drawn);
-    free : free-space mask, to tell "too close to a wall" from "solid / outside";
-    spawns : (k, 3) ``[x, z, heading]``; region : ``[[x0, z0], [x1, z1]]`` to zoom in;
-    annotate : "rows" (renglón/total), "cols" (columna/total), "both" or "none".
-    """
-    import matplotlib
-
-    if os.environ.get("DISPLAY") is None:
-        matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+def _draw_panel(ax, grid, walls, free, quadtree, spawns, annotate, view, j0, j1, i0, i1, width_in, across, view_span,
+                relief, plt, title, whole) -> int:
+    """Draw one level's nodes, walls, leaves, spawns and run numbers on ``ax``."""
     from matplotlib.collections import LineCollection
     from matplotlib.colors import ListedColormap
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
     b = grid.bounds
-    view = b.copy() if region is None else np.asarray(region, dtype=np.float64).reshape(2, 2)
-    # the cells the view touches; they decide how big the figure must be for labels
-    j0 = max(0, int(math.floor((view[0, 0] - grid.origin[0]) / grid.cell)))
-    j1 = min(grid.nx, int(math.ceil((view[1, 0] - grid.origin[0]) / grid.cell)))
-    i0 = max(0, int(math.floor((view[0, 1] - grid.origin[1]) / grid.cell)))
-    i1 = min(grid.nz, int(math.ceil((view[1, 1] - grid.origin[1]) / grid.cell)))
-    if region is not None:  # widen a region to whole cells, so no label is cut
-        view = grid.origin + grid.cell * np.array([[j0, i0], [j1, i1]], dtype=np.float64)
-    view_span = float(np.max(view[1] - view[0]))
-    if region is None:
-        pad = 0.02 * view_span
-        view = view + np.array([[-pad], [pad]])
-    across = max(1, j1 - j0)
-    tall = max(1, i1 - i0)
-    aspect = (view[1, 1] - view[0, 1]) / max(view[1, 0] - view[0, 0], 1e-9)
-    want_pt = MIN_LABEL_PT.get(annotate, 0.0) * 1.45
-    width_in = 10.0
-    if annotate != "none" and across <= 80 and tall <= 80:
-        width_in = min(max(width_in, across * want_pt / 72.0), 22.0)
-    height_in = min(max(width_in * aspect, 3.0), 22.0)
-    width_in = min(width_in, 22.0) + 2.6  # room for the legend
-    fig = plt.figure(figsize=(width_in, height_in + 0.8))
-    ax = fig.add_axes((0.06, 0.06, (width_in - 2.6) / width_in * 0.92, 0.86))
-
     states = node_states(grid, free)
     cmap = ListedColormap(list(STATE_COLOURS.values()))
     ax.imshow(
         states, origin="lower", cmap=cmap, vmin=-0.5, vmax=3.5, interpolation="nearest",
         extent=(b[0, 0], b[1, 0], b[0, 1], b[1, 1]), zorder=0,
     )
+    if relief is not None:  # reachable nodes shaded by their height
+        shade = np.where(states == 2, grid.heights()[0], np.nan)
+        ax.imshow(shade, origin="lower", cmap=HEIGHT_CMAP, vmin=relief[0], vmax=max(relief[1], relief[0] + 1e-6),
+                  alpha=0.85, interpolation="nearest", extent=(b[0, 0], b[1, 0], b[0, 1], b[1, 1]), zorder=0)
     cell_pt = (width_in - 2.6) * 0.92 * 72.0 / across
     labelling = annotate != "none" and cell_pt >= MIN_LABEL_PT.get(annotate, 99)
     if cell_pt >= 6:  # node centres and cell edges, when they do not turn into a smear
@@ -163,13 +133,88 @@ def render_navgrid(
     ax.set_ylabel("z [m]")
     n_valid = int(grid.valid.sum())
     n_reach = int((grid.valid & grid.reachable).sum())
-    head = title or "navigation grid"
+    head = title
+    total = whole if whole is not None else grid
+    levels = f", {whole.levels} levels" if whole is not None and whole.levels > 1 else ""
     ax.set_title(
-        f"{head}: {grid.nz} x {grid.nx} nodes, cell {grid.cell:g} m, clearance {grid.clearance:g} m\n"
-        f"{n_valid:,} valid ({n_reach:,} reachable, {n_valid - n_reach:,} unreachable) of {grid.valid.size:,}",
+        f"{head}: {grid.nz} x {grid.nx} nodes{levels}, cell {grid.cell:g} m, clearance {grid.clearance:g} m\n"
+        f"{n_valid:,} valid ({n_reach:,} reachable, {n_valid - n_reach:,} unreachable)"
+        + (f" of {total.valid.size:,}" if whole is not None or total is grid else ""),
         fontsize=10,
     )
+    return labelled
+
+
+def render_navgrid(
+    grid: Any,
+    walls: Any,
+    *,
+    fmt: str = "png",
+    quadtree: Any = None,
+    free: np.ndarray | None = None,
+    spawns: np.ndarray | None = None,
+    annotate: str = "both",
+    region: np.ndarray | None = None,
+    title: str | None = None,
+    dpi: int = 120,
+) -> bytes:
+    """The picture as PNG or SVG bytes (``fmt``).
+
+    grid : NavGrid; walls : WallList; quadtree : WallQuadtree (its leaves are drawn);
+    free : free-space mask, to tell "too close to a wall" from "solid / outside";
+    spawns : (k, 3) ``[x, z, heading]``; region : ``[[x0, z0], [x1, z1]]`` to zoom in;
+    annotate : "rows" (renglón/total), "cols" (columna/total), "both" or "none".
+    """
+    import matplotlib
+
+    if os.environ.get("DISPLAY") is None:
+        matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import ListedColormap
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    b = grid.bounds
+    view = b.copy() if region is None else np.asarray(region, dtype=np.float64).reshape(2, 2)
+    # the cells the view touches; they decide how big the figure must be for labels
+    j0 = max(0, int(math.floor((view[0, 0] - grid.origin[0]) / grid.cell)))
+    j1 = min(grid.nx, int(math.ceil((view[1, 0] - grid.origin[0]) / grid.cell)))
+    i0 = max(0, int(math.floor((view[0, 1] - grid.origin[1]) / grid.cell)))
+    i1 = min(grid.nz, int(math.ceil((view[1, 1] - grid.origin[1]) / grid.cell)))
+    if region is not None:  # widen a region to whole cells, so no label is cut
+        view = grid.origin + grid.cell * np.array([[j0, i0], [j1, i1]], dtype=np.float64)
+    view_span = float(np.max(view[1] - view[0]))
+    if region is None:
+        pad = 0.02 * view_span
+        view = view + np.array([[-pad], [pad]])
+    across = max(1, j1 - j0)
+    tall = max(1, i1 - i0)
+    aspect = (view[1, 1] - view[0, 1]) / max(view[1, 0] - view[0, 0], 1e-9)
+    want_pt = MIN_LABEL_PT.get(annotate, 0.0) * 1.45
+    width_in = 10.0
+    if annotate != "none" and across <= 80 and tall <= 80:
+        width_in = min(max(width_in, across * want_pt / 72.0), 22.0)
+    height_in = min(max(width_in * aspect, 3.0), 22.0)
+    width_in = min(width_in, 22.0) + 2.6  # room for the legend
+    L = grid.levels
+    heights = grid.heights()
+    hv = heights[np.isfinite(heights)]
+    relief = (float(hv.min()), float(hv.max())) if len(hv) and hv.max() - hv.min() > 0.25 else None
+    panel_h = height_in + 0.8
+    fig = plt.figure(figsize=(width_in, panel_h * L))
+    labelled = 0
+    for lv in range(L):
+        top = 1.0 - lv / L
+        ax = fig.add_axes((0.06, top - (0.94 / L), (width_in - 2.6) / width_in * 0.92, 0.86 / L))
+        g = level_view(grid, lv)
+        w = walls.on_level(lv) if getattr(walls, "layered", False) else walls
+        labelled += _draw_panel(ax, g, w, free if L == 1 else None, quadtree, spawns if lv == 0 else None, annotate, view, j0, j1,
+                    i0, i1, width_in, across, view_span, relief, plt,
+                    f"{title or 'navigation grid'}" + (f", level {lv}" if L > 1 else ""), grid if lv == 0 else None)
     handles = [Patch(fc=c, ec="#888888", label=k) for k, c in STATE_COLOURS.items()]
+    if relief is not None:
+        handles[2] = Patch(fc="#6fb36b", ec="#888888", label="valid (shade: height)")
     handles.append(Line2D([], [], color=WALL_COLOUR, lw=1.8, label="wall (tick: free side)"))
     if walls.aux is not None:
         handles.append(Line2D([], [], color=WALL_COLOUR, lw=0.8, ls="--", label="auxiliary rectangle"))
@@ -183,6 +228,12 @@ def render_navgrid(
             "rows": "labels: renglón/total", "cols": "labels: columna/total",
             "both": "labels: renglón/total\n            columna/total"}[annotate]))
     fig.legend(handles=handles, loc="upper right", fontsize=8, frameon=False, bbox_to_anchor=(0.995, 0.93))
+    if relief is not None:
+        import matplotlib.cm as cm
+        from matplotlib.colors import Normalize
+
+        cax = fig.add_axes((0.90, 0.08, 0.015, 0.25))
+        fig.colorbar(cm.ScalarMappable(Normalize(*relief), HEIGHT_CMAP), cax=cax, label="surface y [m]")
     buf = io.BytesIO()
     # SVG keeps its text as text, so run numbers can be searched and selected
     with plt.rc_context({"svg.fonttype": "none"}):

@@ -1,0 +1,66 @@
+"""The bundled vehicles' sizes: the defaults the arena tools take from them.
+
+An arena is built for the tanks that will play on it: the headroom a walkable
+surface needs is the tallest bundled vehicle's height, the clearance of the
+navigation grid and of spawn points the largest footprint radius, and spawns keep a
+tank's length apart.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+#: where the bundled vehicles live in a checkout
+VEHICLES_DIR = Path(__file__).resolve().parents[1] / "vehicles"
+
+
+@dataclass
+class Fleet:
+    """Extremes over the bundled vehicles (each with the vehicle that sets it)."""
+
+    radius: float = 2.0
+    length: float = 4.0
+    height: float = 2.0
+    radius_of: str = "built-in default"
+    length_of: str = "built-in default"
+    height_of: str = "built-in default"
+    names: list[str] = field(default_factory=list)
+
+
+def bundled_fleet(folder: Path | None = None, warn: Callable[[str], None] | None = None) -> Fleet:
+    """The largest footprint radius, length and height over the vehicle bundles in
+    ``folder`` (default the bundled ones); a broken bundle is skipped with a warning."""
+    from .formats.vehicle_bundle import load_vehicle
+
+    fleet = Fleet()
+    found = False
+    for vt in sorted((folder or VEHICLES_DIR).glob("*/vehicle.toml")):
+        try:
+            v = load_vehicle(vt.parent)
+        except Exception as e:  # a broken vehicle must not stop the arena tools
+            if warn is not None:
+                warn(f"{vt}: skipped for the arena defaults ({e})")
+            continue
+        hull = np.asarray(v.hull, dtype=np.float64)
+        r = float(v.footprint_radius)
+        length = float(hull[:, 0].max() - hull[:, 0].min())
+        height = float(hull[:, 1].max() - hull[:, 1].min())
+        if not all(math.isfinite(a) and a > 0 for a in (r, length, height)):
+            continue
+        if not found:
+            fleet = Fleet(r, length, height, v.name, v.name, v.name)
+            found = True
+        else:
+            if r > fleet.radius:
+                fleet.radius, fleet.radius_of = r, v.name
+            if length > fleet.length:
+                fleet.length, fleet.length_of = length, v.name
+            if height > fleet.height:
+                fleet.height, fleet.height_of = height, v.name
+        fleet.names.append(v.name)
+    return fleet

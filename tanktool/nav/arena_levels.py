@@ -1,0 +1,242 @@
+"""An arena's levels from its triangles: walkable surface, walls, spawns and the report.
+
+The one place ``import-arena`` asks "where can a tank be?":
+
+1. the walkable surface (:mod:`tanktool.nav.walkable`) on a grid over the model;
+2. its walls per level and region (:mod:`tanktool.nav.level_walls`);
+3. a navigation grid at the largest bundled tank's footprint radius, measured to
+   those walls exactly: where that tank fits;
+4. spawn points where it fits, on the largest part of the grid it can drive around
+   in, at least a tank's length apart (tanktool.geometry.spawns);
+5. per level its area and height range, and what was left out and why
+   (:mod:`tanktool.nav.surface_report`).
+
+A model where no tank fits anywhere is refused (ArenaError).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+import shapely
+
+from ..errors import ArenaError
+from ..fleet import Fleet
+from ..geometry.spawns import SPAWN_CLEARANCE, SPAWN_COUNT, facing_centre, spawn_candidates, spread
+from .level_walls import LevelWalls, level_walls
+from .navgrid import NavGrid, on_wall_tolerance, too_close
+from .surface_report import LeftOut, left_out
+from .walkable import Surface, WalkableParams, walkable_surface
+
+#: spawn points keep this much more than the footprint radius from walls (m)
+SPAWN_MARGIN = 0.25
+#: stages reported to a progress callback
+STAGES = ("surface", "walls", "grid", "spawns", "report")
+
+
+@dataclass
+class LevelInfo:
+    level: int
+    area: float
+    y_lo: float
+    y_hi: float
+    regions: int
+
+
+@dataclass
+class ArenaLevels:
+    surface: Surface
+    params: WalkableParams
+    walls: LevelWalls
+    grid: NavGrid  # valid where the largest bundled tank fits
+    spawns: np.ndarray  # (k, 4) x, z, heading, y
+    levels: list[LevelInfo]
+    left_out: list[LeftOut]
+    floor_y: float
+    flat: bool  # one level, one region, one floor height: the 2002 case
+    vertices: np.ndarray | None = None  # the model (world frame), for pictures of steep faces
+    faces: np.ndarray | None = None
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def free(self):
+        return self.walls.free()
+
+
+def walls_too_close(walls, origin: np.ndarray, cell: float, shape: tuple[int, int], levels: int,
+                    clearance: float) -> np.ndarray:
+    """(L, nz, nx): nodes closer than ``clearance`` to a wall of their own level."""
+    tol = on_wall_tolerance(walls.bounds)
+    out = np.zeros((levels, *shape), dtype=bool)
+    for lv in range(levels):
+        seg = walls.segments[walls.level == lv]
+        out[lv] = too_close(seg, origin, cell, shape, clearance, tol=tol)
+    return out
+
+
+def tank_grid(surface: Surface, lw: LevelWalls, radius: float) -> NavGrid:
+    """The grid of nodes where a tank of ``radius`` fits (exact distance to the walls)."""
+    from .walkable import grid_from_surface
+
+    origin = surface.hf.origin[[0, 2]]
+    tc = walls_too_close(lw.walls, origin, surface.hf.cs, surface.shape, max(surface.levels, 1), radius)
+    return grid_from_surface(surface, radius, origin, too_close=tc)
+
+
+def _components(grid: NavGrid) -> tuple[np.ndarray, int]:
+    """Component labels (L, nz, nx) of a grid's valid nodes over its links (0: none)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from .navgrid import STEPS
+
+    valid = grid.layered("valid")
+    link = grid.links()
+    L, nz, nx = valid.shape
+    ids = np.full(valid.shape, -1, dtype=np.int64)
+    pts = np.nonzero(valid)
+    ids[pts] = np.arange(len(pts[0]))
+    src, dst = [], []
+    for d, (di, dj) in enumerate(STEPS.values()):
+        l_, i_, j_ = pts
+        t = link[l_, i_, j_, d].astype(np.int64)
+        ok = t >= 0
+        src.append(ids[l_[ok], i_[ok], j_[ok]])
+        dst.append(ids[t[ok], i_[ok] + di, j_[ok] + dj])
+    s, t = np.concatenate(src), np.concatenate(dst)
+    good = t >= 0
+    n = len(pts[0])
+    g = coo_matrix((np.ones(int(good.sum()), dtype=np.int8), (s[good], t[good])), shape=(n, n))
+    k, lab = connected_components(g, directed=True, connection="weak")
+    labels = np.zeros(valid.shape, dtype=np.int64)
+    labels[pts] = lab + 1
+    return labels, int(k)
+
+
+def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarray,
+                  count: int = SPAWN_COUNT) -> np.ndarray:
+    """Spawn points ``[x, z, heading, y]`` where the largest tank fits (see the module
+    docstring); the clearance is the radius plus SPAWN_MARGIN, at least SPAWN_CLEARANCE
+    when that leaves ``count`` candidates."""
+    labels, k = _components(grid)
+    if k == 0:
+        raise ArenaError("no place where the largest bundled tank fits")
+    sizes = np.bincount(labels.ravel(), minlength=k + 1)
+    sizes[0] = 0
+    best = int(np.argmax(sizes))
+    height = grid.heights()
+    floor_c = fleet.radius + SPAWN_MARGIN
+    chosen = None
+    for c in sorted({max(SPAWN_CLEARANCE, floor_c), floor_c}, reverse=True):
+        pts, ys = [], []
+        for r in lw.regions:
+            cand = spawn_candidates(r.free, c)
+            if len(cand) == 0:
+                continue
+            node = grid.nodes_of(cand)
+            lab = labels[r.level, node[:, 0], node[:, 1]]
+            keep = lab == best
+            pts.append(cand[keep])
+            ys.append(height[r.level, node[keep, 0], node[keep, 1]])
+        pts = np.concatenate(pts) if pts else np.zeros((0, 2))
+        ys = np.concatenate(ys) if ys else np.zeros(0)
+        chosen = (pts, ys)
+        if len(pts) >= count:
+            break
+    pts, ys = chosen
+    if len(pts) == 0:
+        raise ArenaError(f"no place where the largest bundled tank fits: {fleet.radius_of} (footprint radius "
+                         f"{fleet.radius:.2f} m) needs {floor_c:.2f} m from every wall for a spawn point")
+    region = shapely.union_all([r.free for r in lw.regions])
+    start = np.asarray(shapely.get_coordinates(shapely.centroid(region))[0])
+    idx = spread(pts, count, fleet.length, start)
+    p = pts[idx]
+    return np.column_stack([p, facing_centre(p, bounds), ys[idx]])
+
+
+def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParams, fleet: Fleet,
+                  cut_height: float = 1.0, tolerance: float = 0.01, spawn_count: int = SPAWN_COUNT,
+                  progress: Callable[[str], None] | None = None) -> ArenaLevels:
+    """Everything ``import-arena`` needs to know about a model's levels (module docstring)."""
+    step = progress or (lambda _s: None)
+    vertices = np.asarray(vertices, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    if len(faces) == 0:
+        raise ArenaError("the model has no triangles")
+    if not np.isfinite(vertices).all():
+        raise ArenaError("the model has non-finite vertices (NaN or inf)")
+    t = {}
+    t0 = time.perf_counter()
+    surface = walkable_surface(vertices, faces, params, fleet.radius)
+    t["surface"] = time.perf_counter() - t0
+    step("surface")
+    if not surface.main.any():
+        raise ArenaError(
+            f"no surface a tank can stand on: every upward face is steeper than {params.max_slope:g} deg, "
+            f"has less than {params.headroom:g} m headroom or is narrower than a cell "
+            f"(is the up axis right? try --up; the scale? try --scale)")
+    t0 = time.perf_counter()
+    lw = level_walls(surface, vertices, faces, cut_height, params.headroom, params.climb, tolerance,
+                     params.max_slope)
+    t["walls"] = time.perf_counter() - t0
+    step("walls")
+    t0 = time.perf_counter()
+    grid = tank_grid(surface, lw, fleet.radius)
+    t["grid"] = time.perf_counter() - t0
+    step("grid")
+    if not grid.valid.any():
+        widest = 2 * float(np.nanmax(np.where(surface.main, surface.clearance, 0.0)))
+        raise ArenaError(
+            f"no place where the largest bundled tank fits: {fleet.radius_of} needs a circle of "
+            f"{2 * fleet.radius:.2f} m, the walkable surface's widest spot is about {widest:.2f} m across "
+            f"(wrong --scale?)")
+    t0 = time.perf_counter()
+    spawns = choose_spawns(lw, grid, fleet, lw.walls.bounds, spawn_count)
+    t["spawns"] = time.perf_counter() - t0
+    step("spawns")
+    t0 = time.perf_counter()
+    levels = []
+    cell2 = surface.hf.cs ** 2
+    for lv in range(surface.levels):
+        m = surface.level == lv
+        ys = surface.y[m]
+        levels.append(LevelInfo(lv, float(m.sum() * cell2), float(ys.min()), float(ys.max()),
+                                sum(1 for r in lw.regions if r.level == lv)))
+    report = left_out(surface, vertices, faces, params, fleet.radius)
+    flat = len(lw.regions) == 1 and lw.regions[0].y_hi - lw.regions[0].y_lo <= params.cell_height + 1e-9
+    floor_y = _floor_y(lw, surface)
+    t["report"] = time.perf_counter() - t0
+    step("report")
+    return ArenaLevels(surface, params, lw, grid, spawns, levels, report, floor_y, flat, vertices, faces, t)
+
+
+def _floor_y(lw: LevelWalls, surface: Surface) -> float:
+    """The arena's main floor: the height of the largest exact flat floor of level 0
+    (the 2002 floor on a flat arena), else the lowest walkable height."""
+    flat = [(area, h) for r in lw.regions if r.level == 0 for h, area in r.flat_heights]
+    if flat:
+        return float(max(flat)[1])
+    return float(np.min(surface.y[surface.main]))
+
+
+def spawn_y_needed(result: ArenaLevels) -> bool:
+    """Whether spawns need their height written (anything but one flat floor)."""
+    return not (result.flat and len(result.levels) == 1)
+
+
+def describe_levels(result: ArenaLevels) -> list[str]:
+    """The report's lines: each level, then what was left out."""
+    lines = []
+    for lv in result.levels:
+        span = f"y {lv.y_lo:.2f}" if math.isclose(lv.y_lo, lv.y_hi, abs_tol=0.005) else f"y {lv.y_lo:.2f} .. {lv.y_hi:.2f}"
+        regions = f", {lv.regions} regions" if lv.regions > 1 else ""
+        lines.append(f"  level {lv.level}: {lv.area:,.0f} m^2 at {span}{regions}")
+    if result.left_out:
+        lines.append("  left out: " + "; ".join(x.describe() for x in result.left_out))
+    else:
+        lines.append("  left out: nothing")
+    return lines

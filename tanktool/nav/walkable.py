@@ -1,0 +1,403 @@
+"""Walkable surfaces: from the voxel heightfield to connected, layered open spans.
+
+After :mod:`tanktool.geometry.heightfield` has rasterised and filtered the solid spans,
+this module does what Recast's compact heightfield does:
+
+* every walkable span becomes an *open span*: its floor is the span's top, its ceiling
+  the bottom of the next span up (open sky above the highest);
+* two open spans of neighbouring columns are *linked* when a tank can pass from one
+  to the other: the floors differ by at most the climb and the overlap of the two open
+  intervals is at least the headroom (the lowest such span of the neighbour column);
+* a span's *clearance* is its distance to the nearest edge of walkable space (a side
+  of a span without a link), measured along the links with Recast's chamfer weights
+  (2 a straight step, 3 a diagonal one, in half cells) from half a cell at the edge;
+* connected *regions* are the components of the link graph; the region the arena is
+  played on is the largest (or the one holding given seed points);
+* the spans of that region are stacked into *levels*: a span's level is the number of
+  the region's spans below it in its column (0 on the ground, 1 on a deck over a
+  passage, ...), so that each level holds at most one span a column.
+
+Everything is numpy over spans; the links are found by pairing each span with the
+spans of its neighbour column.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ArenaError
+from ..geometry.heightfield import OPEN, Heightfield, build_heightfield, column_starts, neighbour_columns
+
+#: the four link directions as (di, dj) on the grid: +x, +z, -x, -z (navgrid.STEPS order)
+DIRS = ((0, 1), (1, 0), (0, -1), (-1, 0))
+
+#: defaults for tanks: slopes a tank climbs, steps it drives over; headroom defaults to
+#: the tallest bundled vehicle (tanktool.fleet)
+MAX_SLOPE = 35.0
+CLIMB = 0.9
+CELL_HEIGHT = 0.1
+
+
+@dataclass
+class WalkableParams:
+    """How walkable surfaces are found (metres and degrees).
+
+    cell : voxel and navigation-grid cell size;  cell_height : voxel height
+    max_slope : steepest walkable face;  climb : highest step between neighbours
+    headroom : free height a span needs above it
+    """
+
+    cell: float = 0.5
+    cell_height: float = CELL_HEIGHT
+    max_slope: float = MAX_SLOPE
+    climb: float = CLIMB
+    headroom: float = 2.0
+
+    def check(self) -> "WalkableParams":
+        """Raise ArenaError naming the option when a value is absurd."""
+        def bad(name: str, value: float, lo: float, hi: float, open_lo: bool = True) -> None:
+            ok = math.isfinite(value) and (value > lo if open_lo else value >= lo) and value <= hi
+            if not ok:
+                raise ArenaError(f"--{name} must be {'>' if open_lo else '>='} {lo:g} and <= {hi:g}, got {value:g}")
+        bad("cell", self.cell, 0.0, 50.0)
+        bad("cell-height", self.cell_height, 0.0, 10.0)
+        bad("max-slope", self.max_slope, 0.0, 89.0)
+        bad("climb", self.climb, 0.0, 100.0, open_lo=False)
+        bad("headroom", self.headroom, 0.0, 1000.0)
+        if self.cell_height > max(self.headroom, 1e-9) / 3:
+            raise ArenaError(f"--cell-height {self.cell_height:g} is too coarse for a headroom of "
+                             f"{self.headroom:g} m (at most a third of it)")
+        return self
+
+    def as_toml(self) -> dict[str, float]:
+        return {"cell": float(self.cell), "cell_height": float(self.cell_height), "max_slope": float(self.max_slope),
+                "climb": float(self.climb), "headroom": float(self.headroom)}
+
+    def describe(self) -> str:
+        return (f"cell {self.cell:g} m, cell height {self.cell_height:g} m, max slope {self.max_slope:g} deg, "
+                f"climb {self.climb:g} m, headroom {self.headroom:g} m")
+
+
+@dataclass
+class Surface:
+    """Open spans (one per walkable span) of a heightfield, sorted by (column, floor).
+
+    col : (n,) column ``i * nx + j``;  floor / ceil : (n,) in cell-height steps
+    link : (n, 4) index of the linked span in each direction (DIRS), -1 for none
+    clearance : (n,) metres to the nearest edge (capped at ``max_clearance``)
+    region : (n,) component label;  main : (n,) in the played region
+    level : (n,) the span's level among the main region's spans (-1 outside it)
+    """
+
+    hf: Heightfield
+    col: np.ndarray
+    floor: np.ndarray
+    ceil: np.ndarray
+    link: np.ndarray
+    clearance: np.ndarray
+    region: np.ndarray
+    main: np.ndarray
+    level: np.ndarray
+    max_clearance: float
+    stats: dict = field(default_factory=dict)
+    height: np.ndarray | None = None
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.hf.shape
+
+    @property
+    def levels(self) -> int:
+        return int(self.level.max()) + 1 if (self.level >= 0).any() else 0
+
+    @property
+    def y(self) -> np.ndarray:
+        """World height of each span's floor: the height of the horizontal faces it
+        stands on where there are any (exact), else the middle of its top voxel step
+        (within half a cell height)."""
+        if self.height is not None:
+            return self.height
+        return self.hf.origin[1] + (self.floor - 0.5) * self.hf.ch
+
+    def ij(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.divmod(self.col, self.hf.shape[1])
+
+
+def link_spans(col: np.ndarray, floor: np.ndarray, ceil: np.ndarray, shape: tuple[int, int],
+               headroom: int, climb: int) -> np.ndarray:
+    """(n, 4) links between open spans (see the module docstring); steps in cells.
+
+    The spans of each neighbour column are tried k-th by k-th, lowest first; a span's
+    link is the first that fits.
+    """
+    nz, nx = shape
+    n = len(col)
+    start = column_starts(col, nz * nx)
+    count = np.diff(start)
+    link = np.full((n, 4), -1, dtype=np.int64)
+    for d, ncol in enumerate(neighbour_columns(col, shape)):
+        off = ncol < 0
+        nc = np.where(off, 0, ncol)
+        cnt = np.where(off, 0, count[nc])
+        first = start[nc]
+        out = link[:, d]
+        idx = np.arange(n)
+        k = 0
+        while True:
+            idx = idx[cnt[idx] > k]
+            if not len(idx):
+                break
+            kk = first[idx] + k
+            f0, f1 = floor[idx], floor[kk]
+            ok = (np.minimum(ceil[idx], ceil[kk]) - np.maximum(f0, f1) >= headroom) & (np.abs(f1 - f0) <= climb)
+            out[idx[ok]] = kk[ok]
+            idx = idx[~ok]
+            k += 1
+    return link
+
+
+def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
+    """Chamfer distance (half cells) from each span to the nearest edge of walkable space.
+
+    A span with a side lacking a link is half a cell (1) from the edge; a straight step
+    costs 2, a diagonal one 3 (through either of its two straight paths, both links
+    present).  Values stop growing at ``limit``: only whether a span is that far
+    matters, and the relaxation needs about limit / 2 rounds.
+    """
+    n = len(link)
+    dist = np.where((link < 0).any(axis=1), 1, limit).astype(np.int32)
+    if n == 0:
+        return dist
+    # index n is a sentinel at distance 0: a missing link leads off the edge
+    safe = [np.ascontiguousarray(np.where(link[:, d] < 0, n, link[:, d])) for d in range(4)]
+    ext_safe = [np.append(a, n) for a in safe]
+    diag = []
+    for d in range(4):
+        e = (d + 1) % 4
+        diag.append(np.minimum(ext_safe[e][safe[d]], n) if True else None)
+        diag.append(ext_safe[d][safe[e]])
+    ext = np.zeros(n + 1, dtype=np.int32)
+    for _ in range(limit // 2 + 2):
+        ext[:n] = dist
+        new = dist.copy()
+        for a in safe:
+            np.minimum(new, ext[a] + 2, out=new)
+        for a in diag:
+            np.minimum(new, ext[a] + 3, out=new)
+        if np.array_equal(new, dist):
+            break
+        dist = new
+    return dist
+
+
+def components(link: np.ndarray) -> np.ndarray:
+    """Connected-component label of each span over its links."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    n = len(link)
+    src = np.repeat(np.arange(n), 4)
+    dst = link.reshape(-1)
+    ok = dst >= 0
+    graph = coo_matrix((np.ones(int(ok.sum()), dtype=np.int8), (src[ok], dst[ok])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    return label.astype(np.int64)
+
+
+def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = None, rounds: int = 64) -> np.ndarray:
+    """Level of each kept span: first how many kept spans lie below it in its column;
+    then, round by round, a span moves to the level most of its linked neighbours are
+    on when that level is free in its column (the deck over a pillar joins the deck
+    over the passage instead of standing alone on level 0)."""
+    level = np.full(len(col), -1, dtype=np.int64)
+    idx = np.flatnonzero(keep)
+    if len(idx) == 0:
+        return level
+    c = col[idx]
+    first = np.ones(len(c), dtype=bool)
+    first[1:] = c[1:] != c[:-1]
+    start = np.flatnonzero(first)
+    level[idx] = np.arange(len(c)) - np.repeat(start, np.diff(np.append(start, len(c))))
+    if link is None or level.max() == 0:
+        return level
+    lv = np.append(level, -1)
+    nb = np.where(link[idx] >= 0, link[idx], len(level))
+    col_rank = np.searchsorted(np.unique(c), c)
+    for _ in range(rounds):
+        nl = lv[nb]  # (k, 4) levels of the linked neighbours
+        cur = lv[idx]
+        votes = np.stack([(nl == nl[:, d:d + 1]).sum(axis=1) for d in range(4)], axis=1)
+        votes = np.where(nl >= 0, votes, -1)
+        best = np.take_along_axis(nl, votes.argmax(axis=1)[:, None], axis=1)[:, 0]
+        mine = (nl == cur[:, None]).sum(axis=1)
+        top = votes.max(axis=1)
+        # more neighbours there, or as many and it is the higher level (a tie at the
+        # corner of a deck's patch over a pillar resolves upwards)
+        move = (best >= 0) & (best != cur) & ((top > mine) | ((top == mine) & (best > cur)))
+        if not move.any():
+            break
+        # the new level must be free in the column: no other kept span there holds it,
+        # and of two spans of one column moving to the same level in a round, neither does
+        cand = np.flatnonzero(move)
+        key = col_rank * 256 + np.where(move, best, cur)
+        taken = np.zeros(len(idx), dtype=bool)
+        uniq, counts = np.unique(key, return_counts=True)
+        taken[cand] = counts[np.searchsorted(uniq, key[cand])] > 1
+        ok = cand[~taken[cand]]
+        if len(ok) == 0:
+            break
+        lv[idx[ok]] = best[ok]
+    level = lv[:-1]
+    # levels numbered from 0 without gaps, in order of height
+    used = np.unique(level[idx])
+    remap = np.full(int(used.max()) + 1, -1)
+    remap[used] = np.arange(len(used))
+    level[idx] = remap[level[idx]]
+    return level
+
+
+def walkable_surface(vertices: np.ndarray, faces: np.ndarray, params: WalkableParams, clearance: float,
+                     origin_xz=None, shape=None, seeds: np.ndarray | None = None) -> Surface:
+    """Triangles to surface in one call: :func:`build_heightfield` then
+    :func:`build_surface`."""
+    from ..geometry.heightfield import flat_heights
+
+    hf = build_heightfield(vertices, faces, params.cell, params.cell_height, params.max_slope, params.headroom,
+                           params.climb, origin_xz, shape)
+    surface = build_surface(hf, params.headroom, params.climb, clearance, seeds)
+    surface.height = snap_heights(surface, flat_heights(np.asarray(vertices, dtype=np.float64), faces)[0])
+    return surface
+
+
+def snap_heights(surface: Surface, flat: np.ndarray) -> np.ndarray:
+    """Span floors as heights: a flat span's top voxel step [top - ch, top) holds the
+    height of the horizontal faces it stands on, found among ``flat`` (sorted cluster
+    heights); other spans get the middle of that step."""
+    hf = surface.hf
+    top = hf.origin[1] + surface.floor * hf.ch
+    y = top - 0.5 * hf.ch
+    if len(flat) == 0 or len(top) == 0:
+        return y
+    w = np.flatnonzero(hf.walkable)
+    is_flat = hf.flat[w]
+    k = np.searchsorted(flat, top + 1e-9, side="right") - 1  # the highest cluster at or below the top
+    ok = is_flat & (k >= 0)
+    h = flat[np.maximum(k, 0)]
+    ok &= h >= top - hf.ch - 1e-9
+    return np.where(ok, h, y)
+
+
+def build_surface(hf: Heightfield, headroom: float, climb: float, max_clearance: float,
+                  seeds: np.ndarray | None = None) -> Surface:
+    """Open spans, links, clearance, regions and levels of a filtered heightfield.
+
+    ``seeds`` (k, 2) world (x, z) points: the played region is the one holding the
+    span nearest each (all such regions); default the largest region.
+    """
+    head = int(math.ceil(headroom / hf.ch - 1e-9))
+    clim = int(math.floor(climb / hf.ch + 1e-9))
+    w = hf.walkable
+    ceil_all = hf.ceiling()
+    col, floor, ceil = hf.col[w], hf.smax[w], np.minimum(ceil_all[w], OPEN)
+    link = link_spans(col, floor, ceil, hf.shape, head, clim)
+    limit = int(math.ceil(2 * max_clearance / hf.cs)) + 2
+    dist = chamfer_clearance(link, limit)
+    clearance = np.where(dist >= limit, np.inf, dist * hf.cs / 2)
+    region = components(link) if len(col) else np.zeros(0, dtype=np.int64)
+    main = _main_region(hf, col, floor, region, seeds)
+    level = stack_levels(col, main, link)
+    return Surface(hf, col, floor, ceil, link, clearance, region, main, level, float(max_clearance),
+                   {"climb_steps": clim, "headroom_steps": head})
+
+
+def _main_region(hf: Heightfield, col, floor, region, seeds) -> np.ndarray:
+    if len(col) == 0:
+        return np.zeros(0, dtype=bool)
+    if seeds is not None and len(seeds):
+        nz, nx = hf.shape
+        s = np.asarray(seeds, dtype=np.float64).reshape(-1, 2)
+        sj = np.clip(np.floor((s[:, 0] - hf.origin[0]) / hf.cs), 0, nx - 1).astype(np.int64)
+        si = np.clip(np.floor((s[:, 1] - hf.origin[2]) / hf.cs), 0, nz - 1).astype(np.int64)
+        i, j = np.divmod(col, nx)
+        picked = []
+        for a, b in zip(si, sj):
+            d = (i - a) ** 2 + (j - b) ** 2
+            picked.append(region[int(np.argmin(d))])
+        return np.isin(region, picked)
+    sizes = np.bincount(region)
+    return region == int(np.argmax(sizes))
+
+
+def surface_layers(surface: Surface) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The main region's spans as ``(L, nz, nx)`` layers: (node exists, height, voxel
+    clearance in metres, span index or -1)."""
+    nz, nx = surface.shape
+    L = max(surface.levels, 1)
+    exists = np.zeros((L, nz, nx), dtype=bool)
+    height = np.full((L, nz, nx), np.nan)
+    clear = np.zeros((L, nz, nx))
+    span = np.full((L, nz, nx), -1, dtype=np.int64)
+    m = np.flatnonzero(surface.level >= 0)
+    i, j = np.divmod(surface.col[m], nx)
+    lv = surface.level[m]
+    exists[lv, i, j] = True
+    height[lv, i, j] = surface.y[m]
+    clear[lv, i, j] = surface.clearance[m]
+    span[lv, i, j] = m
+    return exists, height, clear, span
+
+
+def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray, seeds: np.ndarray | None = None,
+                      too_close: np.ndarray | None = None):
+    """The layered navigation grid of a surface (cell = the heightfield's cell).
+
+    A node is valid where the main region has a span whose clearance (the voxel
+    chamfer distance, or, when ``too_close`` (L, nz, nx) is given, the exact distance to
+    the level's walls) is at least ``clearance``.  ``seeds`` (k, 2+) spawn points
+    ``[x, z, ...]`` mark the reachable nodes (all valid nodes when None).
+    """
+    from .navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3
+
+    exists, height, clear, span = surface_layers(surface)
+    if too_close is None:
+        valid = exists & (clear >= clearance)
+    else:
+        valid = exists & ~too_close
+    L, nz, nx = valid.shape
+    link = np.full((L, nz, nx, 4), -1, dtype=np.int8)
+    lv_of = np.append(surface.level, -1)  # span -1 (no link) -> level -1
+    for d, (di, dj) in enumerate(DIRS):
+        l_, i_, j_ = np.nonzero(valid)
+        t = surface.link[span[l_, i_, j_], d]
+        tl = lv_of[t]
+        ii, jj = i_ + di, j_ + dj
+        ok = tl >= 0
+        ok[ok] = valid[tl[ok], ii[ok], jj[ok]]
+        link[l_[ok], i_[ok], j_[ok], d] = tl[ok]
+    ri, rt, ci, ct = layered_runs(valid, link)
+    cell = surface.hf.cs
+    seeds_n: list = []
+    if seeds is not None and len(seeds):
+        reach = int(math.ceil(clearance / cell)) + 2
+        for sp in np.asarray(seeds, dtype=np.float64).reshape(len(seeds), -1):
+            node = (int(np.clip(math.floor((sp[1] - origin_xz[1]) / cell), 0, nz - 1)),
+                    int(np.clip(math.floor((sp[0] - origin_xz[0]) / cell), 0, nx - 1)))
+            y = float(sp[3]) if len(sp) > 3 and math.isfinite(sp[3]) else None
+            n = nearest_valid_node3(valid, height, node, y, reach)
+            if n is not None:
+                seeds_n.append(n)
+        reachable = layered_reachable(valid, link, seeds_n) if seeds_n else np.zeros_like(valid)
+    else:
+        reachable = valid.copy()
+    height = np.where(valid, height, np.nan)
+    arrays = [valid, ri, rt, ci, ct, reachable]
+    if L == 1:
+        arrays = [a[0] for a in arrays]
+        height, link = height[0], link[0]
+    grid = NavGrid(np.asarray(origin_xz, dtype=np.float64), float(cell), (nz, nx), *arrays, float(clearance),
+                   height=height, link=link)
+    grid.spawn_nodes = [n[1:] if L == 1 else n for n in seeds_n]
+    return grid
