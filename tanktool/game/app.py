@@ -60,12 +60,10 @@ def display_problem() -> str | None:
 
 
 def bundled(kind: str) -> list[str]:
-    """Names of the bundled arenas or vehicles."""
-    from ..sim.match import REPO
+    """Names of the bundled arenas or vehicles (in the package or the checkout)."""
+    from ..content import bundled_names
 
-    base = REPO / kind
-    manifest = "arena.toml" if kind == "arenas" else "vehicle.toml"
-    return sorted(d.name for d in base.iterdir() if (d / manifest).is_file()) if base.is_dir() else []
+    return bundled_names(kind)
 
 
 @dataclass

@@ -429,3 +429,96 @@ def excess_volume(centers: np.ndarray, radii: np.ndarray, inside, samples: int =
     if solid == 0:
         return float("inf")
     return float(np.sum(in_spheres & ~in_model)) / solid
+
+
+#: a refitted triangle is at most this fraction of the smallest leaf's radius long
+_COVER_EDGE = 0.25
+#: ... unless that makes more triangles than this (then they are longer)
+_COVER_TRIANGLES = 200_000
+
+
+def _split_long_triangles(vertices: np.ndarray, faces: np.ndarray,
+                          max_edge: float) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (n, 3) and triangles (m, 3) covering the same surface, each long
+    triangle halved across its longest edge until every edge is at most ``max_edge``
+    (a sliver becomes a row of pieces, not a grid of them).  Midpoints are new
+    vertices of their own: the pieces need not share them to cover the triangle."""
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    verts, done = [v], []
+    n = len(v)
+    for _ in range(64):
+        allv = np.concatenate(verts) if len(verts) > 1 else verts[0]
+        verts = [allv]
+        t = allv[f]
+        edges = np.linalg.norm(np.roll(t, -1, axis=1) - t, axis=2)       # edge i: corner i -> i+1
+        long = edges.max(axis=1) > max_edge
+        done.append(f[~long])
+        f, edges = f[long], edges[long]
+        if not len(f):
+            break
+        i = np.argmax(edges, axis=1)
+        rows = np.arange(len(f))
+        a, b, c = f[rows, i], f[rows, (i + 1) % 3], f[rows, (i + 2) % 3]
+        m = n + np.arange(len(f))
+        verts.append((allv[a] + allv[b]) / 2)
+        n += len(f)
+        f = np.concatenate([np.stack([a, m, c], axis=1), np.stack([m, b, c], axis=1)])
+    done.append(f)
+    return np.concatenate(verts), np.concatenate(done)
+
+
+def cover_surface(tree: SphereTree, vertices: np.ndarray, faces: np.ndarray, seed: int = 0) -> SphereTree:
+    """The tree refitted to hold the model's whole surface, not only the points it was
+    built on (vertices and surface samples: a triangle whose corners fall in different
+    leaves may bulge out between them).
+
+    Each triangle (the long ones halved first, to a quarter of the smallest leaf radius)
+    is given to one leaf: among the leaves whose sphere holds its three corners the one
+    whose centre is nearest, else the leaf it sticks out of least.  Then every sphere
+    becomes the minimum sphere of the corners of the triangles given to its subtree.
+    A ball is convex, so holding a triangle's corners is holding the triangle: every
+    point of the surface is in a leaf and in all the leaf's ancestors.  A leaf that is
+    given no triangle (its part lies wholly in its neighbours) keeps its sphere.  The
+    tree's shape (ids, parents, levels) does not change.
+    """
+    leaves = tree.leaves()
+    C, R = tree.centers[leaves], tree.radii[leaves]
+    v0 = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    f0 = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    span = float(np.ptp(v0, axis=0).max()) if len(v0) else 1.0
+    span = span or 1.0
+    positive = R[R > 1e-9 * span]
+    edge = _COVER_EDGE * (float(positive.min()) if len(positive) else span)
+    t = v0[f0]
+    area = 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum()
+    # a piece of edge e has about e^2 / 2.5 of area at least: keep the count bounded
+    edge = max(edge, float(np.sqrt(area / (_COVER_TRIANGLES * 0.4))), 1e-9 * span)
+    v, f = _split_long_triangles(v0, f0, edge)
+    # distance of every vertex from every leaf's centre, and how far it sticks out
+    dist = np.empty((len(v), len(leaves)))
+    for k in range(len(leaves)):
+        dist[:, k] = np.sqrt(np.sum((v - C[k]) ** 2, axis=1))
+    owner = np.empty(len(f), dtype=np.int64)
+    step = max(1, 3_000_000 // max(3 * len(leaves), 1))
+    rr = np.maximum(R, 1e-12 * span)
+    for s0 in range(0, len(f), step):
+        d = dist[f[s0:s0 + step]]                                   # (k, 3, L)
+        out = (d - R[None, None]).max(axis=1)                       # (k, L) stick-out
+        holds = out <= 1e-12 * span
+        near = d.mean(axis=1) / rr[None]                            # nearness, in radii
+        owner[s0:s0 + step] = np.where(holds.any(axis=1), np.argmin(np.where(holds, near, np.inf), axis=1),
+                                       np.argmin(out, axis=1))
+    # the vertices given to each sphere: a leaf's own, and every node's through its leaves
+    given: dict[int, list[np.ndarray]] = {}
+    for k, leaf in enumerate(leaves):
+        mine = np.unique(f[owner == k])
+        if not len(mine):
+            continue
+        for node in tree.ancestors(int(leaf)):
+            given.setdefault(int(node), []).append(mine)
+    centers, radii = tree.centers.copy(), tree.radii.copy()
+    for node, parts in given.items():
+        idx = parts[0] if len(parts) == 1 else np.unique(np.concatenate(parts))
+        centers[node], radii[node] = min_enclosing_sphere(v[idx], seed)
+    return SphereTree(centers, radii, tree.parent.copy(), tree.level.copy())
