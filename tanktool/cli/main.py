@@ -10,6 +10,7 @@ it (every command gets the same two options, see :func:`_add_output_options`).
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import logging
 import re
 import sys
