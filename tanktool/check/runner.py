@@ -160,6 +160,32 @@ def _names(paths) -> str:
     return ", ".join(sorted(f"'{Path(p).name}'" for p in paths))
 
 
+def _context(bundle: Path, kind: str, named: list[Path], lonely: list[Path]) -> list[Path]:
+    """The ``kind`` bundles ("arenas"/"vehicles") that ``bundle`` meets besides the ones
+    named: those beside it; when there are none and none of that kind were named,
+    tanktool's bundled ones (and ``bundle`` joins ``lonely``, for the note)."""
+    near = _siblings(bundle, kind, ARENA_MANIFEST if kind == "arenas" else VEHICLE_MANIFEST)
+    if not named and not near:
+        near = _bundled(kind)
+        lonely.append(bundle)
+    return near
+
+
+def _consult(paths: list[Path], cache: dict, measure) -> set[Path]:
+    """Keys of the bundles in ``paths`` that ``measure(path) -> (diagnostics, what)``
+    can measure, filling ``cache`` (key -> what); their own diagnostics are not reported."""
+    keys = set()
+    for p in paths:
+        key = p.resolve()
+        if key not in cache:
+            res = _guard(Report(), p, measure, p)
+            if not res or not res[1]:
+                continue
+            cache[key] = res[1]
+        keys.add(key)
+    return keys
+
+
 def _fallback_note(what: list[Path], kind: str, used: list[Path]) -> str:
     """The note saying that ``what`` (arenas or vehicles) met tanktool's bundled ``kind``."""
     one = "arena" if kind == "vehicles" else "vehicle"
@@ -176,10 +202,8 @@ def _fallback_note(what: list[Path], kind: str, used: list[Path]) -> str:
 def run_check(paths: list[str | os.PathLike]) -> Report:
     targets = discover([Path(p) for p in paths])
     report = Report(unreadable=list(targets.unreadable))
-    lonely_arenas: list[Path] = []
+    lonely_arenas: list[Path] = []      # arenas that met the bundled vehicles (for the note)
     lonely_vehicles: list[Path] = []
-    used_vehicles: list[Path] = []
-    used_arenas: list[Path] = []
 
     # vehicles first: their sizes feed the arena rules
     sizes: dict[Path, VehicleSize] = {}
@@ -195,21 +219,8 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
     for a in targets.arenas:
         report.files.append(str(a))
         # each arena meets the vehicles being checked and the bundled ones beside it
-        mine = set(checked_vehicles)
-        near = _siblings(a, "vehicles", VEHICLE_MANIFEST)
-        if not targets.vehicles and not near:
-            # nothing named, nothing beside it: tanktool's own vehicles, said in the notes
-            near = _bundled("vehicles")
-            lonely_arenas.append(a)
-            used_vehicles = used_vehicles or near
-        for v in near:
-            key = v.resolve()
-            if key not in sizes:
-                res = _guard(Report(), v, check_vehicle, v, False)  # only its size is needed
-                if not res or not res[1]:
-                    continue
-                sizes[key] = res[1]
-            mine.add(key)
+        near = _context(a, "vehicles", targets.vehicles, lonely_arenas)
+        mine = checked_vehicles | _consult(near, sizes, lambda v: check_vehicle(v, False))  # only its size
         res = _guard(report, a, check_arena, a, [sizes[k] for k in sorted(mine, key=str)])
         if res:
             report.diagnostics += res[0]
@@ -227,28 +238,16 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
             size = sizes.get(v.resolve())
             if size is None:
                 continue
-            mine = set(checked)
-            near = _siblings(v, "arenas", ARENA_MANIFEST)
-            if not targets.arenas and not near:
-                near = _bundled("arenas")
-                lonely_vehicles.append(v)
-                used_arenas = used_arenas or near
-            for a in near:
-                key = a.resolve()
-                if key not in infos:
-                    res = _guard(Report(), a, check_arena, a, [], False)
-                    if not res:
-                        continue
-                    infos[key] = res[1]
-                mine.add(key)
+            near = _context(v, "arenas", targets.arenas, lonely_vehicles)
+            mine = checked | _consult(near, infos, lambda a: check_arena(a, [], False))
             for key in sorted(mine, key=str):
                 res = _guard(report, v, vehicle_fit, size, infos[key])
                 if res:
                     report.diagnostics += res
     if lonely_arenas:
-        report.notes.append(_fallback_note(lonely_arenas, "vehicles", used_vehicles))
+        report.notes.append(_fallback_note(lonely_arenas, "vehicles", _bundled("vehicles")))
     if lonely_vehicles:
-        report.notes.append(_fallback_note(lonely_vehicles, "arenas", used_arenas))
+        report.notes.append(_fallback_note(lonely_vehicles, "arenas", _bundled("arenas")))
     # a compiler's order: file by file, top to bottom (stable, so rules keep their order on a line)
     report.diagnostics.sort(key=lambda d: (d.path, d.line))
     return report
