@@ -98,3 +98,15 @@ def test_reports_match_across_processes(tmp_path):
         rep.pop("timing")
         reports.append(rep)
     assert reports[0] == reports[1]
+
+
+def test_seconds_is_never_silently_ignored(tmp_path, monkeypatch):
+    # a replay lasts as long as its recording: --seconds is refused with a word
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", "box", "--bots", "2", "--seconds", "1",
+                                 "--record", "m.ttr"])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, ["play", "--headless", "--replay", "m.ttr", "--seconds", "5"])
+    assert r.exit_code == 0, r.output
+    assert "warning: --seconds 5 ignored: a replay lasts as long as its recording" in r.output
+    assert "120 steps" in r.output and "bit for bit" in r.output
