@@ -11,6 +11,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test,bench]'
 	touch $(STAMP)
+	@echo "installed in $(VENV)/: run $(BIN)/tanktool, or 'source $(BIN)/activate' to put tanktool on the PATH"
 
 install: $(STAMP)
 

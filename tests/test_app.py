@@ -71,6 +71,24 @@ def test_pause_restart_menu_quit(app):
     assert app.state == "quit"
 
 
+def test_seconds_ends_a_window_match(make_app, tmp_path):
+    # --seconds in the window: the match ends after that much simulated time, and the
+    # menu comes back saying why (the recording, if any, is written then)
+    rec = tmp_path / "m.ttr"
+    app = make_app((480, 320), bots=1, seconds=0.5, record=rec)
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    taken = sum(app.advance(0.25) for _ in range(4))
+    assert taken == 60                      # 0.5 s at 120 steps/s, then no more
+    assert app.session.world.steps == 60
+    assert app.state == "menu" and "time up" in app.notice and "0.5 s" in app.notice
+    assert rec.is_file() and any("60 steps" in line for line in app.saved)
+    app.frame(0.016)                        # the menu draws with the notice
+    goto(app, "start")                      # a new match gets the same length
+    press(app, pygame.K_RETURN)
+    assert app.state == "playing" and app.session.world.steps == 0
+
+
 def test_views_and_overlays_toggle(app):
     goto(app, "start")
     press(app, pygame.K_RETURN)

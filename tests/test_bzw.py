@@ -50,6 +50,41 @@ def test_world_size_is_the_half_width_and_defaults_to_400(tmp_path):
     assert box.size == (10.0, 5.0, 8.0) and box.line == 7 and w.warnings == []
 
 
+def test_options_world_size_is_the_full_width(tmp_path):
+    # `options -set _worldSize 200` used to be skipped: an 800 m world instead of 200 m
+    text = "options\n  -c -j +r\n  -set _worldSize 200 -set _wallHeight 3\nend\nbox\n size 5 5 5\nend\n"
+    w = parse_bzw(tmp_path / "o.bzw", text=text)
+    assert w.size == 100.0 and w.wall_height == 3.0
+    assert w.warnings == [f"{tmp_path / 'o.bzw'}:1: options that do not change the arena ignored: -c -j +r"]
+    v, _, _ = world_meshes(w)["ground"]
+    assert v[:, 0].min() == -100 and v[:, 0].max() == 100
+    v, _, _ = world_meshes(w)["outer_walls"]
+    assert v[:, 2].max() == 3.0
+    # world size and _worldSize set one variable: the later wins, and a change is said
+    text = "world\n size 60\nend\noptions -set _worldSize 300\nend\n"
+    w = parse_bzw(tmp_path / "b.bzw", text=text)
+    assert w.size == 150.0
+    assert len(w.warnings) == 1 and ":4: options -set _worldSize 300 replaces world size 60 (line 2)" in w.warnings[0]
+    w = parse_bzw(tmp_path / "c.bzw", text="options\n -set _worldSize 120\nend\nworld\n size 60\nend\n")
+    assert w.size == 60.0 and w.warnings == []     # the same size twice: nothing to say
+    for bad in ("-set _worldSize big", "-set _worldSize -5", "-set _wallHeight 0"):
+        with pytest.raises(FormatError) as e:
+            parse_bzw(tmp_path / "d.bzw", text=f"options\n {bad}\nend\n")
+        assert f"{tmp_path / 'd.bzw'}:2: options -set" in str(e.value) and "positive number" in str(e.value)
+    with pytest.raises(FormatError) as e:
+        parse_bzw(tmp_path / "e.bzw", text="options\n -set _worldSize 200\n")
+    assert ":1: 'options' is never closed" in str(e.value)
+
+
+def test_cli_options_world_size_gives_the_arena_its_size(tmp_path):
+    src = tmp_path / "small.bzw"
+    src.write_text("options\n  -set _worldSize 200\nend\nbox\n  position 20 20 0\n  size 5 5 5\nend\n")
+    res = CliRunner().invoke(cli, ["import-arena", str(src), "-o", str(tmp_path / "small")])
+    assert res.exit_code == 0, res.output
+    assert "(202.0 x 202.0 m)" in res.output        # 200 m and the 1 m outer walls outside it
+    assert "warning" not in res.output
+
+
 def test_keywords_are_case_insensitive_and_comments_stripped(tmp_path):
     text = "WORLD\n Size 20 # half\nEND\nBox # a box\n POSITION 1 2 3\n Rotation 15\nEnd\n"
     w = parse_bzw(tmp_path / "c.bzw", text=text)
@@ -78,7 +113,8 @@ def test_unknown_objects_and_properties_are_warnings_with_their_lines():
     w = parse_bzw(BZW / "unknown.bzw")
     lines = {int(m.split(":")[1]): m for m in w.warnings}
     assert sorted(lines) == [7, 18, 23, 37, 46, 55]
-    assert "'options'" in lines[7] and "'link'" in lines[18] and "'mesh'" in lines[23]
+    assert "options that do not change the arena ignored: -c -j" in lines[7]
+    assert "'link'" in lines[18] and "'mesh'" in lines[23]
     assert "define" in lines[37] and "'spin'" in lines[46] and "drivethrough" in lines[55]
     # the mesh's nested drawinfo/lod/matref 'end's did not end the skip early, the
     # define's box stayed inside it, and the known objects after them were read

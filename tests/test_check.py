@@ -100,8 +100,11 @@ def test_cli_unreadable_path_exits_2(tmp_path):
     assert "in 2 files" in res.output  # the readable paths are still checked
 
 
-def test_cli_needs_a_path_and_lists_rules():
-    assert CliRunner().invoke(cli, ["check"]).exit_code == 2
+def test_cli_without_a_path_checks_the_bundled_content_and_lists_rules():
+    res = CliRunner().invoke(cli, ["check", "--strict"])
+    assert res.exit_code == 0, res.output
+    assert "note: no PATH given: checking the bundled content" in res.output
+    assert res.output.strip().splitlines()[-1] == "0 errors, 0 warnings in 5 files"
     res = CliRunner().invoke(cli, ["check", "--rules"])
     assert res.exit_code == 0
     assert all(code in res.output for code in RULES)
@@ -311,3 +314,72 @@ def test_a_long_wall_votes_for_every_face_along_it():
     assert len(fs.faces) == 2 and fs.free.all()
     assert (fs.piece_wall == 0).sum() == 2  # the bottom wall is two pieces, one per room
     assert check_walls(walls, fs, "w") == []
+
+
+# ------------------------------------------------------------------ always against vehicles
+def _small_room(tmp_path: Path) -> Path:
+    """A 4.7 x 4.2 m room imported outside any arenas/ folder: no vehicle beside it."""
+    import trimesh
+
+    w, d, t, h = 4.7, 4.2, 0.2, 2.0
+    parts = [trimesh.creation.box(extents=[w + 2 * t, 0.1, d + 2 * t]).apply_translation([w / 2, -0.05, d / 2])]
+    for ext, c in (([w + 2 * t, h, t], [w / 2, h / 2, -t / 2]), ([w + 2 * t, h, t], [w / 2, h / 2, d + t / 2]),
+                   ([t, h, d], [-t / 2, h / 2, d / 2]), ([t, h, d], [w + t / 2, h / 2, d / 2])):
+        parts.append(trimesh.creation.box(extents=ext).apply_translation(c))
+    trimesh.util.concatenate(parts).export(tmp_path / "room.obj")
+    res = CliRunner().invoke(cli, ["import-arena", str(tmp_path / "room.obj"), "-o", str(tmp_path / "room")])
+    assert res.exit_code == 0, res.output
+    return tmp_path / "room"
+
+
+def test_an_arena_alone_is_checked_against_the_bundled_vehicles(tmp_path, root_dir):
+    # it used to pass, checked against no vehicle at all; then tanks left it in `play`
+    room = _small_room(tmp_path)
+    report = run_check([room])
+    assert {d.code for d in report.diagnostics} == {"A303"}
+    assert all("vehicle 'heavy'" in d.message for d in report.diagnostics)
+    (note,) = report.notes
+    assert note.startswith("note: arena 'room' checked against the bundled vehicles 'heavy', 'light' in ")
+    assert "no vehicle named or beside it" in note
+    res = CliRunner().invoke(cli, ["check", str(room)])
+    assert res.exit_code == 1 and note in res.output
+    assert note not in CliRunner().invoke(cli, ["check", "-q", str(room)]).output
+    doc = json.loads(CliRunner().invoke(cli, ["check", "--json", str(room)]).output)
+    assert doc["notes"] == [note]
+    # a vehicle named with it replaces the bundled ones (and no note is needed)
+    small = tmp_path / "small"
+    shutil.copytree(BROKEN / "V107_tiny" / "vehicles" / "tank", small)
+    report = run_check([room, small])
+    assert {d.code for d in report.diagnostics} == {"V107"} and report.notes == []
+    # a vehicle alone meets the bundled arenas
+    report = run_check([small])
+    assert report.notes and report.notes[0].startswith("note: vehicle 'small' checked against the bundled arenas")
+
+
+def test_the_sphere_tree_must_hold_the_surface_not_only_the_vertices(tmp_path):
+    """A tree built on the 8 corners of a box holds every vertex, but its spheres leave
+    parts of the faces between the corners out: V202 finds them on surface samples."""
+    from tanktool.formats.bundle import dumps_toml, sha256_file
+    from tanktool.geometry.sphere_build import build_sphere_tree
+    from tanktool.geometry.spheres import write_spheres
+
+    tank = tmp_path / "tank"
+    shutil.copytree(CLEAN / "vehicles" / "tank", tank)
+    from tanktool.check.glb import load_triangles
+
+    v, _ = load_triangles(tank / "model.glb")
+    corners = np.unique(v, axis=0)
+    assert len(corners) == 8
+    write_spheres(tank / "spheres.txt", build_sphere_tree(corners, levels=2, branching=4))
+    from tanktool.check.manifest import tomllib
+
+    doc = tomllib.loads((tank / "vehicle.toml").read_text())
+    doc["derived"]["spheres.txt"] = sha256_file(tank / "spheres.txt")
+    (tank / "vehicle.toml").write_text(dumps_toml(doc))
+    report = run_check([tank])
+    (d,) = [d for d in report.diagnostics if d.code == "V202"]
+    assert "model vertices" not in d.message            # every vertex is held
+    assert "% of the model's surface" in d.message and "points sampled over it" in d.message
+    # the same samples every run
+    assert run_check([tank]).diagnostics[0].message == report.diagnostics[0].message
+    assert {x.code for x in report.diagnostics} <= {"V202", "V203"}

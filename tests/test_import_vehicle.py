@@ -170,3 +170,116 @@ def test_real_3ds_models_are_wrapped_conservatively(tmp_path, name):
     assert contains_points(b.spheres, v, tol=0).all()
     doc = read_toml(out / "vehicle.toml")
     assert doc["hull"]["footprint_area"] <= 1.15 * doc["hull"]["convex_area"]
+
+
+# ------------------------------------------------------------------ facing, posture, sanity, precision
+@pytest.mark.parametrize("up", ["y", "z"])
+@pytest.mark.parametrize("forward", ["+x", "-x", "+y", "-y", "+z", "-z"])
+def test_forward_rotation_turns_the_file_axis_to_plus_x(up, forward):
+    from tanktool.cli.import_vehicle import forward_rotation
+    from tanktool.errors import VehicleError
+    from tanktool.formats.models import Z_UP_TO_Y_UP
+
+    if forward[1] == up:
+        with pytest.raises(VehicleError, match="is the model's up axis"):
+            forward_rotation(forward, up)
+        return
+    m = forward_rotation(forward, up)
+    assert np.allclose(m[:3, :3] @ m[:3, :3].T, np.eye(3)) and np.linalg.det(m[:3, :3]) == pytest.approx(1)
+    axis = np.zeros(4)
+    axis["xyz".index(forward[1])] = 1.0 if forward[0] == "+" else -1.0
+    world = (Z_UP_TO_Y_UP if up == "z" else np.eye(4)) @ axis      # what load_scene made of it
+    assert np.allclose(m @ world, [1, 0, 0, 0])
+    assert np.allclose(m @ [0, 1, 0, 0], [0, 1, 0, 0])              # up stays up
+
+
+def test_forward_option_turns_a_model_facing_z(tmp_path):
+    """A tank modelled along +z comes in sideways without --forward (and says so);
+    with --forward +z it is the same vehicle as the one modelled along +x."""
+    along_x = tmp_path / "x.obj"
+    small_tank().export(along_x)
+    along_z = tmp_path / "z.obj"
+    turned = small_tank()
+    turned.apply_transform(trimesh.transformations.rotation_matrix(-np.pi / 2, [0, 1, 0]))  # +x -> +z
+    turned.export(along_z)
+    r = run("import-vehicle", along_z, "-o", tmp_path / "sideways")
+    assert r.exit_code == 0, r.output
+    assert "warning: " in r.output and "along its forward axis" in r.output
+    assert "(--forward +z or --forward -z)" in r.output
+    r = run("import-vehicle", along_z, "--forward", "+z", "-o", tmp_path / "z")
+    assert r.exit_code == 0 and "warning" not in r.output, r.output
+    assert run("import-vehicle", along_x, "-o", tmp_path / "x").exit_code == 0
+    vz = np.unique(np.round(load_vehicle_source(tmp_path / "z").vertices, 6), axis=0)
+    vx = np.unique(np.round(load_vehicle_source(tmp_path / "x").vertices, 6), axis=0)
+    assert vz.shape == vx.shape and np.allclose(vz, vx, atol=1e-5)
+    assert read_toml(tmp_path / "z" / "vehicle.toml")["source"]["forward"] == "+z"
+    assert np.allclose(load_vehicle(tmp_path / "z").hull, load_vehicle(tmp_path / "x").hull, atol=2e-4)
+    # facing backwards: the barrel (the long thin end) ends up at -x
+    assert run("import-vehicle", along_x, "--forward", "-x", "-o", tmp_path / "back").exit_code == 0
+    back = load_vehicle_source(tmp_path / "back").vertices
+    front = load_vehicle_source(tmp_path / "x").vertices
+    assert np.allclose(np.sort(back[:, 0]), np.sort(-front[:, 0]), atol=1e-5)
+    # the check agrees: the sideways bundle gets V106, the turned one nothing
+    from tanktool.check import run_check
+
+    assert {d.code for d in run_check([tmp_path / "sideways"]).diagnostics} == {"V106"}
+    assert run_check([tmp_path / "z"]).diagnostics == []
+    r = run("import-vehicle", along_x, "--forward", "+y", "-o", tmp_path / "bad")
+    assert r.exit_code == 2 and "--forward +y is the model's up axis (--up y)" in r.output
+    assert not (tmp_path / "bad").exists()
+
+
+def test_a_vehicle_on_its_side_is_a_warning_then_a_check_error(tmp_path, tank_obj):
+    # an OBJ (Y up) read as Z up: the tank lies on its side
+    r = run("import-vehicle", tank_obj, "--up", "z", "-o", tmp_path / "side")
+    assert r.exit_code == 0, r.output
+    assert "lies on its side" in r.output and "(--up y; it was read as --up z)" in r.output
+    from tanktool.check import run_check
+
+    report = run_check([tmp_path / "side"])
+    assert [d.code for d in report.diagnostics] == ["V105"]
+    assert report.exit_code() == 1 and "--up y" in report.diagnostics[0].hint
+
+
+def test_absurd_sizes_and_masses_are_warned_and_figures_keep_their_digits(tmp_path, tank_obj):
+    from tanktool.check import run_check
+
+    # the issue's 32 m, 794 t "vehicle"
+    r = run("import-vehicle", tank_obj, "--scale", "7", "--mass", "794000", "-o", tmp_path / "huge")
+    assert r.exit_code == 0, r.output
+    assert "m long at its longest, outside the 1 .. 15 m" in r.output
+    assert "a mass of 794 t is outside" in r.output
+    assert {d.code for d in run_check([tmp_path / "huge"]).diagnostics} >= {"V107", "V303"}
+    # a toy: figures written with significant digits, never rounded to zero
+    r = run("import-vehicle", tank_obj, "--scale", "0.01", "--mass", "2", "-o", tmp_path / "toy")
+    assert r.exit_code == 0, r.output
+    assert r.output.count("warning: ") == 2 and "inertia 0.000" in r.output
+    doc = read_toml(tmp_path / "toy" / "vehicle.toml")
+    b = load_vehicle(tmp_path / "toy")
+    assert doc["drive"]["turn_torque"] > 0 and doc["mass"]["inertia"] > 0
+    assert doc["drive"]["turn_torque"] == pytest.approx(1.5 * b.inertia, rel=1e-5)
+    assert doc["footprint_radius"] == pytest.approx(b.footprint_radius, rel=1e-4)
+    com = np.array(doc["mass"]["centre_of_mass"])
+    assert np.abs(com).max() > 0 and np.all((com == 0) | (np.abs(com) > 1e-5))
+    assert {d.code for d in run_check([tmp_path / "toy"]).diagnostics} == {"V107", "V303"}
+
+
+def test_sphere_trees_hold_the_whole_surface(tmp_path, tank_obj):
+    """Not only the vertices: points sampled over the surface (the check's own, not the
+    builder's) are all inside a leaf and its ancestors."""
+    from tanktool.check.glb import load_triangles
+    from tanktool.check.vehicle_rules import GEOM_TOL, surface_points
+
+    out = tmp_path / "t"
+    assert run("import-vehicle", tank_obj, "-o", out, "--sphere-levels", "3", "--branching", "5").exit_code == 0
+    tree = load_vehicle(out).spheres
+    v, f = load_triangles(out / "model.glb")
+    p = np.vstack([v, surface_points(v, f)])
+    held = np.zeros(len(p), dtype=bool)
+    for leaf in tree.leaves():
+        chain = tree.ancestors(int(leaf))
+        inside = np.ones(len(p), dtype=bool)
+        for s in chain:
+            inside &= np.linalg.norm(p - tree.centers[s], axis=1) <= tree.radii[s] + GEOM_TOL
+        held |= inside
+    assert held.all()

@@ -57,3 +57,18 @@ def test_drive_defaults_scale_with_mass():
     assert light["hit_points"] == 100 and heavy["hit_points"] > 100
     assert heavy["fire_interval"] > light["fire_interval"]
     assert heavy["turn_torque"] > light["turn_torque"]
+
+
+def test_drive_defaults_of_a_toy_keep_their_digits():
+    # fixed decimals wrote turn_torque = 0.0 for a small vehicle: it never turned
+    d = drive_defaults(2.0, 4.5e-4)
+    assert d["turn_torque"] == pytest.approx(6.75e-4) and d["engine_force"] == pytest.approx(6.0)
+    assert all(v > 0 for v in d.values())
+
+
+def test_significant_digits_and_scaled_rounding():
+    from tanktool.geometry.mass import sig, to_scale
+
+    assert sig(1.23456789e-5, 3) == 1.23e-5 and sig(26241.7291, 8) == 26241.729 and sig(-0.0) == 0.0
+    assert to_scale(-0.48499989, 5.8) == -0.4849999 and to_scale(0.0123456789, 0.05) == 0.012345679
+    assert str(to_scale(-1e-12, 5.0)) == "0.0"      # no "-0.0"

@@ -40,16 +40,24 @@ def test_headless_report(tmp_path):
     assert rep == rep2
 
 
-def test_play_without_headless_runs_a_match_and_draws_it(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
+def test_play_without_headless_runs_a_match_and_writes_nothing_unasked(tmp_path, monkeypatch):
+    # `make play` on a machine without a display used to leave match.png in the checkout
+    work = tmp_path / "work"
+    work.mkdir()
+    monkeypatch.chdir(work)
     arena = _arena(tmp_path, maze=True)
     r = CliRunner().invoke(cli, ["play", "--arena", str(arena), "--seconds", "3"])
     assert r.exit_code == 0, r.output
     assert "no display to open the game window" in r.output
-    assert "picture: match.png" in r.output
-    png = (tmp_path / "match.png").read_bytes()
-    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+    assert "picture:" not in r.output
+    assert list(work.iterdir()) == []
     assert sum(1 for line in r.output.splitlines() if line.startswith("bot")) == 4
+    # asked for: the top view of the final state
+    r = CliRunner().invoke(cli, ["play", "--arena", str(arena), "--seconds", "3", "--picture", "end.png"])
+    assert r.exit_code == 0, r.output
+    assert "picture: end.png" in r.output
+    png = (work / "end.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
 
 
 def test_bad_input_is_one_line_and_exit_2(tmp_path):
@@ -90,3 +98,15 @@ def test_reports_match_across_processes(tmp_path):
         rep.pop("timing")
         reports.append(rep)
     assert reports[0] == reports[1]
+
+
+def test_seconds_is_never_silently_ignored(tmp_path, monkeypatch):
+    # a replay lasts as long as its recording: --seconds is refused with a word
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", "box", "--bots", "2", "--seconds", "1",
+                                 "--record", "m.ttr"])
+    assert r.exit_code == 0, r.output
+    r = CliRunner().invoke(cli, ["play", "--headless", "--replay", "m.ttr", "--seconds", "5"])
+    assert r.exit_code == 0, r.output
+    assert "warning: --seconds 5 ignored: a replay lasts as long as its recording" in r.output
+    assert "120 steps" in r.output and "bit for bit" in r.output

@@ -28,7 +28,7 @@ from tanktool.formats.bundle import dumps_toml, sha256_file  # noqa: E402
 from tanktool.formats.vehicle_bundle import format_hull  # noqa: E402
 from tanktool.formats.walls_txt import WallList, aux_rectangle, format_walls  # noqa: E402
 from tanktool.geometry.mass import drive_defaults  # noqa: E402
-from tanktool.geometry.sphere_build import build_points, build_sphere_tree  # noqa: E402
+from tanktool.geometry.sphere_build import build_points, build_sphere_tree, cover_surface  # noqa: E402
 from tanktool.geometry.spheres import format_spheres  # noqa: E402
 
 BROKEN = ROOT / "tests" / "data" / "broken"
@@ -116,15 +116,18 @@ def write_arena(out: Path, segs=None, dirs=None, spawns=None, toml_edit=None, bu
 SIZE = (4.0, 2.0, 2.4)  # length (x), height (y), width (z): footprint radius 2.33 m
 
 
-def write_vehicle(out: Path, hull_edit=None, spheres_edit=None, toml_edit=None) -> None:
+def write_vehicle(out: Path, hull_edit=None, spheres_edit=None, toml_edit=None, size=SIZE,
+                  mass: float | None = None) -> None:
+    """A box tank of ``size`` (x, y, z) and ``mass`` (default 2000 kg/m^3), its sphere
+    tree refitted to hold the whole surface as import-vehicle does."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import trimesh
 
     out.mkdir(parents=True, exist_ok=True)
-    lx, ly, lz = SIZE
-    mesh = trimesh.creation.box(extents=SIZE)
+    lx, ly, lz = size
+    mesh = trimesh.creation.box(extents=size)
     mesh.apply_translation([0, ly / 2, 0])
     (out / "tank.obj").write_text(mesh.export(file_type="obj"))
     (out / "model.glb").write_bytes(mesh.export(file_type="glb"))
@@ -132,11 +135,12 @@ def write_vehicle(out: Path, hull_edit=None, spheres_edit=None, toml_edit=None) 
     corners = np.array([[lx / 2, lz / 2], [-lx / 2, lz / 2], [-lx / 2, -lz / 2], [lx / 2, -lz / 2]])[::-1]
     hull = np.vstack([np.column_stack([corners[:, 0], np.full(4, y), corners[:, 1]]) for y in (0.0, ly)])
     hull_text = format_hull(hull, "check corpus")
-    tree = build_sphere_tree(build_points(np.asarray(mesh.vertices), np.asarray(mesh.faces), 400), 2, 4)
+    v, f = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+    tree = cover_surface(build_sphere_tree(build_points(v, f, 400), 2, 4), v, f)
     spheres_text = format_spheres(tree, "check corpus")
     (out / "hull.txt").write_text(hull_edit(hull_text) if hull_edit else hull_text)
     (out / "spheres.txt").write_text(spheres_edit(spheres_text) if spheres_edit else spheres_text)
-    mass = 2000.0 * lx * ly * lz
+    mass = 2000.0 * lx * ly * lz if mass is None else mass
     inertia = mass * (lx * lx + lz * lz) / 12.0
     doc = {
         "name": out.name, "tool_version": "corpus",
@@ -175,10 +179,12 @@ def wall_line(path: Path, seg) -> int:
 
 
 def spawn_line(path: Path, i: int) -> int:
-    """Line where spawn ``i`` starts in a manifest written by tomli_w (one number a line)."""
+    """Line where spawn ``i`` starts in a manifest written by dumps_toml (a spawn a line,
+    or one number a line as tomli_w alone writes them)."""
     lines = path.read_text().splitlines()
     start = next(no for no, ln in enumerate(lines, 1) if ln.startswith("spawns = "))
-    items = [no for no, ln in enumerate(lines, 1) if no > start and ln == "    ["]
+    end = next(no for no, ln in enumerate(lines, 1) if no > start and ln == "]")
+    items = [no for no, ln in enumerate(lines, 1) if start < no < end and ln.startswith("    [")]
     return items[i]
 
 
@@ -350,6 +356,15 @@ def make_cases() -> None:
     expect(c, "V103", "vehicles/tank", "vehicles/tank/hull.txt", [0])
     c, v = vcase("V104", "com_outside", toml_edit=lambda d: d["mass"].update(centre_of_mass=[5.0, 1.0, 0.0]))
     expect(c, "V104", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "centre_of_mass")])
+    # imported with the wrong up axis: 3 m tall, 2 m wide
+    c, v = vcase("V105", "on_its_side", size=(4.0, 3.0, 2.0))
+    expect(c, "V105", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "up = ")])
+    # its front along z: 2.4 m long, 4 m across
+    c, v = vcase("V106", "sideways", size=(2.4, 2.0, 4.0))
+    expect(c, "V106", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "up = ")])
+    # a model in decimetres imported as metres: 0.4 m long (given a plausible mass)
+    c, v = vcase("V107", "tiny", size=(0.4, 0.2, 0.24), mass=150.0)
+    expect(c, "V107", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "footprint_radius")])
     c, v = vcase("V201", "spheres_bad_line", spheres_edit=lambda t: t.replace("\n1 0 2 ", "\n1 0 2 x "))
     expect(c, "V201", "vehicles/tank", "vehicles/tank/spheres.txt", [line_of(v / "spheres.txt", "1 0 2 x ")])
 

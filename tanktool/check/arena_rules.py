@@ -21,6 +21,7 @@ import numpy as np
 import shapely
 
 from ..formats.walls_txt import WallList
+from ..geometry.hull import min_width
 from .diagnostics import Diagnostic, diag, fmt_xz
 from .freespace import UNBOUNDED, FreeSpace, analyse
 from .manifest import Manifest, file_rules, safe_file
@@ -56,20 +57,6 @@ class VehicleSize:
         c, s = math.cos(heading), math.sin(heading)
         fx, fz = self.footprint[:, 0], self.footprint[:, 1]
         return shapely.Polygon(np.column_stack([x + c * fx - s * fz, z + s * fx + c * fz]))
-
-
-def min_width(poly: np.ndarray) -> float:
-    """Narrowest extent of a convex polygon: over its edge directions, the largest
-    distance of a vertex from the edge's line (rotating calipers, all edges at once)."""
-    p = np.asarray(poly, dtype=np.float64)
-    e = np.roll(p, -1, axis=0) - p
-    L = np.hypot(e[:, 0], e[:, 1])
-    ok = L > 0
-    if not ok.any():
-        return 0.0
-    e, a = e[ok] / L[ok, None], p[ok]
-    d = np.abs(e[:, None, 0] * (p[None, :, 1] - a[:, None, 1]) - e[:, None, 1] * (p[None, :, 0] - a[:, None, 0]))
-    return float(d.max(axis=1).min())
 
 
 @dataclass

@@ -4,7 +4,10 @@ A path may be an arena bundle, a vehicle bundle (the folder or its manifest), a 
 walls file, or a folder holding any of them at any depth.  Rules that relate arenas
 and vehicles (clearance, passages, V401) see the bundles being checked plus the
 bundled ones beside them: for ``X/arenas/<name>`` the vehicles in ``X/vehicles/``,
-and the other way round.
+and the other way round.  An arena with no vehicle named or beside it is checked
+against tanktool's bundled vehicles (and a vehicle with no arena, against the
+bundled arenas), and the report's ``notes`` say so: an arena is never checked
+against no vehicle at all without a word.
 """
 
 from __future__ import annotations
@@ -27,6 +30,8 @@ class Report:
     files: list[str] = field(default_factory=list)
     diagnostics: list[Diagnostic] = field(default_factory=list)
     unreadable: list[str] = field(default_factory=list)   # one message per path that cannot be read
+    #: what the rules were measured against, when the user did not say (one line each)
+    notes: list[str] = field(default_factory=list)
 
     @property
     def errors(self) -> int:
@@ -51,6 +56,7 @@ class Report:
     def to_dict(self) -> dict:
         return {"files": self.files,
                 "diagnostics": [d.to_dict() for d in self.diagnostics],
+                "notes": self.notes,
                 "summary": {"errors": self.errors, "warnings": self.warnings}}
 
 
@@ -144,9 +150,60 @@ def _guard(report: Report, path: Path, fn, *args):
     return None
 
 
+def _bundled(kind: str) -> list[Path]:
+    from ..content import bundled_paths
+
+    return [_shown(p) for p in bundled_paths(kind)]
+
+
+def _names(paths) -> str:
+    return ", ".join(sorted(f"'{Path(p).name}'" for p in paths))
+
+
+def _context(bundle: Path, kind: str, named: list[Path], lonely: list[Path]) -> list[Path]:
+    """The ``kind`` bundles ("arenas"/"vehicles") that ``bundle`` meets besides the ones
+    named: those beside it; when there are none and none of that kind were named,
+    tanktool's bundled ones (and ``bundle`` joins ``lonely``, for the note)."""
+    near = _siblings(bundle, kind, ARENA_MANIFEST if kind == "arenas" else VEHICLE_MANIFEST)
+    if not named and not near:
+        near = _bundled(kind)
+        lonely.append(bundle)
+    return near
+
+
+def _consult(paths: list[Path], cache: dict, measure) -> set[Path]:
+    """Keys of the bundles in ``paths`` that ``measure(path) -> (diagnostics, what)``
+    can measure, filling ``cache`` (key -> what); their own diagnostics are not reported."""
+    keys = set()
+    for p in paths:
+        key = p.resolve()
+        if key not in cache:
+            res = _guard(Report(), p, measure, p)
+            if not res or not res[1]:
+                continue
+            cache[key] = res[1]
+        keys.add(key)
+    return keys
+
+
+def _fallback_note(what: list[Path], kind: str, used: list[Path]) -> str:
+    """The note saying that ``what`` (arenas or vehicles) met tanktool's bundled ``kind``."""
+    one = "arena" if kind == "vehicles" else "vehicle"
+    other = kind[:-1]
+    subject = f"{one} {_names(what)}" if len(what) == 1 else f"{len(what)} {one}s"
+    if not used:
+        return (f"note: {subject} checked against no {other}: none named, none beside "
+                f"{'it' if len(what) == 1 else 'them'}, none bundled (the rules that need a {other} were skipped)")
+    return (f"note: {subject} checked against the bundled {kind} {_names(used)} in "
+            f"{Path(used[0]).parent}/: no {other} named or beside {'it' if len(what) == 1 else 'them'} "
+            f"(name {other} bundles to check against others)")
+
+
 def run_check(paths: list[str | os.PathLike]) -> Report:
     targets = discover([Path(p) for p in paths])
     report = Report(unreadable=list(targets.unreadable))
+    lonely_arenas: list[Path] = []      # arenas that met the bundled vehicles (for the note)
+    lonely_vehicles: list[Path] = []
 
     # vehicles first: their sizes feed the arena rules
     sizes: dict[Path, VehicleSize] = {}
@@ -162,15 +219,8 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
     for a in targets.arenas:
         report.files.append(str(a))
         # each arena meets the vehicles being checked and the bundled ones beside it
-        mine = set(checked_vehicles)
-        for v in _siblings(a, "vehicles", VEHICLE_MANIFEST):
-            key = v.resolve()
-            if key not in sizes:
-                res = _guard(Report(), v, check_vehicle, v, False)  # only its size is needed
-                if not res or not res[1]:
-                    continue
-                sizes[key] = res[1]
-            mine.add(key)
+        near = _context(a, "vehicles", targets.vehicles, lonely_arenas)
+        mine = checked_vehicles | _consult(near, sizes, lambda v: check_vehicle(v, False))  # only its size
         res = _guard(report, a, check_arena, a, [sizes[k] for k in sorted(mine, key=str)])
         if res:
             report.diagnostics += res[0]
@@ -188,19 +238,16 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
             size = sizes.get(v.resolve())
             if size is None:
                 continue
-            mine = set(checked)
-            for a in _siblings(v, "arenas", ARENA_MANIFEST):
-                key = a.resolve()
-                if key not in infos:
-                    res = _guard(Report(), a, check_arena, a, [], False)
-                    if not res:
-                        continue
-                    infos[key] = res[1]
-                mine.add(key)
+            near = _context(v, "arenas", targets.arenas, lonely_vehicles)
+            mine = checked | _consult(near, infos, lambda a: check_arena(a, [], False))
             for key in sorted(mine, key=str):
                 res = _guard(report, v, vehicle_fit, size, infos[key])
                 if res:
                     report.diagnostics += res
+    if lonely_arenas:
+        report.notes.append(_fallback_note(lonely_arenas, "vehicles", _bundled("vehicles")))
+    if lonely_vehicles:
+        report.notes.append(_fallback_note(lonely_vehicles, "arenas", _bundled("arenas")))
     # a compiler's order: file by file, top to bottom (stable, so rules keep their order on a line)
     report.diagnostics.sort(key=lambda d: (d.path, d.line))
     return report

@@ -1,10 +1,11 @@
-"""Rules on vehicle bundles: hull points, sphere tree, mass and drive figures, and
-whether the vehicle fits the bundled arenas.
+"""Rules on vehicle bundles: hull points, sphere tree, mass and drive figures, posture
+and size, and whether the vehicle fits the bundled arenas.
 
 hull.txt and spheres.txt are scanned line by line with the same field rules as
 :mod:`tanktool.formats.vehicle_bundle` and :mod:`tanktool.geometry.spheres`, so every
 bad line is reported, not only the first.  The geometric rules use the vertices of
-the bundle's model (``model.glb``, already in the vehicle frame).
+the bundle's model (``model.glb``, already in the vehicle frame) and, for the sphere
+tree, points sampled over its surface.
 """
 
 from __future__ import annotations
@@ -26,6 +27,10 @@ from .manifest import Manifest, file_rules, safe_file
 GEOM_TOL = 2e-4
 #: m: hull points and spheres farther out than this are typos, not vehicles
 MAX_SIZE = 1000.0
+#: points sampled over the model's surface for V202/V203 (0.005 % of the surface each
+#: for 20,000), and the seed that makes them the same every run
+SURFACE_SAMPLES = 20_000
+SURFACE_SEED = 2002
 
 
 def scan_hull(path: Path) -> tuple[np.ndarray, list[Diagnostic]]:
@@ -111,42 +116,107 @@ def scan_spheres(path: Path) -> tuple[SphereTree | None, np.ndarray, list[Diagno
     return tree, np.array(lines), out
 
 
-def sphere_rules(tree: SphereTree, lines: np.ndarray, vertices: np.ndarray, path: str) -> list[Diagnostic]:
-    """V202: every vertex in some leaf; V203: in every ancestor of a leaf holding it."""
-    v = vertices
-    inside = np.zeros((len(v), len(tree)), dtype=bool)
-    for s in range(len(tree)):  # one sphere at a time keeps memory at (n,) per step
-        inside[:, s] = np.sum((v - tree.centers[s]) ** 2, axis=1) <= (tree.radii[s] + GEOM_TOL) ** 2
+def sphere_rules(tree: SphereTree, lines: np.ndarray, vertices: np.ndarray, path: str,
+                 surface: np.ndarray | None = None) -> list[Diagnostic]:
+    """V202: every vertex, and every point sampled over the surface, in some leaf;
+    V203: in every ancestor of a leaf holding it.
+
+    The vertices alone are not enough: a triangle whose corners lie in two leaves can
+    bulge out between them.  ``surface`` is (m, 3) points spread over the triangles by
+    area (:func:`surface_points`), so the share of them outside is the share of the
+    surface outside.  Points are tested a block at a time, so memory stays bounded
+    whatever the tree's size.
+    """
+    v = vertices if surface is None else np.vstack([vertices, surface])
+    nv, ns = len(vertices), 0 if surface is None else len(surface)
     leaves = tree.leaves()
     chains = [tree.ancestors(int(leaf)) for leaf in leaves]
-    in_chain = np.zeros(len(v), dtype=bool)
-    for chain in chains:
-        in_chain |= inside[:, chain].all(axis=1)
-    in_leaf = inside[:, leaves].any(axis=1)
-    out = []
-    lost = np.flatnonzero(~in_leaf)
-    if len(lost):
-        p = v[lost[0]]
-        # name the leaf whose centre is nearest: the one that most likely should hold it
-        dc = np.sqrt(np.sum((tree.centers[leaves] - p) ** 2, axis=1))
-        k = int(np.argmin(dc))
-        near = int(leaves[k])
-        out.append(diag("V202", path, int(lines[near]),
-                        f"{len(lost)} of {len(v)} model vertices are in no leaf sphere, e.g. "
-                        f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f}), {dc[k] - tree.radii[near]:.3f} m outside leaf {near}"))
-    # vertices some leaf holds but whose every chain breaks: name the parent that lets go
-    broken = np.flatnonzero(in_leaf & ~in_chain)
+    lost_v = lost_s = 0
+    worst: tuple[float, np.ndarray] | None = None       # (outside by, point)
     culprits: dict[int, list[int]] = {}
-    for i in broken:
-        for leaf, chain in zip(leaves, chains):
-            if inside[i, leaf]:
-                miss = [a for a in chain if not inside[i, a]]
-                culprits.setdefault(int(miss[0]), []).append(int(leaf))
-                break
+    block = max(1, 2_000_000 // max(len(tree), 1))
+    for start in range(0, len(v), block):
+        p = v[start:start + block]
+        inside = np.empty((len(p), len(tree)), dtype=bool)
+        for s in range(len(tree)):
+            inside[:, s] = np.sum((p - tree.centers[s]) ** 2, axis=1) <= (tree.radii[s] + GEOM_TOL) ** 2
+        in_leaf = inside[:, leaves].any(axis=1)
+        in_chain = np.zeros(len(p), dtype=bool)
+        for chain in chains:
+            in_chain |= inside[:, chain].all(axis=1)
+        lost = np.flatnonzero(~in_leaf)
+        if len(lost):
+            is_vertex = start + lost < nv
+            lost_v += int(is_vertex.sum())
+            lost_s += int((~is_vertex).sum())
+            q = p[lost]
+            by = np.min(np.sqrt(((q[:, None, :] - tree.centers[leaves][None]) ** 2).sum(axis=2))
+                        - tree.radii[leaves][None], axis=1)
+            k = int(np.argmax(by))
+            if worst is None or by[k] > worst[0]:
+                worst = (float(by[k]), q[k])
+        # points some leaf holds but whose every chain breaks: name the parent that lets go
+        for i in np.flatnonzero(in_leaf & ~in_chain):
+            for leaf, chain in zip(leaves, chains):
+                if inside[i, leaf]:
+                    miss = [a for a in chain if not inside[i, a]]
+                    culprits.setdefault(int(miss[0]), []).append(int(leaf))
+                    break
+    out = []
+    if worst is not None:
+        by, pt = worst
+        # name the leaf whose centre is nearest: the one that most likely should hold it
+        dc = np.sqrt(np.sum((tree.centers[leaves] - pt) ** 2, axis=1))
+        near = int(leaves[int(np.argmin(dc))])
+        what = []
+        if lost_v:
+            what.append(f"{lost_v} of {nv} model vertices")
+        if lost_s:
+            what.append(f"about {100.0 * lost_s / ns:.2g} % of the model's surface ({lost_s} of {ns} points "
+                        "sampled over it)")
+        out.append(diag("V202", path, int(lines[near]),
+                        f"{' and '.join(what)} {'is' if not lost_v else 'are'} in no leaf sphere; the farthest, "
+                        f"({pt[0]:.3f}, {pt[1]:.3f}, {pt[2]:.3f}), is {by:.3f} m outside, nearest leaf {near}"))
     for parent, kids in sorted(culprits.items()):
         out.append(diag("V203", path, int(lines[parent]),
                         f"sphere {parent} does not enclose the part of the model in its descendant leaf "
-                        f"{kids[0]} ({len(kids)} vertices outside it)"))
+                        f"{kids[0]} ({len(kids)} points of the model outside it)"))
+    return out
+
+
+def surface_points(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(SURFACE_SAMPLES, 3) points spread over the model's triangles by area, the same
+    ones every run (a fixed seed, not the one the sphere tree was built with)."""
+    from ..geometry.sphere_build import surface_samples
+
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    f = f[((f >= 0) & (f < len(v))).all(axis=1)]   # a damaged model's stray indices name nothing
+    return surface_samples(v, f, SURFACE_SAMPLES, seed=SURFACE_SEED)
+
+
+def proportion_rules(hull: np.ndarray, man: Manifest) -> list[Diagnostic]:
+    """V105 on its side, V106 facing sideways, V107 an absurd size, from the hull (which
+    encloses the model): the same tests import-vehicle warns with."""
+    from ..geometry.proportions import on_its_side, proportions, sideways, size_problem
+
+    mpath = str(man.path)
+    p = proportions(hull)
+    up = man.get("source", "up")
+    out = []
+    why = on_its_side(p, "the vehicle")
+    if why:
+        other = {"y": "z", "z": "y"}.get(up) if isinstance(up, str) else None
+        hint = f"re-import it with --up {other}: it was imported with --up {up}" if other else None
+        out.append(diag("V105", mpath, man.lines.key("source", "up"), why, hint))
+    why = sideways(p, "the vehicle")
+    if why:
+        key = "forward" if man.get("source", "forward") is not None else "up"
+        line = man.lines.key("source", key)
+        out.append(diag("V106", mpath, line, why))
+    why = size_problem(p, "the vehicle")
+    if why:
+        out.append(diag("V107", mpath, man.lines.key("", "footprint_radius"), why))
     return out
 
 
@@ -195,9 +265,12 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
         if val is not None and val <= 0:
             out.append(diag("V301", mpath, man.lines.key("mass", key),
                             f"[mass] {key} = {val:g} must be positive"))
-    if mass is not None and mass > 0 and not 1.0 <= mass <= 1e6:
-        out.append(diag("V303", mpath, man.lines.key("mass", "mass"),
-                        f"[mass] mass = {mass:g} kg: outside 1 kg .. 1,000 t, check the unit"))
+    if mass is not None and mass > 0:
+        from ..geometry.proportions import mass_problem
+
+        why = mass_problem(mass)
+        if why:
+            out.append(diag("V303", mpath, man.lines.key("mass", "mass"), f"[mass] mass = {mass:g} kg: {why}"))
     com = man.get("mass", "centre_of_mass")
     if not (isinstance(com, list) and len(com) == 3
             and all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in com)):
@@ -233,6 +306,7 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
         out += hd
         if not hd:
             hull = pts
+            out += proportion_rules(hull, man)
     tree = None
     sfile = man.string("spheres", "file", out, default="spheres.txt")
     spath = safe_file(bundle, sfile) if sfile else None
@@ -264,7 +338,7 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
         from .glb import load_triangles
 
         try:
-            verts, _ = load_triangles(mfile)
+            verts, faces = load_triangles(mfile)
         except FormatError as e:
             out.append(diag("B201", mpath, man.lines.key("model", "file"), f"model file cannot be read: {e}"))
         else:
@@ -278,7 +352,7 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
                                     f"{len(outside)} of {len(v)} model vertices are outside the hull, e.g. "
                                     f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f})"))
             if tree is not None:
-                out += sphere_rules(tree, slines, v, str(spath))
+                out += sphere_rules(tree, slines, v, str(spath), surface_points(verts, faces))
 
     size = None
     if hull is not None:

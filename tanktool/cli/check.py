@@ -20,12 +20,18 @@ import click
 @click.option("--strict", is_flag=True, help="Exit 1 on warnings too.")
 @click.option("--rules", "list_rules", is_flag=True, help="List every rule code and exit.")
 def check(paths: tuple[Path, ...], as_json: bool, strict: bool, list_rules: bool) -> None:
-    """Validate arena bundles, vehicle bundles, walls.txt files, or folders of them.
+    """Validate arena bundles, vehicle bundles, walls.txt files, or folders of them
+    (no PATH: tanktool's bundled arenas and vehicles).
+
+    Arenas are measured against the vehicles named with them or beside them
+    (X/vehicles/ for X/arenas/NAME), else against the bundled vehicles, and the
+    output says so; vehicles likewise against arenas.
 
     \b
     Examples:
       tanktool check arenas vehicles
       tanktool check --strict --json arenas/yard
+      tanktool check --strict                      (the bundled content)
     """
     from ..check import RULES, run_check
     from .main import is_quiet
@@ -34,9 +40,17 @@ def check(paths: tuple[Path, ...], as_json: bool, strict: bool, list_rules: bool
         for r in RULES.values():
             click.echo(f"{r.code}  {r.severity:<7}  {r.title}")
         return
+    notes = []
     if not paths:
-        raise click.UsageError("give at least one PATH (an arena, a vehicle, a walls.txt or a folder)")
+        from ..content import bundled_dir
+
+        paths = tuple(p for p in (bundled_dir("arenas"), bundled_dir("vehicles")) if p is not None)
+        if not paths:
+            raise click.UsageError("no PATH given and no bundled content found: give at least one PATH "
+                                   "(an arena, a vehicle, a walls.txt or a folder)")
+        notes.append(f"note: no PATH given: checking the bundled content ({', '.join(map(str, paths))})")
     report = run_check(list(paths))
+    report.notes[:0] = notes
     for msg in report.unreadable:
         click.echo(f"error: {msg}", err=True)
     if as_json:
@@ -45,5 +59,8 @@ def check(paths: tuple[Path, ...], as_json: bool, strict: bool, list_rules: bool
         for d in report.diagnostics:
             if d.severity == "error" or not is_quiet():
                 click.echo(d.format())
+        if not is_quiet():
+            for note in report.notes:
+                click.echo(note)
         click.echo(report.summary())
     sys.exit(report.exit_code(strict))

@@ -10,7 +10,7 @@ import math
 import re
 import shutil
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +22,8 @@ from ..errors import VehicleError
 from .main import echo
 from .options import force_option, name_option, out_option, scale_option, up_option
 
+#: the model file's axes a vehicle may face (``--forward``)
+FORWARD_AXES = ("+x", "-x", "+y", "-y", "+z", "-z")
 HULL_POINTS = (8, 16)
 LEVELS = (1, 5)
 BRANCHING = (2, 8)
@@ -44,6 +46,7 @@ class ImportResult:
     inertia: float
     method: str
     seconds: float
+    warnings: list[str] = field(default_factory=list)
 
     def summary(self) -> str:
         ratio = self.footprint_area / self.convex_area if self.convex_area else 1.0
@@ -53,9 +56,15 @@ class ImportResult:
             f"{ratio:.3f} x convex hull ({self.convex_area:.3f} m^2)",
             f"  spheres  {self.sphere_count} in {self.levels} levels, {self.leaf_count} leaves, "
             f"root radius {self.root_radius:.3f} m",
-            f"  mass     {self.mass:,.0f} kg ({self.method}), inertia {self.inertia:,.0f} kg m^2 about the vertical axis",
+            f"  mass     {_amount(self.mass)} kg ({self.method}), inertia {_amount(self.inertia)} kg m^2 "
+            "about the vertical axis",
             f"  took     {self.seconds:.2f} s",
         ])
+
+
+def _amount(x: float) -> str:
+    """A figure as people read it: thousands separated, small ones with their digits."""
+    return f"{x:,.0f}" if abs(x) >= 1000 else f"{x:.4g}"
 
 
 def check_options(hull_points: int, sphere_levels: int, branching: int, mass: float | None, name: str) -> None:
@@ -74,6 +83,32 @@ def check_options(hull_points: int, sphere_levels: int, branching: int, mass: fl
         raise VehicleError(f"--name {name!r}: use letters, digits, '_', '-' and '.' only")
 
 
+def forward_rotation(forward: str, up: str) -> np.ndarray:
+    """4x4 rotation about the world's vertical (y) axis that turns the model file's
+    ``forward`` axis to +x, the vehicle frame's front.
+
+    The file's axes have already been turned Y-up by :func:`load_scene` (``up``: "z"
+    maps file (x, y, z) to (x, z, -y)), so ``forward`` is first mapped the same way;
+    it must be horizontal, i.e. not the file's up axis.
+    """
+    if forward not in FORWARD_AXES:
+        raise VehicleError(f"--forward must be one of {' '.join(FORWARD_AXES)}, got {forward!r}")
+    if forward[1] == up:
+        raise VehicleError(f"--forward {forward} is the model's up axis (--up {up}): the front must be "
+                           "a horizontal axis")
+    e = np.zeros(3)
+    e["xyz".index(forward[1])] = 1.0 if forward[0] == "+" else -1.0
+    wx, _, wz = (e[0], e[2], -e[1]) if up == "z" else (e[0], e[1], e[2])
+    m = np.eye(4)
+    m[:3, :3] = [[wx, 0.0, wz], [0.0, 1.0, 0.0], [-wz, 0.0, wx]]
+    return m
+
+
+def _across_axis(up: str) -> str:
+    """The model file's horizontal axis that is not x (the one that maps to world z)."""
+    return "y" if up == "z" else "z"
+
+
 def vehicle_frame_offset(vertices: np.ndarray) -> np.ndarray:
     """Translation into the vehicle frame: origin at the centre of the footprint's
     bounding box, y = 0 at the lowest point."""
@@ -82,34 +117,68 @@ def vehicle_frame_offset(vertices: np.ndarray) -> np.ndarray:
 
 
 def derive(mesh, hull_points_n: int, levels: int, branching: int, mass: float | None):
-    """Hull, sphere tree and mass properties of a vehicle-frame mesh."""
+    """Hull, sphere tree and mass properties of a vehicle-frame mesh.
+
+    The sphere tree is built on the vertices and surface samples, then refitted to
+    hold the whole surface (``cover_surface``): ``check`` tests it on points sampled
+    over the surface, not only on the vertices.
+    """
     from ..geometry.hull import hull_points
     from ..geometry.mass import mass_properties
-    from ..geometry.sphere_build import build_points, build_sphere_tree
+    from ..geometry.sphere_build import build_points, build_sphere_tree, cover_surface
 
     v = np.asarray(mesh.vertices, dtype=np.float64)
+    f = np.asarray(mesh.faces)
     hull, fp = hull_points(v, hull_points_n)
-    pts = build_points(v, np.asarray(mesh.faces), SURFACE_SAMPLES, seed=0)
-    tree = build_sphere_tree(pts, levels=levels, branching=branching, seed=0)
+    pts = build_points(v, f, SURFACE_SAMPLES, seed=0)
+    tree = cover_surface(build_sphere_tree(pts, levels=levels, branching=branching, seed=0), v, f)
     mp = mass_properties(mesh, fp.polygon, mass=mass)
     return hull, fp, tree, mp
+
+
+def sanity_warnings(model: Path, vertices: np.ndarray, mass: float, forward: str, up: str) -> list[str]:
+    """What looks wrong with an imported vehicle (it is still written): lying on its
+    side, facing sideways, an absurd size or mass.  The same tests as ``check``'s
+    V105-V107 and V303 (:mod:`tanktool.geometry.proportions`)."""
+    from ..geometry.proportions import mass_problem, on_its_side, proportions, sideways, size_problem
+
+    p = proportions(vertices)
+    out = []
+    why = on_its_side(p)
+    if why:
+        other = "y" if up == "z" else "z"
+        out.append(f"{model}: {why}: is the file's up axis {other}? (--up {other}; it was read as --up {up})")
+    why = sideways(p)
+    if why:
+        ax = _across_axis(up) if forward[1] == "x" else "x"
+        out.append(f"{model}: {why} (--forward {forward}): does it face +{ax} or -{ax}? "
+                   f"(--forward +{ax} or --forward -{ax})")
+    why = size_problem(p)
+    if why:
+        out.append(f"{model}: {why}: wrong --scale? (the model's units times --scale must be metres)")
+    why = mass_problem(mass)
+    if why:
+        out.append(f"{model}: {why}: wrong --scale or --mass?")
+    return out
 
 
 def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = None, scale: float = 1.0,
                          hull_points_n: int = 16, levels: int = 3, branching: int = 4,
                          mass: float | None = None, force: bool = False,
-                         drive: dict[str, Any] | None = None) -> ImportResult:
+                         drive: dict[str, Any] | None = None, forward: str = "+x") -> ImportResult:
     """Read ``model`` and write the vehicle bundle ``out`` atomically.
 
-    ``drive`` replaces the computed [drive] defaults (``make vehicles`` keeps the
-    hand-edited figures of a bundled vehicle this way).
+    ``forward`` is the model file's axis that points to the vehicle's front; it is
+    turned to +x.  ``drive`` replaces the computed [drive] defaults (``make vehicles``
+    keeps the hand-edited figures of a bundled vehicle this way).  What looks wrong
+    but is written anyway is in the result's ``warnings``.
     """
     import trimesh
 
     from ..formats.bundle import dumps_toml, sha256_file, staged_dir, atomic_write_text, atomic_write_bytes
     from ..formats.models import default_up, detect_format, load_scene
     from ..formats.vehicle_bundle import write_hull
-    from ..geometry.mass import drive_defaults
+    from ..geometry.mass import drive_defaults, sig, to_scale
     from ..geometry.spheres import write_spheres
     from ..plots.vehicle import plot_vehicle
 
@@ -123,7 +192,10 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
         raise VehicleError(f"{out}: the output folder must not be the folder of the model being imported")
     fmt = detect_format(model)
     up_used = up or default_up(fmt)
+    turn = forward_rotation(forward, up_used)
     scene = load_scene(model, up=up_used, scale=scale)
+    if not np.array_equal(turn, np.eye(4)):
+        scene.apply_transform(turn)
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
     extent = np.ptp(mesh.vertices, axis=0)
@@ -140,6 +212,7 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
         raise VehicleError(f"{model}: its volume ({mp.volume:.3g} m^3, {mp.method}) gives a mass of "
                            f"{mp.mass:.4g} kg, outside {MASS_RANGE[0]:g}..{MASS_RANGE[1]:g} kg: "
                            f"wrong --scale? or give --mass")
+    warnings = sanity_warnings(model, np.asarray(mesh.vertices), mp.mass, forward, up_used)
     params = drive_defaults(mp.mass, mp.inertia)
     if drive:
         params.update({k: drive[k] for k in params if k in drive})
@@ -154,20 +227,23 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
         plot_vehicle(tmp / "preview.png", mesh, hull, tree,
                      title=f"{name}: {len(hull)} hull points, {len(tree)} spheres, {mp.mass / 1000:.1f} t")
         radius = float(np.max(np.hypot(hull[:, 0], hull[:, 2])))
+        size = float(np.ptp(np.asarray(mesh.vertices), axis=0).max())
+        # significant digits, not fixed decimals: a 5 cm model keeps its figures too
         doc = {
             "name": name,
             "tool_version": __version__,
-            "footprint_radius": round(radius, 4),
+            "footprint_radius": sig(radius),
             "source": {"file": source_name, "sha256": sha256_file(tmp / source_name), "up": up_used,
-                       "scale": float(scale), "vehicle_frame_offset": [round(float(x), 6) + 0.0 for x in offset]},
+                       "forward": forward, "scale": float(scale),
+                       "vehicle_frame_offset": [to_scale(x, size) for x in offset]},
             "model": {"file": "model.glb"},
-            "mass": {"mass": round(mp.mass, 3), "inertia": round(mp.inertia, 3),
-                     "centre_of_mass": [round(float(x), 4) for x in mp.centre_of_mass],
-                     "method": mp.method, "volume": round(mp.volume, 6),
+            "mass": {"mass": sig(mp.mass), "inertia": sig(mp.inertia),
+                     "centre_of_mass": [to_scale(x, size) for x in mp.centre_of_mass],
+                     "method": mp.method, "volume": sig(mp.volume),
                      "mass_given": mass is not None},
             "drive": params,
             "hull": {"file": "hull.txt", "points": int(len(hull)), "requested": hull_points_n,
-                     "footprint_area": round(fp.area, 6), "convex_area": round(fp.convex_area, 6)},
+                     "footprint_area": sig(fp.area), "convex_area": sig(fp.convex_area)},
             "spheres": {"file": "spheres.txt", "levels": int(tree.levels), "branching": branching,
                         "count": int(len(tree)), "leaves": int(len(tree.leaves())),
                         "requested_levels": levels},
@@ -176,7 +252,7 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
         atomic_write_text(tmp / "vehicle.toml", DRIVE_COMMENT + dumps_toml(doc))
     return ImportResult(out, name, len(hull), fp.area, fp.convex_area, len(tree), len(tree.leaves()),
                         int(tree.levels), float(tree.radii[0]), mp.mass, mp.inertia, mp.method,
-                        time.perf_counter() - t0)
+                        time.perf_counter() - t0, warnings)
 
 
 DRIVE_COMMENT = """\
@@ -204,18 +280,26 @@ DRIVE_COMMENT = """\
 @click.option("--branching", type=int, default=4, show_default=True, help="Children per sphere (2..8).")
 @click.option("--mass", type=float, default=None,
               help="Mass in kg (default: 2000 kg/m^3 times the model's volume).")
+@click.option("--forward", type=click.Choice(FORWARD_AXES), default="+x", show_default=True,
+              help="The model file's axis that points to the vehicle's front (it is turned to +x).")
 @force_option
 def import_vehicle(model: Path, out: Path | None, name: str | None, up: str | None, scale: float,
-                   hull_points: int, sphere_levels: int, branching: int, mass: float | None, force: bool) -> None:
+                   hull_points: int, sphere_levels: int, branching: int, mass: float | None, forward: str,
+                   force: bool) -> None:
     """Turn a vehicle MODEL (.3ds, .obj, .stl, .glb, ...) into a vehicle bundle.
 
     Writes vehicle.toml, a copy of MODEL, model.glb, hull.txt, spheres.txt and
-    preview.png into the bundle folder, all or nothing.  The model should face +x.
+    preview.png into the bundle folder, all or nothing.  The vehicle's front is the
+    file's --forward axis (default +x).  A vehicle that looks wrong (on its side,
+    facing sideways, an absurd size or mass) is written with a warning.
     """
     name = name or model.stem
     out = out if out is not None else Path(name)
     result = build_vehicle_bundle(model, out, name, up=up, scale=scale, hull_points_n=hull_points,
-                                  levels=sphere_levels, branching=branching, mass=mass, force=force)
+                                  levels=sphere_levels, branching=branching, mass=mass, force=force,
+                                  forward=forward)
+    for w in result.warnings:
+        click.echo(f"warning: {w}", err=True)
     echo(result.summary())
 
 
@@ -229,6 +313,7 @@ def load_vehicle_source(bundle: Path):
     doc = read_toml(Path(bundle) / "vehicle.toml")
     src = doc["source"]
     scene = load_scene(Path(bundle) / src["file"], up=src["up"], scale=src["scale"])
+    scene.apply_transform(forward_rotation(src.get("forward", "+x"), src["up"]))
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
     mesh.apply_translation(vehicle_frame_offset(np.asarray(mesh.vertices)))
@@ -239,7 +324,7 @@ def rebuild_params(doc: dict[str, Any]) -> dict[str, Any]:
     """The build_vehicle_bundle keyword arguments a bundle was made with."""
     src, hull, spheres, mass = doc["source"], doc["hull"], doc["spheres"], doc["mass"]
     return {
-        "up": src["up"], "scale": float(src["scale"]),
+        "up": src["up"], "scale": float(src["scale"]), "forward": src.get("forward", "+x"),
         "hull_points_n": int(hull.get("requested", hull["points"])),
         "levels": int(spheres.get("requested_levels", spheres["levels"])),
         "branching": int(spheres["branching"]),

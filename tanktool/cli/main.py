@@ -2,12 +2,15 @@
 
 Commands live in one module each and are imported only when invoked, so that
 ``tanktool --help`` stays instant.  Errors derived from TanktoolError become one
-line on stderr and exit status 2 (``-v`` shows the traceback).
+line on stderr and exit status 2 (``-v`` shows the traceback).  ``-v`` and ``-q``
+work anywhere on the line: before the sub-command (the group's options) or after
+it (every command gets the same two options, see :func:`_add_output_options`).
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import logging
 import re
 import sys
@@ -39,6 +42,44 @@ class UserError(click.ClickException):
         click.echo(f"error: {self.format_message()}", err=True)
 
 
+def _set_output(ctx: click.Context, verbose: int, quiet: bool) -> None:
+    """Record -v/-q in the root context's dict (where :func:`is_quiet` and the error
+    handler look) and set the logging level from them."""
+    root = ctx.find_root()
+    root.ensure_object(dict)
+    obj = root.obj
+    obj["verbose"] = obj.get("verbose", 0) + verbose
+    obj["quiet"] = bool(obj.get("quiet", False) or quiet)
+    v, q = obj["verbose"], obj["quiet"]
+    level = logging.ERROR if q else (logging.DEBUG if v > 1 else logging.INFO if v else logging.WARNING)
+    logging.basicConfig(level=level, format="%(message)s")
+    logging.getLogger().setLevel(level)
+
+
+def _verbose_cb(ctx: click.Context, param: click.Parameter, value: int) -> None:
+    if value:
+        _set_output(ctx, value, False)
+
+
+def _quiet_cb(ctx: click.Context, param: click.Parameter, value: bool) -> None:
+    if value:
+        _set_output(ctx, 0, True)
+
+
+def _add_output_options(cmd: click.Command) -> click.Command:
+    """Give a sub-command the group's -v/-q (once): ``tanktool check -q x`` then means
+    the same as ``tanktool -q check x``.  They are eager so that they take effect
+    before any other option's callback runs."""
+    names = {o for p in cmd.params for o in getattr(p, "opts", [])}
+    if "-v" not in names and "--verbose" not in names:
+        cmd.params.append(click.Option(["-v", "--verbose"], count=True, expose_value=False, is_eager=True,
+                                       callback=_verbose_cb, help="More output; tracebacks on errors."))
+    if "-q" not in names and "--quiet" not in names:
+        cmd.params.append(click.Option(["-q", "--quiet"], is_flag=True, expose_value=False, is_eager=True,
+                                       callback=_quiet_cb, help="Only errors; no progress bars."))
+    return cmd
+
+
 class LazyGroup(click.Group):
     def invoke(self, ctx: click.Context):
         try:
@@ -59,7 +100,7 @@ class LazyGroup(click.Group):
         if name not in COMMANDS or not self._available(name):
             return None
         module, attr, _ = COMMANDS[name]
-        return getattr(importlib.import_module(module), attr)
+        return _add_output_options(getattr(importlib.import_module(module), attr))
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         rows = [(name, COMMANDS[name][2]) for name in self.list_commands(ctx)]
@@ -85,10 +126,9 @@ def cli(ctx: click.Context, verbose: int, quiet: bool) -> None:
       tanktool play --arena arenas/mine
     """
     ctx.ensure_object(dict)
-    ctx.obj["verbose"] = verbose
-    ctx.obj["quiet"] = quiet
-    level = logging.ERROR if quiet else (logging.DEBUG if verbose > 1 else logging.INFO if verbose else logging.WARNING)
-    logging.basicConfig(level=level, format="%(message)s")
+    ctx.obj["verbose"] = 0
+    ctx.obj["quiet"] = False
+    _set_output(ctx, verbose, quiet)
 
 
 def is_quiet() -> bool:
@@ -106,6 +146,16 @@ def echo(message: str) -> None:
         click.echo(message)
 
 
+def _wants_verbose(args: list[str]) -> bool:
+    """-v anywhere on the line (before a ``--`` that ends the options)."""
+    for a in args:
+        if a == "--":
+            return False
+        if a == "--verbose" or re.fullmatch(r"-v+", a):
+            return True
+    return False
+
+
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point: click's own handling plus a short line for bugs."""
     args = sys.argv[1:] if argv is None else argv
@@ -114,7 +164,7 @@ def main(argv: list[str] | None = None) -> None:
     except SystemExit:
         raise
     except Exception as e:  # a bug, not bad input: say so briefly unless -v
-        if any(a == "--verbose" or re.fullmatch(r"-v+", a) for a in args):
+        if _wants_verbose(args):
             traceback.print_exc()
         else:
             click.echo(f"internal error: {type(e).__name__}: {e} (run with -v for the traceback)", err=True)

@@ -6,7 +6,13 @@ the machine allows and can write a JSON report; with ``--frames``/``--screenshot
 of the 3D or top view instead (``tanktool.game.headless``).  Without ``--headless`` the
 game window opens (``tanktool.game.app``); when there is no display to open it on, the
 command says so and does the best thing that exists: a short headless match on the
-default arena, a scoreboard, and a top-view picture of the final state.
+default arena and a scoreboard (and, with ``--picture``, a top view of the final
+state: nothing is written into the working folder unless asked for).
+
+``--seconds`` is the length of a match everywhere: headless, and in the window, where
+each local match ends after that much simulated time and the menu comes back.  A
+replay lasts as long as its recording, and a network match in the window until you
+quit: there ``--seconds`` is refused/ignored with a word, never silently.
 """
 
 from __future__ import annotations
@@ -48,7 +54,8 @@ def _size(text: str) -> tuple[int, int]:
               help="Vehicle bundle: a folder, or the name of a bundled one (light, heavy).")
 @click.option("--bots", type=click.IntRange(1, 64), default=None, help="Number of tanks (default 8 headless, 4 otherwise).")
 @click.option("--seconds", type=click.FloatRange(0, 86400, min_open=True), default=None,
-              help="Simulated seconds (default 60 headless, 20 otherwise).")
+              help="Length of a match in simulated seconds: headless (default 60), in the window (each "
+                   "match ends after it; default: when you quit), without a display (default 20).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed: same seed, same match.")
 @click.option("--difficulty", type=click.Choice(["easy", "normal", "hard"]), default="normal", show_default=True,
               help="Computer opponents' skill: reaction time, aim noise, vision range (headless matches).")
@@ -59,7 +66,7 @@ def _size(text: str) -> tuple[int, int]:
 @click.option("--report", "report_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Write the match report (JSON) here.")
 @click.option("--picture", "picture", type=click.Path(dir_okay=False, path_type=Path), default=None,
-              help="Save a top view of the final state (PNG).  Default without --headless: match.png.")
+              help="Save a top view of the final state (PNG): headless, or without a display.")
 @click.option("--view", type=click.Choice(["3d", "top"]), default="3d", show_default=True,
               help="3D view (OpenGL) or the 2D top-down view: the window's first view, or what --screenshot renders.")
 @click.option("--frames", type=click.IntRange(0, 1_000_000), default=None,
@@ -100,6 +107,9 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         if record_path is not None or replay_path is not None:
             raise click.UsageError("network matches are not recorded: --record/--replay go without --host/--join")
 
+        if not headless and seconds is not None and _window_possible():
+            click.echo("warning: --seconds is ignored in a network match in the window (it lasts until you "
+                       "quit); use --headless for a timed network match", err=True)
         if not headless and run_network_window(host, join, player_name, password, arena, vehicle, bots, seed,
                                                view, _size(size), fullscreen, echo):
             return
@@ -136,6 +146,10 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         for out in (record_path, report_path, picture):
             if out is not None and not out.parent.exists():
                 raise TanktoolError(f"{out}: folder {out.parent} does not exist")
+        if replay_path is not None and seconds is not None:
+            click.echo(f"warning: --seconds {seconds:g} ignored: a replay lasts as long as its recording",
+                       err=True)
+            seconds = None
         if replay_path is not None and not headless and report_path is None and picture is None:
             # the recording in the game window; no display: the headless playback and its check
             from ..game.app import NoDisplay, run_window
@@ -166,7 +180,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         try:
             saved = run_window(arena=arena, vehicle=vehicle, bots=3 if bots is None else max(bots - 1, 0),
                                seed=seed, view=view, size=(width, height), fullscreen=fullscreen,
-                               difficulty=difficulty, bot=bot_driver, record=record_path)
+                               difficulty=difficulty, bot=bot_driver, record=record_path, seconds=seconds)
             for line in saved:
                 echo(line)
             if record_path is not None and not saved:
@@ -174,10 +188,9 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             return
         except NoDisplay as e:
             echo(f"no display to open the game window ({e}); running a short headless match instead "
-                 "(tanktool play --headless for options).")
+                 "(tanktool play --headless for options; --picture F.png saves a top view).")
         bots = 4 if bots is None else bots
         seconds = 20.0 if seconds is None else seconds
-        picture = picture or Path("match.png")
     bots = 8 if bots is None else bots
     seconds = 60.0 if seconds is None else seconds
     replay = None
@@ -240,6 +253,12 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             raise click.ClickException(f"replay diverged from the recording: final state sha256 "
                                        f"{playback.digest[:16]}..., recorded {replay.header['final_state'][:16]}...")
         echo(f"replay: final state matches the recording bit for bit (sha256 {playback.digest[:16]}...)")
+
+
+def _window_possible() -> bool:
+    from ..game.app import display_problem
+
+    return display_problem() is None
 
 
 def _stored_ref(ref: str | None) -> str | None:

@@ -14,6 +14,12 @@ counter-clockwise seen from above):
   2S x 2S); default S = 400, an 800 x 800 world.  A ground plane covers it and,
   unless ``nowalls`` is given, four outer walls 6.15 high (BZFlag's
   ``_wallHeight`` = 3 x tank height) stand just outside its edge.
+- ``options``: the server options a world carries.  ``-set _worldSize W`` is the
+  *full* width (BZFlag's BZDB variable, default 800: the same as ``world size
+  W/2``) and ``-set _wallHeight H`` the outer walls' height; both ``world size`` and
+  ``_worldSize`` set the same variable as bzfs reads the file, so the later one wins
+  (with a warning when they disagree).  The other options (game rules: flags,
+  jumping, shots, ...) do not change the arena and are named in one warning.
 - ``box`` / ``meshbox``: ``size`` x and y are half-extents, z the full height
   from ``position``'s z up (default 30 30 9.42).
 - ``pyramid`` / ``meshpyr``: a rectangle of half-extents x, y at z, apex at the
@@ -117,6 +123,8 @@ class BzwWorld:
     path: Path
     size: float = WORLD_SIZE       # half-width: the world spans [-size, size] in x and y
     walls: bool = True             # BZFlag's outer walls
+    wall_height: float = OUTER_WALL_HEIGHT   # the outer walls' height (options -set _wallHeight)
+    size_from: str = ""            # what set ``size`` last ("line 3: world size 60"), for warnings
     objects: list[BzwObject] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
 
@@ -167,6 +175,8 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
     skipping: tuple[str, int] | None = None  # an unknown object being skipped: (kind, line)
     skip_stack: list[str] = []             # drawinfo / lod / matref blocks inside it
     in_define: int | None = None
+    options: list[tuple[int, str]] | None = None   # tokens of an open ``options`` block, with lines
+    options_line = 0
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = _strip(raw)
         if not line:
@@ -177,6 +187,13 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
         if in_define is not None:
             if key == "enddef":
                 in_define = None
+            continue
+        if options is not None:
+            if key == "end" and not args:
+                _apply_options(path, options_line, options, world)
+                options = None
+            else:
+                options.extend((lineno, w) for w in words)
             continue
         if skipping is not None:
             # BZFlag's mesh drawinfo nests blocks that close with their own ``end``
@@ -193,6 +210,8 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
                 raise FormatError(f"{path}:{lineno}: 'end' without an object to close")
             if key == "world":
                 in_world = lineno
+            elif key == "options":
+                options, options_line = [(lineno, w) for w in args], lineno
             elif key in SOLIDS:
                 current = BzwObject(key, lineno, size=DEFAULT_SIZE[key])
             elif key == "define":
@@ -217,7 +236,7 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
                 (s,) = _numbers(path, lineno, "size", args, 1)
                 if s <= 0:
                     raise FormatError(f"{path}:{lineno}: world 'size' must be positive, got {s:g}")
-                world.size = s
+                _set_size(world, s, lineno, f"world size {s:g}")
             elif key == "nowalls":
                 world.walls = False
             elif key not in _QUIET_PROPS:
@@ -245,12 +264,59 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
             warn(f"{path}:{lineno}: {current.kind} property '{words[0]}' ignored")
     for open_line, what in ((current.line if current else None, current.kind if current else ""),
                             (in_world, "world"), (skipping[1] if skipping else None, skipping[0] if skipping else ""),
-                            (in_define, "define")):
+                            (in_define, "define"), (options_line if options is not None else None, "options")):
         if open_line is not None:
             closer = "enddef" if what == "define" else "end"
             raise FormatError(f"{path}:{open_line}: '{what}' is never closed (expected '{closer}' "
                               f"before the end of the file)")
     return world
+
+
+def _set_size(world: BzwWorld, half: float, line: int, said: str) -> None:
+    """The world's half-width, set by ``world size`` or ``_worldSize``: the later wins,
+    as in bzfs (both set one variable while the file is read); say so if they differ."""
+    if world.size_from and not math.isclose(half, world.size, rel_tol=1e-9):
+        world.warnings.append(f"{world.path}:{line}: {said} replaces {world.size_from}: the world is "
+                              f"{2 * half:g} x {2 * half:g} m (the later setting wins, as in bzfs)")
+    world.size, world.size_from = half, f"{said} (line {line})"
+
+
+#: BZDB variables that shape the arena, read from ``options -set NAME VALUE``
+_GEOMETRY_VARS = ("_worldsize", "_wallheight")
+
+
+def _apply_options(path: Path, line: int, tokens: list[tuple[int, str]], world: BzwWorld) -> None:
+    """Read an ``options`` block's tokens (bzfs command-line arguments)."""
+    ignored: list[str] = []
+    i = 0
+    while i < len(tokens):
+        at, tok = tokens[i]
+        if tok.lower() == "-set" and i + 2 < len(tokens) and tokens[i + 1][1].lower() in _GEOMETRY_VARS:
+            name, value = tokens[i + 1][1], tokens[i + 2][1]
+            try:
+                v = float(value)
+            except ValueError:
+                v = math.nan
+            if not math.isfinite(v) or v <= 0:
+                raise FormatError(f"{path}:{tokens[i + 2][0]}: options -set {name} expects a positive number "
+                                  f"(metres), got {value!r}")
+            if name.lower() == "_worldsize":
+                _set_size(world, v / 2, at, f"options -set {name} {value}")
+            else:
+                world.wall_height = v
+            i += 3
+            continue
+        if tok.lower() == "-set" and i + 2 < len(tokens):
+            ignored.append(f"-set {tokens[i + 1][1]} {tokens[i + 2][1]}")
+            i += 3
+            continue
+        ignored.append(tok)
+        i += 1
+    if ignored:
+        shown = " ".join(ignored)
+        if len(shown) > 120:
+            shown = shown[:117] + "..."
+        world.warnings.append(f"{path}:{line}: options that do not change the arena ignored: {shown}")
 
 
 def _finish(path: Path, obj: BzwObject, world: BzwWorld) -> None:
@@ -369,7 +435,7 @@ def world_meshes(world: BzwWorld) -> dict[str, tuple[np.ndarray, np.ndarray, tup
         walls = []
         for cx, cy, hx, hy in ((0.0, -s - t / 2, s + t, t / 2), (0.0, s + t / 2, s + t, t / 2),
                                (-s - t / 2, 0.0, t / 2, s), (s + t / 2, 0.0, t / 2, s)):
-            v, f = box_mesh(hx, hy, 0.0, OUTER_WALL_HEIGHT)
+            v, f = box_mesh(hx, hy, 0.0, world.wall_height)
             v[:, 0] += cx
             v[:, 1] += cy
             walls.append((v, f))

@@ -60,12 +60,10 @@ def display_problem() -> str | None:
 
 
 def bundled(kind: str) -> list[str]:
-    """Names of the bundled arenas or vehicles."""
-    from ..sim.match import REPO
+    """Names of the bundled arenas or vehicles (in the package or the checkout)."""
+    from ..content import bundled_names
 
-    base = REPO / kind
-    manifest = "arena.toml" if kind == "arenas" else "vehicle.toml"
-    return sorted(d.name for d in base.iterdir() if (d / manifest).is_file()) if base.is_dir() else []
+    return bundled_names(kind)
 
 
 @dataclass
@@ -169,7 +167,8 @@ class App:
                  bots: int = 3, seed: int = 0, view: str = "3d", size: tuple[int, int] = (1280, 720),
                  fullscreen: bool = False, bindings: Bindings | None = None, sound: bool = True,
                  bindings_file: Path | None = None, difficulty: str = "normal", bot: str = "agent",
-                 record: Path | None = None, replay: Any = None, replay_name: str = "") -> None:
+                 record: Path | None = None, replay: Any = None, replay_name: str = "",
+                 seconds: float | None = None) -> None:
         arenas, vehicles = bundled("arenas"), bundled("vehicles")
         self.menu = Menu(Choice("arena", arenas + ([arena] if arena and arena not in arenas else [])),
                          Choice("vehicle", vehicles + ([vehicle] if vehicle and vehicle not in vehicles else [])
@@ -217,6 +216,8 @@ class App:
         self._notice_seen, self._notice_t = "", 0.0
         self.player_name: str | None = None
         self.password: str | None = None
+        #: ``--seconds``: a local match ends after this much simulated time (None: when you quit)
+        self.match_seconds = seconds
 
     # ------------------------------------------------------------------ lifecycle
     def size(self) -> tuple[int, int]:
@@ -512,12 +513,26 @@ class App:
                 self._replay_over()
                 self.acc = 0.0
                 break
+            if self._time_up():
+                break
             events = self.session.step(self.input.command())
             if self.audio is not None:
                 self.audio.on_events(events)
             self.acc -= dt
             steps += 1
         return steps
+
+    def _time_up(self) -> bool:
+        """``--seconds`` is over for a local match: record it, back to the menu with a notice."""
+        if self.match_seconds is None or self.replay is not None or self.session is None:
+            return False
+        if self.session.world.steps * self.session.dt < self.match_seconds - 1e-9:
+            return False
+        self.end_match()
+        self.acc = 0.0
+        self.state = "menu"
+        self.notice = f"time up: the match lasted {self.match_seconds:g} s (--seconds)"
+        return True
 
     def _replay_over(self) -> None:
         if self.replay_done:
@@ -628,18 +643,20 @@ def run_window(arena: str | None = None, vehicle: str | None = None, bots: int =
                view: str = "3d", size: tuple[int, int] = (1280, 720), fullscreen: bool = False,
                difficulty: str = "normal", bot: str = "agent", record: Path | None = None,
                replay: Any = None, replay_name: str = "", network: tuple[str, str] | None = None,
-               name: str | None = None, password: str | None = None) -> list[str]:
+               name: str | None = None, password: str | None = None,
+               seconds: float | None = None) -> list[str]:
     """Open the window and play until the player quits (``record``: every match is
     recorded, the file holds the last one; ``replay``: show that recording instead of
     the menu; ``network``: ("host" or "join", address) starts that network match at
-    once).  Returns the lines saying what happened (files written, network summary).
+    once; ``seconds``: each local match ends after that much simulated time and the
+    menu comes back).  Returns the lines saying what happened (files written, network summary).
     Raises NoDisplay when there is no screen."""
     problem = display_problem()
     if problem is not None:
         raise NoDisplay(problem)
     pygame.init()
     app = App(None, arena, vehicle, bots, seed, view, size, fullscreen, difficulty=difficulty, bot=bot,
-              record=record, replay=replay, replay_name=replay_name)
+              record=record, replay=replay, replay_name=replay_name, seconds=seconds)
     app.player_name, app.password = name, password
     app.open_window()
     try:

@@ -77,6 +77,20 @@ def polygon_area(poly: np.ndarray) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
 
 
+def min_width(poly: np.ndarray) -> float:
+    """Narrowest extent of a convex polygon: over its edge directions, the largest
+    distance of a vertex from the edge's line (rotating calipers, all edges at once)."""
+    p = np.asarray(poly, dtype=np.float64)
+    e = np.roll(p, -1, axis=0) - p
+    L = np.hypot(e[:, 0], e[:, 1])
+    ok = L > 0
+    if not ok.any():
+        return 0.0
+    e, a = e[ok] / L[ok, None], p[ok]
+    d = np.abs(e[:, None, 0] * (p[None, :, 1] - a[:, None, 1]) - e[:, None, 1] * (p[None, :, 0] - a[:, None, 0]))
+    return float(d.max(axis=1).min())
+
+
 def _support(hull: np.ndarray, theta: np.ndarray) -> np.ndarray:
     """h(θ) = max over hull corners of (cos θ, sin θ)·p, for each θ."""
     n = np.stack([np.cos(theta), np.sin(theta)], axis=-1)

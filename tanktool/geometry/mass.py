@@ -14,6 +14,7 @@ gives 26 t for the bundled light tank (5.8 x 2.9 x 1.8 m) and 68 t for the heavy
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +28,25 @@ ACCELERATION = 3.0        # m/s^2 at full throttle from rest
 TURN_ACCELERATION = 1.5   # rad/s^2 at full steer from rest
 SHELL_SPEED = 200.0       # m/s: slow enough to see, fast enough to need leading
 RESTITUTION = 0.2
+
+
+def sig(x: float, digits: int = 8) -> float:
+    """``x`` to ``digits`` significant digits, for writing: a small vehicle's figures
+    keep their digits (fixed decimals turned a 1.2e-5 N m turn torque into 0.0)."""
+    x = float(x)
+    if x == 0.0 or not math.isfinite(x):
+        return x + 0.0
+    return float(f"{x:.{digits}g}") + 0.0     # + 0.0: no "-0.0"
+
+
+def to_scale(x: float, scale: float, digits: int = 8) -> float:
+    """``x`` (a coordinate of a body ``scale`` metres across) rounded to ``digits``
+    significant digits of ``scale``: the same absolute precision for every coordinate,
+    fine enough for a toy, not noisy for a tank."""
+    x = float(x)
+    if not (scale > 0 and math.isfinite(scale)) or not math.isfinite(x):
+        return sig(x, digits)
+    return round(x, digits - 1 - math.floor(math.log10(scale))) + 0.0
 
 
 @dataclass
@@ -105,14 +125,15 @@ def drive_defaults(mass: float, inertia: float) -> dict[str, float]:
     top_speed = float(np.clip(17.5 - tonnes / 8.0, 10.0, 15.0))
     engine_force = mass * ACCELERATION
     friction = ACCELERATION / top_speed
+    # significant digits, never fixed decimals: a 2 kg model's turn torque is 1e-3 N m
     return {
-        "engine_force": round(engine_force, 1),
-        "turn_torque": round(inertia * TURN_ACCELERATION, 1),
-        "strafe_force": round(0.5 * engine_force, 1),
-        "friction": round(friction, 4),
+        "engine_force": sig(engine_force, 6),
+        "turn_torque": sig(inertia * TURN_ACCELERATION, 6),
+        "strafe_force": sig(0.5 * engine_force, 6),
+        "friction": sig(friction, 4),
         "restitution": RESTITUTION,
-        "top_speed": round(top_speed, 2),
-        "fire_interval": round(float(np.clip(0.6 + tonnes / 50.0, 0.8, 2.5)), 2),
+        "top_speed": sig(top_speed, 4),
+        "fire_interval": sig(float(np.clip(0.6 + tonnes / 50.0, 0.8, 2.5)), 3),
         "shell_speed": SHELL_SPEED,
         "hit_points": int(round(float(np.clip(100.0 * np.sqrt(max(tonnes, 1e-9) / 20.0), 50.0, 300.0)))),
     }

@@ -429,3 +429,99 @@ def excess_volume(centers: np.ndarray, radii: np.ndarray, inside, samples: int =
     if solid == 0:
         return float("inf")
     return float(np.sum(in_spheres & ~in_model)) / solid
+
+
+#: a triangle no leaf holds is halved until it is at most this fraction of the
+#: smallest leaf's radius long
+_COVER_EDGE = 0.25
+#: ... or until the halving has made this many vertices (a bound on time and memory)
+_COVER_VERTICES = 2_000_000
+
+
+def _halve(v: np.ndarray, f: np.ndarray, first: int) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles ``f`` of vertices ``v`` halved across their longest edge: the midpoints
+    (new vertices, numbered from ``first``) and the 2 x len(f) halves."""
+    t = v[f]
+    edges = np.linalg.norm(np.roll(t, -1, axis=1) - t, axis=2)      # edge i: corner i -> i+1
+    i = np.argmax(edges, axis=1)
+    rows = np.arange(len(f))
+    a, b, c = f[rows, i], f[rows, (i + 1) % 3], f[rows, (i + 2) % 3]
+    m = first + np.arange(len(f))
+    return (v[a] + v[b]) / 2, np.concatenate([np.stack([a, m, c], axis=1), np.stack([m, b, c], axis=1)])
+
+
+def cover_surface(tree: SphereTree, vertices: np.ndarray, faces: np.ndarray, seed: int = 0) -> SphereTree:
+    """The tree refitted to hold the model's whole surface, not only the points it was
+    built on (vertices and surface samples: a triangle whose corners fall in different
+    leaves may bulge out between them).
+
+    Each triangle is given to one leaf: among the leaves whose sphere holds its three
+    corners the one whose centre is nearest; a triangle no leaf holds is halved across
+    its longest edge, again and again, down to a quarter of the smallest leaf's radius,
+    and a piece still held by none goes to the leaf it sticks out of least.  Then every
+    sphere becomes the minimum sphere of the corners of the triangles given to its
+    subtree.  A ball is convex, so holding a triangle's corners is holding the triangle:
+    every point of the surface is in a leaf and in all the leaf's ancestors.  A leaf
+    given no triangle (its part lies wholly in its neighbours) keeps its sphere.  The
+    tree's shape (ids, parents, levels) does not change.
+    """
+    leaves = tree.leaves()
+    C, R = tree.centers[leaves], tree.radii[leaves]
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+    pending = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    span = (float(np.ptp(v, axis=0).max()) if len(v) else 1.0) or 1.0
+    positive = R[R > 1e-9 * span]
+    edge = max(_COVER_EDGE * (float(positive.min()) if len(positive) else span), 1e-9 * span)
+    rr = np.maximum(R, 1e-12 * span)
+
+    def distances(points: np.ndarray) -> np.ndarray:
+        return np.sqrt(((points[:, None, :] - C[None]) ** 2).sum(axis=2))     # (n, L)
+
+    verts, dist = [v], [distances(v)]
+    given_f, given_to = [], []
+    step = max(1, 3_000_000 // max(3 * len(leaves), 1))
+    for _ in range(64):
+        allv = verts[0] if len(verts) == 1 else np.concatenate(verts)
+        alld = dist[0] if len(dist) == 1 else np.concatenate(dist)
+        verts, dist = [allv], [alld]
+        left = []
+        for s0 in range(0, len(pending), step):
+            f = pending[s0:s0 + step]
+            d = alld[f]                                            # (k, 3, L)
+            out = (d - R[None, None]).max(axis=1)                  # (k, L) how far it sticks out
+            holds = out <= 1e-12 * span
+            held = holds.any(axis=1)
+            near = np.where(holds, d.mean(axis=1) / rr[None], np.inf)
+            given_f.append(f[held])
+            given_to.append(np.argmin(near[held], axis=1))
+            t = allv[f[~held]]
+            long = np.linalg.norm(np.roll(t, -1, axis=1) - t, axis=2).max(axis=1) > edge
+            given_f.append(f[~held][~long])                        # short enough: the least bad leaf
+            given_to.append(np.argmin(out[~held][~long], axis=1))
+            left.append(f[~held][long])
+        pending = np.concatenate(left) if left else np.zeros((0, 3), dtype=np.int64)
+        if not len(pending) or len(allv) > _COVER_VERTICES:
+            break
+        mids, pending = _halve(allv, pending, len(allv))
+        verts.append(mids)
+        dist.append(distances(mids))
+    allv = verts[0] if len(verts) == 1 else np.concatenate(verts)
+    if len(pending):                                               # the vertex budget ran out
+        d = (np.concatenate(dist) if len(dist) > 1 else dist[0])[pending]
+        given_f.append(pending)
+        given_to.append(np.argmin((d - R[None, None]).max(axis=1), axis=1))
+    f = np.concatenate(given_f)
+    owner = np.concatenate(given_to)
+    # the vertices given to each sphere: a leaf's own, and every node's through its leaves
+    given: dict[int, np.ndarray] = {}
+    for k, leaf in enumerate(leaves):
+        mine = f[owner == k]
+        if not len(mine):
+            continue
+        for node in tree.ancestors(int(leaf)):
+            mask = given.setdefault(int(node), np.zeros(len(allv), dtype=bool))
+            mask[mine.ravel()] = True
+    centers, radii = tree.centers.copy(), tree.radii.copy()
+    for node, mask in given.items():
+        centers[node], radii[node] = min_enclosing_sphere(allv[mask], seed)
+    return SphereTree(centers, radii, tree.parent.copy(), tree.level.copy())

@@ -49,29 +49,39 @@ class MatchResult:
 
 
 def _bundle_dir(ref: str | Path, kind: str, defaults: tuple[str, ...]) -> Path:
-    """A bundle folder from a path or a bundled name (``box`` -> <repo>/arenas/box)."""
+    """A bundle folder from a path or a bundled name (``box`` -> the bundled arenas/box,
+    inside the installed package or the checkout: tanktool/content.py)."""
+    from ..content import bundled_dir, bundled_names
+
     p = Path(ref)
     if p.exists():
         return p
-    for base in (REPO / kind, Path.cwd() / kind):
+    home = bundled_dir(kind)
+    for base in ([home] if home is not None else []) + [Path.cwd() / kind]:
         if (base / str(ref)).is_dir():
             return base / str(ref)
-    have = sorted(d.name for d in (REPO / kind).iterdir() if d.is_dir()) if (REPO / kind).is_dir() else []
+    have = bundled_names(kind)
     err = ArenaError if kind == "arenas" else VehicleError
     raise err(f"{ref}: no such {kind[:-1]} (a folder path, or one of: {', '.join(have) or 'none bundled yet'})")
 
 
 def default_arena() -> str | None:
     """The first bundled arena that exists, or None."""
+    from ..content import bundled_dir
+
+    home = bundled_dir("arenas")
     for name in DEFAULT_ARENAS:
-        if (REPO / "arenas" / name / "walls.txt").is_file():
+        if home is not None and (home / name / "walls.txt").is_file():
             return name
     return None
 
 
 def default_vehicle() -> str | None:
+    from ..content import bundled_dir
+
+    home = bundled_dir("vehicles")
     for name in DEFAULT_VEHICLES:
-        if (REPO / "vehicles" / name / "vehicle.toml").is_file():
+        if home is not None and (home / name / "vehicle.toml").is_file():
             return name
     return None
 
