@@ -15,8 +15,6 @@ from typing import Callable
 
 import numpy as np
 
-#: where the bundled vehicles live in a checkout
-VEHICLES_DIR = Path(__file__).resolve().parents[1] / "vehicles"
 
 
 @dataclass
@@ -35,11 +33,13 @@ class Fleet:
 def bundled_fleet(folder: Path | None = None, warn: Callable[[str], None] | None = None) -> Fleet:
     """The largest footprint radius, length and height over the vehicle bundles in
     ``folder`` (default the bundled ones); a broken bundle is skipped with a warning."""
+    from .content import bundled_dir
     from .formats.vehicle_bundle import load_vehicle
 
     fleet = Fleet()
     found = False
-    for vt in sorted((folder or VEHICLES_DIR).glob("*/vehicle.toml")):
+    folder = folder if folder is not None else bundled_dir("vehicles")
+    for vt in sorted(folder.glob("*/vehicle.toml")) if folder is not None else []:
         try:
             v = load_vehicle(vt.parent)
         except Exception as e:  # a broken vehicle must not stop the arena tools

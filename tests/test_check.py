@@ -317,9 +317,18 @@ def test_a_long_wall_votes_for_every_face_along_it():
 
 
 # ------------------------------------------------------------------ always against vehicles
-def _small_room(tmp_path: Path) -> Path:
-    """A 4.7 x 4.2 m room imported outside any arenas/ folder: no vehicle beside it."""
+def _small_room(tmp_path: Path, monkeypatch=None) -> Path:
+    """A 4.7 x 4.2 m room imported outside any arenas/ folder: no vehicle beside it.
+
+    import-arena refuses a model where no bundled tank fits; the room is made for a
+    1 m scout (a fleet of one small vehicle) so that check has something to refuse."""
     import trimesh
+
+    import tanktool.fleet as fleet_mod
+
+    if monkeypatch is not None:
+        monkeypatch.setattr(fleet_mod, "bundled_fleet", lambda *a, **k: fleet_mod.Fleet(1.0, 2.0, 1.5, "scout",
+                                                                                          "scout", "scout"))
 
     w, d, t, h = 4.7, 4.2, 0.2, 2.0
     parts = [trimesh.creation.box(extents=[w + 2 * t, 0.1, d + 2 * t]).apply_translation([w / 2, -0.05, d / 2])]
@@ -329,15 +338,18 @@ def _small_room(tmp_path: Path) -> Path:
     trimesh.util.concatenate(parts).export(tmp_path / "room.obj")
     res = CliRunner().invoke(cli, ["import-arena", str(tmp_path / "room.obj"), "-o", str(tmp_path / "room")])
     assert res.exit_code == 0, res.output
+    if monkeypatch is not None:
+        monkeypatch.undo()
     return tmp_path / "room"
 
 
-def test_an_arena_alone_is_checked_against_the_bundled_vehicles(tmp_path, root_dir):
+def test_an_arena_alone_is_checked_against_the_bundled_vehicles(tmp_path, root_dir, monkeypatch):
     # it used to pass, checked against no vehicle at all; then tanks left it in `play`
-    room = _small_room(tmp_path)
+    room = _small_room(tmp_path, monkeypatch)
     report = run_check([room])
-    assert {d.code for d in report.diagnostics} == {"A303"}
-    assert all("vehicle 'heavy'" in d.message for d in report.diagnostics)
+    # too small for the bundled tanks (A303); made for a scout, it has few spawns (A305)
+    assert {d.code for d in report.diagnostics} == {"A303", "A305"}
+    assert all("vehicle 'heavy'" in d.message for d in report.diagnostics if d.code == "A303")
     (note,) = report.notes
     assert note.startswith("note: arena 'room' checked against the bundled vehicles 'heavy', 'light' in ")
     assert "no vehicle named or beside it" in note
@@ -350,7 +362,7 @@ def test_an_arena_alone_is_checked_against_the_bundled_vehicles(tmp_path, root_d
     small = tmp_path / "small"
     shutil.copytree(BROKEN / "V107_tiny" / "vehicles" / "tank", small)
     report = run_check([room, small])
-    assert {d.code for d in report.diagnostics} == {"V107"} and report.notes == []
+    assert {d.code for d in report.diagnostics} == {"V107", "A305"} and report.notes == []
     # a vehicle alone meets the bundled arenas
     report = run_check([small])
     assert report.notes and report.notes[0].startswith("note: vehicle 'small' checked against the bundled arenas")

@@ -20,7 +20,13 @@ from .main import echo, is_quiet
 from .options import progress
 
 #: where bundled vehicles live (the largest footprint sets the default clearance)
-VEHICLES_DIR = Path(__file__).resolve().parents[2] / "vehicles"
+def _vehicles_dir() -> Path:
+    from ..content import CHECKOUT, bundled_dir
+
+    return bundled_dir("vehicles") or CHECKOUT / "vehicles"
+
+
+VEHICLES_DIR = _vehicles_dir()
 DEFAULTS = {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
 #: show a progress bar from this many nodes up
 PROGRESS_NODES = 1_000_000
@@ -222,7 +228,7 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
         from ..fleet import bundled_fleet
 
         wk = target.toml.get("walkable", {})
-        fleet = bundled_fleet(warn=lambda m: click.echo(f"warning: {m}", err=True))
+        fleet = bundled_fleet(VEHICLES_DIR, warn=lambda m: click.echo(f"warning: {m}", err=True))
         params, _ = walkable_params(cell, max_slope, climb, headroom, fleet, wk if isinstance(wk, dict) else {})
     elif any(v is not None for v in (max_slope, climb, headroom)):
         raise ArenaError(f"{arena}: --max-slope, --climb and --headroom need an arena bundle with its model "

@@ -313,7 +313,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
                 t = cut.thin_walls(chains, free, tolerance)
                 if len(t):
                     thin.append(t)
-            thin = np.concatenate(thin) if thin else np.zeros((0, 2, 2))
+            thin = _unique_segments(np.concatenate(thin), tolerance) if thin else np.zeros((0, 2, 2))
             segs = np.concatenate([outline, thin, thin[:, ::-1]]) if len(thin) else outline
             thin_total += 2 * len(thin)
             out_seg.append(segs)
@@ -332,6 +332,17 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     hi = pts.max(axis=0) + AUX_MARGIN
     walls.aux = aux_rectangle(lo[0], lo[1], hi[0], hi[1])
     return LevelWalls(walls, regions, thin_total, portal_len)
+
+
+def _unique_segments(seg: np.ndarray, tolerance: float) -> np.ndarray:
+    """Segments snapped to the tolerance grid, each kept once whichever way it runs (the
+    cuts at several heights meet the same vertical face)."""
+    q = np.round(seg / tolerance).astype(np.int64)
+    a, b = q[:, 0], q[:, 1]
+    swap = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
+    key = np.where(swap[:, None], np.concatenate([b, a], axis=1), np.concatenate([a, b], axis=1))
+    _, first = np.unique(key, axis=0, return_index=True)
+    return seg[np.sort(first)]
 
 
 def _mask_box(mask: np.ndarray, origin: np.ndarray, cell: float, grow: float) -> tuple[float, float, float, float]:
