@@ -208,7 +208,7 @@ def test_exit_seen_only_by_the_host_reaches_everyone(peers):
     # a player that joins and leaves before it ever polls: its mesh links never got
     # past the challenge, so its EXIT reaches only the host; the host's TABLE takes it
     # out of every table
-    ghost = join(peers, peers[0].tcp_address, "ghost", settle=False)     # the ghost never polls
+    ghost = join(peers, peers[0].tcp_address, "ghost", settle=False, link_wait=0)     # the ghost never polls
     pump(peers, 0.1)
     assert ghost.number == 4 and all(4 in p.table for p in peers)
     assert all(4 not in p.links for p in peers[1:])           # only pending links at 2 and 3

@@ -95,10 +95,11 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --replay mine.ttr                   (watch it in the window)
     """
     if host is not None or join is not None:
-        from .net_play import run_network, run_network_window
+        from .net_play import resolve_password, run_network, run_network_window
 
         if record_path is not None or replay_path is not None:
             raise click.UsageError("network matches are not recorded: --record/--replay go without --host/--join")
+        password = resolve_password(password)      # '-': typed at a prompt, once for both paths below
 
         if not headless and run_network_window(host, join, player_name, password, arena, vehicle, bots, seed,
                                                view, _size(size), fullscreen, echo):

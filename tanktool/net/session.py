@@ -23,6 +23,7 @@ them and drives them on.
 
 from __future__ import annotations
 
+import logging
 import math
 import random
 import time
@@ -41,6 +42,10 @@ from .remote import INTERP_DELAY, RemoteTank
 STATE_HZ = 30.0
 #: a process that falls further behind than this skips steps rather than spiral [s]
 MAX_LAG = 0.25
+#: how often what the peer dropped or refused is logged (at ``-v``: one line per kind) [s]
+DROP_LOG_INTERVAL = 5.0
+#: ``tanktool -v`` shows this logger's INFO lines
+log = logging.getLogger("tanktool.net")
 
 
 @dataclass
@@ -233,6 +238,7 @@ class NetMatch:
         self.next_view = math.floor(self.world.t) + 1
         self.skipped = 0
         self.stats_since = start
+        self.next_drop_log = start + DROP_LOG_INTERVAL
 
     def pump(self, until: float | None = None, before_step: Callable[[], None] | None = None) -> list:
         """One turn of the real-time loop: read the network (waiting at most until the
@@ -267,7 +273,16 @@ class NetMatch:
             self.next_state += 1.0 / self.state_hz
             if now - self.next_state > MAX_LAG:
                 self.next_state = now
+        if now >= self.next_drop_log:
+            self.log_drops(DROP_LOG_INTERVAL)
+            self.next_drop_log = now + DROP_LOG_INTERVAL
         return events
+
+    def log_drops(self, seconds: float | None = None) -> None:
+        """Log (INFO, shown at ``-v``) one line per kind of message the peer dropped or
+        refused since the last call: attacks leave a trace, not a line per packet."""
+        for line in self.peer.dropped.lines(seconds):
+            log.info(line)
 
     def run(self, seconds: float) -> dict[str, Any]:
         """Play ``seconds`` of real time; return the report."""
@@ -281,6 +296,8 @@ class NetMatch:
 
     def finish(self) -> dict[str, Any]:
         """The report of the match so far (``run`` ends with it)."""
+        if hasattr(self, "next_drop_log"):
+            self.log_drops(time.monotonic() - (self.next_drop_log - DROP_LOG_INTERVAL))
         return self.report(time.monotonic() - self.started, self.skipped)
 
     # ------------------------------------------------------------------ report
