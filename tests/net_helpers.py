@@ -58,3 +58,27 @@ def join(peers, address, name: str, password: str | None = None, timeout: float 
 def close_all(peers) -> None:
     for p in peers:
         p.close(send_exit=False)
+
+
+def play(peers, seconds: float, hz: float = 30.0) -> list:
+    """Poll every open peer for ``seconds``, each sending its own tank's state ``hz``
+    times a second (the real rate, unlike ``pump(states=True)`` which floods)."""
+    events = []
+    end = time.monotonic() + seconds
+    next_state = time.monotonic()
+    while time.monotonic() < end:
+        if time.monotonic() >= next_state:
+            next_state += 1.0 / hz
+            for p in peers:
+                if not p.closed and p.number:
+                    p.send_state(P.State(p.number, max(p.session_time(), 0.0), 1.0 * p.number, 2.0, 0.0,
+                                         0.0, 0.0, 0.0, 100.0, True))
+        for p in peers:
+            if not p.closed:
+                events += [(p.number, e) for e in p.poll(0.002)]
+    return events
+
+
+def states_from(events, me: int, sender: int) -> int:
+    """How many states from ``sender`` player ``me`` took."""
+    return sum(1 for who, e in events if who == me and e.kind == "state" and e.number == sender)

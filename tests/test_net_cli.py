@@ -94,3 +94,107 @@ def test_hosted_match_with_bots(tmp_path):
                                                                              (3, True, 1), (4, True, 1)]
     moved = [p for p in rep["peers"] if p["bot"]]
     assert len({tuple(p["position"]) for p in moved}) == 3      # three tanks in three places
+
+
+def _serving(password: str | None):
+    """A host peer polled by a thread; returns (host, stop)."""
+    host = Peer.host(("127.0.0.1", 0), "host", password)
+    done = threading.Event()
+
+    def serve() -> None:
+        while not done.is_set():
+            host.poll(0.01)
+
+    th = threading.Thread(target=serve, daemon=True)
+    th.start()
+
+    def stop() -> None:
+        done.set()
+        th.join(5)
+        host.close()
+
+    return host, stop
+
+
+def test_password_from_the_environment_or_a_prompt(tmp_path):
+    host, stop = _serving("s3cret")
+    try:
+        ip, port = host.tcp_address
+        where = f"{ip}:{port}"
+        runner = CliRunner()
+        args = ["play", "--headless", "--arena", "box", "--join", where, "--seconds", "0.5"]
+        r = runner.invoke(cli, args, env={"TANKTOOL_PASSWORD": "s3cret"})
+        assert r.exit_code == 0, r.output
+        assert "joined" in r.output and "s3cret" not in r.output
+        r = runner.invoke(cli, args, env={"TANKTOOL_PASSWORD": "wrong"})
+        _one_line_error(r, "wrong password")
+        # '-': typed at a prompt (here standard input, which is not a terminal)
+        r = runner.invoke(cli, args + ["--password", "-"], input="s3cret\n", env={"TANKTOOL_PASSWORD": ""})
+        assert r.exit_code == 0, r.output
+        assert "s3cret" not in r.output
+        r = runner.invoke(cli, args + ["--password", "-"], input="\n")
+        assert r.exit_code == 2 and "no password given" in r.output
+        # the command line still wins over the environment
+        r = runner.invoke(cli, args + ["--password", "s3cret"], env={"TANKTOOL_PASSWORD": "wrong"})
+        assert r.exit_code == 0, r.output
+    finally:
+        stop()
+    assert host.dropped["refused_password"] == 1
+
+
+def test_password_option_help_names_the_environment_variable():
+    r = CliRunner().invoke(cli, ["play", "--help"], terminal_width=200)
+    assert r.exit_code == 0 and "TANKTOOL_PASSWORD" in r.output and "'-'" in r.output
+
+
+def test_attacks_logged_at_v_one_line_per_kind(tmp_path):
+    """A host run with -v logs what it dropped: one line per kind with its count and
+    where from, however many packets; without -v, nothing."""
+    import os
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    from tanktool.net import protocol as P
+    from tanktool.net.peer import free_port
+
+    root = Path(__file__).resolve().parent.parent
+    env = dict(os.environ, PYTHONPATH=str(root))
+    results = {}
+    for verbose in (True, False):
+        port = free_port()
+        cmd = [sys.executable, "-m", "tanktool", *(["-v"] if verbose else []), "play", "--headless", "--arena",
+               "box", "--host", f"127.0.0.1:{port}", "--seconds", "4", "--report", str(tmp_path / "h.json")]
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=root)
+        try:
+            deadline = time.monotonic() + 30
+            line = ""
+            while "hosting on" not in line and time.monotonic() < deadline:
+                line = proc.stdout.readline()
+            udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+            good = P.encode(P.State(3, 1.0, 9, 9, 0, 0, 0, 0, 100, True), 3, 5, 1.0)
+            for _ in range(200):
+                udp.sendto(b"\xff" * 40, ("127.0.0.1", port))      # bad magic
+                udp.sendto(good, ("127.0.0.1", port))             # nobody's number
+            udp.close()
+            silent = [socket.create_connection(("127.0.0.1", port), timeout=2) for _ in range(30)]
+            out, err = proc.communicate(timeout=60)
+            for s in silent:
+                s.close()
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+        assert proc.returncode == 0, err
+        results[verbose] = err
+    lines = [ln for ln in results[True].splitlines() if ln.startswith("network: ")]
+    kinds = [ln.split()[2].rstrip(":") for ln in lines]
+    assert len(kinds) == len(set(kinds)), lines          # one line per kind
+    by_kind = dict(zip(kinds, lines))
+    assert by_kind["magic"].startswith("network: 200 magic") and "from 127.0.0.1:" in by_kind["magic"]
+    assert by_kind["unknown"].startswith("network: 200 unknown")
+    assert by_kind["pending_timeout"].startswith("network: 30 pending_timeout")
+    assert len(lines) <= 5
+    assert "network: " not in results[False]
+    rep = json.loads((tmp_path / "h.json").read_text())
+    assert rep["network"]["dropped_reasons"]["magic"] == 200

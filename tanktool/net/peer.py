@@ -552,7 +552,7 @@ class Peer:
             except OSError:
                 self.dropped["accept_failed"] += 1
                 return
-            self.dropped.source = addr
+            self.dropped.source = addr[0]      # TCP: by address (each connection has its own port)
             if not self._make_room(addr[0]):
                 self.dropped["too_many_pending"] += 1
                 sock.close()
@@ -583,7 +583,7 @@ class Peer:
         if not victims:
             return False
         victim = min(victims, key=lambda link: (not link.closing, link.hello is not None, link.opened))
-        self.dropped.source = victim.addr
+        self.dropped.source = victim.addr[0]
         self.dropped["evicted"] += 1
         self._close_link(victim)
         return True
@@ -595,7 +595,7 @@ class Peer:
             return
         except OSError:
             data = b""
-        self.dropped.source = link.addr
+        self.dropped.source = link.addr[0]
         if not data:
             self._drop_link(link, "closed")
             return
@@ -898,7 +898,7 @@ class Peer:
         now = self.clock()
         for link in list(self.pending):
             if now - link.opened > (HELLO_WAIT if link.hello is not None else HANDSHAKE_TIMEOUT):
-                self.dropped.source = link.addr
+                self.dropped.source = link.addr[0]
                 self.dropped["pending_timeout"] += 1
                 self._close_link(link)
         if now - self._pruned > 1.0:          # forget the buckets of addresses gone quiet
