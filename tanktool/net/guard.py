@@ -164,11 +164,14 @@ class DropLog(Counter):
         self.source: Any = None
         self.sources: dict[str, Counter] = {}
         self._said: Counter = Counter()
+        #: something was dropped since the last :meth:`lines`
+        self.grown = False
 
     def __setitem__(self, key: str, value: int) -> None:
         grew = value - self.get(key, 0)
         super().__setitem__(key, value)
         if grew > 0:
+            self.grown = True
             where = self.sources.get(key)
             if where is None:
                 where = self.sources[key] = Counter()
@@ -181,6 +184,7 @@ class DropLog(Counter):
     def lines(self, seconds: float | None = None) -> list[str]:
         """One line per reason with new drops since the last call (``seconds``: how long
         that was, said in the line)."""
+        self.grown = False
         out = []
         for key in sorted(self):
             n = self[key] - self._said.get(key, 0)
@@ -188,6 +192,7 @@ class DropLog(Counter):
                 continue
             self._said[key] = self[key]
             where = self.sources.pop(key, Counter())
+            where.pop("-", None)                  # drops with no address to name
             top = ", ".join(f"{s} ({k})" for s, k in where.most_common(3))
             more = len(where) - 3
             span = f" in the last {seconds:.0f} s" if seconds is not None else ""
