@@ -11,18 +11,20 @@ and derive the pair's datagram key from it::
 
 Someone who saw the handshake knows the MAC but not the password, so cannot compute the
 key; each link has its own nonce, so each pair of peers has its own key.  A datagram is
-then the message followed by a tag::
+then the message followed by a tag, keyed BLAKE2b (RFC 7693's MAC mode) cut to 8 bytes::
 
-    tag = HMAC-SHA256(key, message)[:TAG_SIZE]                              # 8 bytes
+    tag = BLAKE2b(message, key=key, digest_size=8)                          # 8 bytes
 
-64 bits is plenty for states that are stale in a tenth of a second (forging one takes
-~2^63 tries, online) and keeps a state datagram at 53 bytes.
+BLAKE2b's keyed mode is a MAC by design and costs under 1 us a datagram here, against
+3-4 us for HMAC-SHA256 (bench/net.py); 64 bits is plenty for states that are stale in a
+tenth of a second (forging one takes ~2^63 tries, online) and keeps a state datagram at
+53 bytes.
 """
 
 from __future__ import annotations
 
 import hmac
-from hashlib import sha256
+from hashlib import blake2b, sha256
 
 #: bytes of the truncated HMAC-SHA256 tag that ends every datagram of a password session
 TAG_SIZE = 8
@@ -47,7 +49,7 @@ def datagram_key(password: str, handshake_mac: bytes) -> bytes:
 
 def seal(key: bytes, message: bytes) -> bytes:
     """``message`` followed by its tag."""
-    return message + hmac.digest(key, message, "sha256")[:TAG_SIZE]
+    return message + blake2b(message, key=key, digest_size=TAG_SIZE).digest()
 
 
 def unseal(key: bytes, datagram: bytes) -> bytes | None:
@@ -55,6 +57,6 @@ def unseal(key: bytes, datagram: bytes) -> bytes | None:
     if len(datagram) <= TAG_SIZE:
         return None
     message, tag = datagram[:-TAG_SIZE], datagram[-TAG_SIZE:]
-    if not hmac.compare_digest(tag, hmac.digest(key, message, "sha256")[:TAG_SIZE]):
+    if not hmac.compare_digest(tag, blake2b(message, key=key, digest_size=TAG_SIZE).digest()):
         return None
     return message
