@@ -36,7 +36,6 @@ import json
 import os
 import re
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -49,7 +48,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from tanktool.errors import NetError  # noqa: E402
-from tanktool.net import auth  # noqa: E402
+from tanktool.net import auth, probe  # noqa: E402
 from tanktool.net import protocol as P  # noqa: E402
 from tanktool.net.peer import Peer, free_port  # noqa: E402
 
@@ -204,49 +203,6 @@ def seal_costs(rounds: int = 20000) -> dict:
             "datagram_bytes_plain": len(datagram), "datagram_bytes_sealed": len(sealed)}
 
 
-def _silent_flood(address: tuple[str, int], stop: threading.Event, held: int = 200, per_s: float = 500) -> None:
-    """Hold ``held`` connections that never speak, opening ~``per_s`` more a second."""
-    socks: list[socket.socket] = []
-    while not stop.is_set():
-        s = socket.socket()
-        s.setblocking(False)
-        s.connect_ex(address)
-        socks.append(s)
-        if len(socks) > held:
-            socks.pop(0).close()
-        time.sleep(1.0 / per_s)
-    for s in socks:
-        s.close()
-
-
-def _join_and_leave(address: tuple[str, int], password: str) -> str:
-    try:
-        s = socket.create_connection(address, timeout=2)
-    except OSError:
-        return "error"
-    try:
-        reader = P.StreamReader(Counter())
-        msgs: list = []
-        while not msgs:
-            data = s.recv(4096)
-            if not data:
-                return "closed"
-            msgs = reader.feed(data)
-        mac = auth.join_mac(password, msgs[0].body.nonce, "flood")
-        s.sendall(P.encode(P.Join("flood", 1, 1, mac), 0, 1, time.time()))
-        msgs = []
-        while not msgs:
-            data = s.recv(4096)
-            if not data:
-                return "closed"
-            msgs = reader.feed(data)
-        return msgs[0].type.name
-    except OSError:
-        return "error"
-    finally:
-        s.close()
-
-
 def attack(tmp: Path) -> dict:
     procs, reports, _ = start_session(tmp, 3, "atk", PASSWORD)
     address = (LOOPBACK, int(procs[0].wait_line(r"hosting on [\d.]+:(\d+)").group(1)))
@@ -255,7 +211,7 @@ def attack(tmp: Path) -> dict:
         t0 = time.monotonic()
         quiet_s, _ = join_until_working(address, t0, password=PASSWORD)
         stop = threading.Event()
-        th = threading.Thread(target=_silent_flood, args=(address, stop), daemon=True)
+        th = threading.Thread(target=probe.silent_flood, args=(address, stop), daemon=True)
         th.start()
         time.sleep(1.0)                 # the attacker's connections fill the pending list
         t1 = time.monotonic()
@@ -267,7 +223,7 @@ def attack(tmp: Path) -> dict:
         replies: Counter = Counter()
         end = time.monotonic() + 2.0
         while time.monotonic() < end:
-            replies[_join_and_leave(address, PASSWORD)] += 1
+            replies[probe.join_once(address, PASSWORD)] += 1
         time.sleep(1.0)
         for p in procs:
             p.p.send_signal(signal.SIGINT)
@@ -280,7 +236,7 @@ def attack(tmp: Path) -> dict:
     host = next(r for r in reps if r["me"] == 1)
     return {"join_quiet_s": round(quiet_s, 3), "join_under_silent_flood_s": round(attacked_s, 3),
             "flood_joins": sum(replies.values()), "flood_admitted": replies["NUMBER"],
-            "flood_refused": replies["REFUSE"],
+            "flood_refused": sum(n for r, n in replies.items() if r.startswith("REFUSE")),
             "host_evicted": host["network"]["dropped_reasons"].get("evicted", 0),
             "peers_rate_drops": [r["network"]["dropped_reasons"].get("rate", 0) for r in reps if r["me"] != 1]}
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 import threading
 import time
 
+import pytest
+
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer
 
@@ -82,3 +84,21 @@ def play(peers, seconds: float, hz: float = 30.0) -> list:
 def states_from(events, me: int, sender: int) -> int:
     """How many states from ``sender`` player ``me`` took."""
     return sum(1 for who, e in events if who == me and e.kind == "state" and e.number == sender)
+
+
+@pytest.fixture
+def peers():
+    """In-process peers made by a test, all closed at its end (import it into the test
+    module: ``from net_helpers import peers``)."""
+    made: list[Peer] = []
+    yield made
+    close_all(made)
+
+
+def session(peers, n: int, password: str | None = None) -> list[Peer]:
+    """A host and ``n - 1`` joiners, in ``peers``, the mesh formed."""
+    host = Peer.host((LOOPBACK, 0), "host", password)
+    peers.append(host)
+    for i in range(2, n + 1):
+        join(peers, host.tcp_address, f"peer{i}", password)
+    return peers

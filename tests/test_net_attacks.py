@@ -10,28 +10,17 @@ import time
 from collections import Counter
 
 import pytest
-from net_helpers import LOOPBACK, close_all, join, play, pump, states_from
+from net_helpers import LOOPBACK, join, peers, play, pump, states_from  # noqa: F401 (peers: the fixture)
+from net_helpers import session as _session
 
 from tanktool.errors import NetError
-from tanktool.net import auth
+from tanktool.net import auth, probe
 from tanktool.net import peer as peer_mod
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer
 
-
-@pytest.fixture
-def peers():
-    made: list[Peer] = []
-    yield made
-    close_all(made)
-
-
-def _session(peers, n: int, password: str | None = None) -> list[Peer]:
-    host = Peer.host((LOOPBACK, 0), "host", password)
-    peers.append(host)
-    for i in range(2, n + 1):
-        join(peers, host.tcp_address, f"peer{i}", password)
-    return peers
+RATE = f"REFUSE {P.RefuseCode.RATE.value}"
+PASSWORD = f"REFUSE {P.RefuseCode.PASSWORD.value}"
 
 
 def _silent(address, n: int, peers, source: str | None = None) -> list[socket.socket]:
@@ -39,12 +28,7 @@ def _silent(address, n: int, peers, source: str | None = None) -> list[socket.so
     peers poll."""
     socks = []
     for _ in range(n):
-        s = socket.socket()
-        if source is not None:
-            s.bind((source, 0))
-        s.setblocking(False)
-        s.connect_ex(address)
-        socks.append(s)
+        socks.append(probe.silent_connection(address, source))
         for p in peers:
             p.poll(0)
     return socks
@@ -78,19 +62,7 @@ def test_a_flood_of_silent_connections_while_a_player_joins(peers):
     _session(peers, 2)
     host = peers[0]
     stop = threading.Event()
-    opened = []
-
-    def flood() -> None:
-        while not stop.is_set():
-            s = socket.socket()
-            s.setblocking(False)
-            s.connect_ex(host.tcp_address)
-            opened.append(s)
-            if len(opened) > 400:           # the attacker's own descriptors run out too
-                opened.pop(0).close()
-            time.sleep(0.001)
-
-    th = threading.Thread(target=flood, daemon=True)
+    th = threading.Thread(target=probe.silent_flood, args=(host.tcp_address, stop, 400, 1000.0), daemon=True)
     th.start()
     try:
         pump(peers, 0.3)
@@ -101,8 +73,6 @@ def test_a_flood_of_silent_connections_while_a_player_joins(peers):
     finally:
         stop.set()
         th.join(5)
-        for s in opened:
-            s.close()
     pump(peers, 0.2)
     assert all(sorted(p.table) == [1, 2, 3, 4] for p in peers)
     assert host.dropped["evicted"] > 0
@@ -215,32 +185,6 @@ def test_states_only_once_the_link_is_up(peers):
 
 
 # ---------------------------------------------------------------- floods of joins
-def _join_and_leave(address, password: str | None = None) -> str:
-    """One raw join attempt: returns the reply's type name (NUMBER, REFUSE...)."""
-    s = socket.create_connection(address, timeout=2)
-    try:
-        reader = P.StreamReader(Counter())
-        msgs: list = []
-        while not msgs:
-            data = s.recv(4096)
-            if not data:
-                return "closed"
-            msgs = reader.feed(data)
-        nonce = msgs[0].body.nonce
-        mac = auth.join_mac(password, nonce, "flood") if password else bytes(P.MAC_SIZE)
-        s.sendall(P.encode(P.Join("flood", 1, 1, mac), 0, 1, time.time()))
-        msgs = []
-        while not msgs:
-            data = s.recv(4096)
-            if not data:
-                return "closed"
-            msgs = reader.feed(data)
-        m = msgs[0]
-        return m.type.name + (f" {m.body.code}" if m.type == P.MessageType.REFUSE else "")
-    finally:
-        s.close()                       # an admitted one leaves at once (closed link)
-
-
 @pytest.mark.parametrize("password", [None, "pw"])
 def test_join_flood_is_limited_and_real_peers_drop_nothing(peers, password):
     _session(peers, 3, password)
@@ -252,7 +196,7 @@ def test_join_flood_is_limited_and_real_peers_drop_nothing(peers, password):
         end = time.monotonic() + 1.5
         while time.monotonic() < end and not stop.is_set():
             try:
-                replies[_join_and_leave(host.tcp_address, password)] += 1
+                replies[probe.join_once(host.tcp_address, password)] += 1
             except OSError:
                 replies["error"] += 1
 
@@ -267,8 +211,8 @@ def test_join_flood_is_limited_and_real_peers_drop_nothing(peers, password):
     admitted = replies["NUMBER"]
     # the burst (less the two real joins) and about one a second after it
     assert admitted <= peer_mod.JOIN_BURST - 2 + 2, replies
-    assert replies[f"REFUSE {P.RefuseCode.RATE.value}"] >= 10, replies
-    assert host.dropped["refused_rate"] == replies[f"REFUSE {P.RefuseCode.RATE.value}"]
+    assert replies[RATE] >= 10, replies
+    assert host.dropped["refused_rate"] == replies[RATE]
     # the real peers dropped none of the host's messages (nor anyone's) to their limiters
     for p in (b, c):
         assert p.dropped["rate"] == 0, dict(p.dropped)
@@ -284,15 +228,15 @@ def test_wrong_password_flood_is_cut_off(peers):
     _session(peers, 2, "pw")
     host = peers[0]
     replies: Counter = Counter()
-    th = threading.Thread(target=lambda: replies.update(_join_and_leave(host.tcp_address, "guess")
+    th = threading.Thread(target=lambda: replies.update(probe.join_once(host.tcp_address, "guess")
                                                         for _ in range(30)), daemon=True)
     th.start()
     while th.is_alive():
         pump(peers, 0.05)
     th.join()
     # ten wrong answers are checked; after that the address's answers are not even looked at
-    assert replies[f"REFUSE {P.RefuseCode.PASSWORD.value}"] == peer_mod.AUTH_FAIL_BURST, replies
-    assert replies[f"REFUSE {P.RefuseCode.RATE.value}"] >= 15, replies
+    assert replies[PASSWORD] == peer_mod.AUTH_FAIL_BURST, replies
+    assert replies[RATE] >= 15, replies
     assert host.dropped["refused_password"] == peer_mod.AUTH_FAIL_BURST
 
 

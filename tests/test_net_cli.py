@@ -46,8 +46,9 @@ def test_port_in_use_and_nobody_there():
     _one_line_error(_run("--join", f"127.0.0.1:{port}", "--seconds", "1"), "cannot reach")
 
 
-def test_refused_join_wrong_password():
-    host = Peer.host(("127.0.0.1", 0), "host", "pw")
+def _serving(password: str | None):
+    """A host peer polled by a thread; returns (host, stop)."""
+    host = Peer.host(("127.0.0.1", 0), "host", password)
     done = threading.Event()
 
     def serve() -> None:
@@ -56,14 +57,23 @@ def test_refused_join_wrong_password():
 
     th = threading.Thread(target=serve, daemon=True)
     th.start()
+
+    def stop() -> None:
+        done.set()
+        th.join(5)
+        host.close()
+
+    return host, stop
+
+
+def test_refused_join_wrong_password():
+    host, stop = _serving("pw")
     try:
         ip, port = host.tcp_address
         _one_line_error(_run("--join", f"{ip}:{port}", "--password", "nope", "--seconds", "1"), "wrong password")
         _one_line_error(_run("--join", f"{ip}:{port}", "--seconds", "1"), "wants a password")
     finally:
-        done.set()
-        th.join(5)
-        host.close()
+        stop()
 
 
 def test_hosted_match_report(tmp_path):
@@ -95,25 +105,6 @@ def test_hosted_match_with_bots(tmp_path):
     moved = [p for p in rep["peers"] if p["bot"]]
     assert len({tuple(p["position"]) for p in moved}) == 3      # three tanks in three places
 
-
-def _serving(password: str | None):
-    """A host peer polled by a thread; returns (host, stop)."""
-    host = Peer.host(("127.0.0.1", 0), "host", password)
-    done = threading.Event()
-
-    def serve() -> None:
-        while not done.is_set():
-            host.poll(0.01)
-
-    th = threading.Thread(target=serve, daemon=True)
-    th.start()
-
-    def stop() -> None:
-        done.set()
-        th.join(5)
-        host.close()
-
-    return host, stop
 
 
 def test_password_from_the_environment_or_a_prompt(tmp_path):

@@ -6,26 +6,12 @@ from __future__ import annotations
 import socket
 
 import pytest
-from net_helpers import LOOPBACK, close_all, join, pump
+from net_helpers import LOOPBACK, join, peers, pump  # noqa: F401 (peers: the fixture)
+from net_helpers import session as _session
 
 from tanktool.errors import NetError
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer, parse_address
-
-
-@pytest.fixture
-def peers():
-    made: list[Peer] = []
-    yield made
-    close_all(made)
-
-
-def _session(peers, n: int, password: str | None = None) -> list[Peer]:
-    host = Peer.host((LOOPBACK, 0), "host", password)
-    peers.append(host)
-    for i in range(2, n + 1):
-        join(peers, host.tcp_address, f"peer{i}", password)
-    return peers
 
 
 def test_full_mesh_and_same_table(peers):

@@ -38,8 +38,7 @@ from typing import Any, Callable
 
 from ..errors import NetError
 from . import protocol as P
-from .auth import datagram_key, hello_mac, join_mac, seal, unseal
-from .auth import TAG_SIZE
+from .auth import TAG_SIZE, datagram_key, hello_mac, join_mac, seal, unseal
 from .guard import Bucket, Buckets, DropLog, JoinLimiter, SeqWindow
 
 __all__ = ["Peer", "NetEvent", "Link", "Bucket", "parse_address", "free_port", "join_mac", "hello_mac",
