@@ -44,7 +44,8 @@ def test_silent_connections_do_not_lock_a_player_out(peers, password):
         pump(peers, 0.3)
         # bounded, however many were opened
         assert len(host.pending) <= peer_mod.MAX_PENDING_PER_IP
-        assert host.dropped["evicted"] >= 300 - peer_mod.MAX_PENDING_PER_IP
+        # (on a slow machine the first ones may have met their deadline before being pushed out)
+        assert host.dropped["evicted"] + host.dropped["pending_timeout"] >= 300 - peer_mod.MAX_PENDING_PER_IP
         # while they are all still open, a real player joins, and links to player 2
         late = join(peers, host.tcp_address, "late", password, timeout=5.0)
         assert late.number == 3 and sorted(late.links) == [1, 2]
@@ -79,14 +80,14 @@ def test_a_flood_of_silent_connections_while_a_player_joins(peers):
 
 
 def test_silent_connections_time_out_after_the_handshake_deadline(peers, monkeypatch):
-    monkeypatch.setattr(peer_mod, "HANDSHAKE_TIMEOUT", 0.3)
+    monkeypatch.setattr(peer_mod, "PENDING_TIMEOUT", 1.0)
     _session(peers, 2)
     host = peers[0]
     socks = _silent(host.tcp_address, 5, peers)
     try:
         pump(peers, 0.1)
         assert len(host.pending) == 5
-        pump(peers, 0.5)
+        pump(peers, 1.5)
         assert not host.pending and host.dropped["pending_timeout"] == 5
     finally:
         for s in socks:

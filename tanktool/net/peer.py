@@ -49,7 +49,7 @@ SILENCE = 3.0
 #: an accepted TCP connection must say JOIN or HELLO within this time [s]: a real peer
 #: answers the challenge within a round trip (a joiner answers its mesh links' challenges
 #: before ``Peer.join`` returns)
-HANDSHAKE_TIMEOUT = 2.0
+PENDING_TIMEOUT = 2.0
 #: a HELLO waits this long for the host's NEW_PLAYER to name its number [s]
 HELLO_WAIT = 5.0
 #: unidentified connections at once, and from one address; past either, a new connection
@@ -250,7 +250,7 @@ class Peer:
 
         Listens on the interface that reaches the host, on ``port`` (0: any free one).
         A host that says "too many joins" is asked again every 0.5 s for ``timeout``
-        seconds.  Before returning, waits up to ``settle`` seconds for the other members'
+        seconds.  Before returning, waits up to ``link_wait`` seconds for the other members'
         challenges and answers them, so the mesh links do not depend on how soon the
         caller first polls.  Raises NetError with one clear line if the host cannot be
         reached or refuses.
@@ -896,7 +896,7 @@ class Peer:
     def _check_timeouts(self) -> None:
         now = self.clock()
         for link in list(self.pending):
-            if now - link.opened > (HELLO_WAIT if link.hello is not None else HANDSHAKE_TIMEOUT):
+            if now - link.opened > (HELLO_WAIT if link.hello is not None else PENDING_TIMEOUT):
                 self.dropped.source = link.addr[0]
                 self.dropped["pending_timeout"] += 1
                 self._close_link(link)
