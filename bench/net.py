@@ -292,23 +292,27 @@ def main() -> None:
     costs = seal_costs()
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
+        # the machine may be shared: say how busy it was when each phase began
+        load_plain = round(os.getloadavg()[0], 2)
         plain = rows_of(steady(tmp, args.peers, args.seconds), args.peers)
+        load_sealed = round(os.getloadavg()[0], 2)
         sealed = rows_of(steady(tmp, args.peers, args.seconds, PASSWORD), args.peers)
         mig = migration(tmp, args.peers)
         atk = attack(tmp)
     worst, worst_sealed = worst_of(plain), worst_of(sealed)
-    result = {"peers": args.peers, "seconds": args.seconds, "rows": plain, "worst": worst,
-              "password": {"rows": sealed, "worst": worst_sealed}, "seal_costs": costs, "migration": mig,
+    result = {"peers": args.peers, "seconds": args.seconds, "rows": plain, "worst": worst, "load_average": load_plain,
+              "password": {"rows": sealed, "worst": worst_sealed, "load_average": load_sealed},
+              "seal_costs": costs, "migration": mig,
               "attack": atk,
               "goals": {"updates_per_s": 30, "latency_p99_ms": 10, "bytes_up_per_s": 16 * 1024, "migration_s": 3}}
     if args.json:
         print(json.dumps(result))
         return
-    print_table(f"{args.peers} peers on loopback, {args.seconds:g} s of steady play (separate processes, box arena)",
-                plain, worst)
+    print_table(f"{args.peers} peers on loopback, {args.seconds:g} s of steady play (separate processes, box arena; "
+                f"load average {load_plain} at the start)", plain, worst)
     print()
-    print_table("the same with a password: every datagram sealed (keyed BLAKE2b, 8-byte tag, a key per pair)",
-                sealed, worst_sealed)
+    print_table("the same with a password: every datagram sealed (keyed BLAKE2b, 8-byte tag, a key per pair; "
+                f"load average {load_sealed})", sealed, worst_sealed)
     print()
     print(f"{'':<34} {'plain':>9} {'password':>9}")
     print(f"{'median p50 state latency [ms]':<34} {worst['median_latency_p50_ms']:>9.3f} "
