@@ -220,6 +220,12 @@ class App:
         self.field = "address"
         self._notice_seen, self._notice_t = "", 0.0
         self.player_name: str | None = None
+        self.password: str | None = None
+
+    # ------------------------------------------------------------------ lifecycle
+    def size(self) -> tuple[int, int]:
+        w, h = (int(v) for v in str(self.menu.resolution.value).split("x"))
+        return w, h
 
     @property
     def password(self) -> str | None:
@@ -229,11 +235,6 @@ class App:
     @password.setter
     def password(self, value: str | None) -> None:
         self.menu.password = value or ""
-
-    # ------------------------------------------------------------------ lifecycle
-    def size(self) -> tuple[int, int]:
-        w, h = (int(v) for v in str(self.menu.resolution.value).split("x"))
-        return w, h
 
     def open_window(self) -> None:
         self.presenter = Presenter(self.size(), bool(self.menu.fullscreen.value), want_gl=True)
