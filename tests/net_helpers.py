@@ -5,6 +5,8 @@ from __future__ import annotations
 import threading
 import time
 
+import pytest
+
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer
 
@@ -58,3 +60,45 @@ def join(peers, address, name: str, password: str | None = None, timeout: float 
 def close_all(peers) -> None:
     for p in peers:
         p.close(send_exit=False)
+
+
+def play(peers, seconds: float, hz: float = 30.0) -> list:
+    """Poll every open peer for ``seconds``, each sending its own tank's state ``hz``
+    times a second (the real rate, unlike ``pump(states=True)`` which floods)."""
+    events = []
+    end = time.monotonic() + seconds
+    next_state = time.monotonic()
+    while time.monotonic() < end:
+        if time.monotonic() >= next_state:
+            next_state += 1.0 / hz
+            for p in peers:
+                if not p.closed and p.number:
+                    p.send_state(P.State(p.number, max(p.session_time(), 0.0), 1.0 * p.number, 2.0, 0.0,
+                                         0.0, 0.0, 0.0, 100.0, True))
+        for p in peers:
+            if not p.closed:
+                events += [(p.number, e) for e in p.poll(0.002)]
+    return events
+
+
+def states_from(events, me: int, sender: int) -> int:
+    """How many states from ``sender`` player ``me`` took."""
+    return sum(1 for who, e in events if who == me and e.kind == "state" and e.number == sender)
+
+
+@pytest.fixture
+def peers():
+    """In-process peers made by a test, all closed at its end (import it into the test
+    module: ``from net_helpers import peers``)."""
+    made: list[Peer] = []
+    yield made
+    close_all(made)
+
+
+def session(peers, n: int, password: str | None = None) -> list[Peer]:
+    """A host and ``n - 1`` joiners, in ``peers``, the mesh formed."""
+    host = Peer.host((LOOPBACK, 0), "host", password)
+    peers.append(host)
+    for i in range(2, n + 1):
+        join(peers, host.tcp_address, f"peer{i}", password)
+    return peers

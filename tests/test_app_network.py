@@ -172,3 +172,45 @@ def test_window_joins_a_headless_host_with_a_bot(app):
         report = host.finish()
     assert [x["reason"] for x in report["left"] if x["number"] == 3] == ["exit"]
     assert any(p["shots"] >= 0 and p["number"] == 2 and p["bot"] for p in report["peers"])
+
+
+def test_menu_password_field_is_masked_and_used(app):
+    from tanktool.errors import NetError
+
+    goto(app, "password")
+    press(app, pygame.K_RETURN)
+    assert app.editing and app.field == "password"
+    for ch in "S3cr et!":                      # any printable character, upper case too
+        press(app, pygame.K_UNKNOWN, ch)
+    press(app, pygame.K_BACKSPACE)
+    press(app, pygame.K_RETURN)
+    assert not app.editing and app.menu.password == "S3cr et" and app.password == "S3cr et"
+    app.frame(0.016)                           # drawn as stars (never the text)
+    goto(app, "network")
+    press(app, pygame.K_RIGHT)                 # host
+    type_address(app, "127.0.0.1:0")
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    assert app.state == "playing", app.notice
+    s = app.session
+    assert s.peer.password == "S3cr et"
+    address = s.peer.tcp_address
+    out = {}
+
+    def try_join(password):
+        try:
+            out[password] = Peer.join(address, "bob", password, timeout=DEADLINE)
+        except NetError as e:
+            out[password] = e
+
+    for password in (None, "S3cr et"):
+        th = threading.Thread(target=try_join, args=(password,), daemon=True)
+        th.start()
+        play_until(app, lambda: password in out)
+        th.join(5)
+    assert isinstance(out[None], NetError) and "wants a password" in str(out[None])
+    joined = out["S3cr et"]
+    assert isinstance(joined, Peer) and joined.number == 2
+    joined.close()
+    press(app, pygame.K_p)
+    press(app, pygame.K_m)

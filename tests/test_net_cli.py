@@ -46,8 +46,9 @@ def test_port_in_use_and_nobody_there():
     _one_line_error(_run("--join", f"127.0.0.1:{port}", "--seconds", "1"), "cannot reach")
 
 
-def test_refused_join_wrong_password():
-    host = Peer.host(("127.0.0.1", 0), "host", "pw")
+def _serving(password: str | None):
+    """A host peer polled by a thread; returns (host, stop)."""
+    host = Peer.host(("127.0.0.1", 0), "host", password)
     done = threading.Event()
 
     def serve() -> None:
@@ -56,14 +57,23 @@ def test_refused_join_wrong_password():
 
     th = threading.Thread(target=serve, daemon=True)
     th.start()
+
+    def stop() -> None:
+        done.set()
+        th.join(5)
+        host.close()
+
+    return host, stop
+
+
+def test_refused_join_wrong_password():
+    host, stop = _serving("pw")
     try:
         ip, port = host.tcp_address
         _one_line_error(_run("--join", f"{ip}:{port}", "--password", "nope", "--seconds", "1"), "wrong password")
         _one_line_error(_run("--join", f"{ip}:{port}", "--seconds", "1"), "wants a password")
     finally:
-        done.set()
-        th.join(5)
-        host.close()
+        stop()
 
 
 def test_hosted_match_report(tmp_path):
@@ -94,3 +104,93 @@ def test_hosted_match_with_bots(tmp_path):
                                                                              (3, True, 1), (4, True, 1)]
     moved = [p for p in rep["peers"] if p["bot"]]
     assert len({tuple(p["position"]) for p in moved}) == 3      # three tanks in three places
+
+
+
+def test_password_from_the_environment_or_a_prompt(tmp_path):
+    host, stop = _serving("s3cret")
+    try:
+        ip, port = host.tcp_address
+        where = f"{ip}:{port}"
+        runner = CliRunner()
+        args = ["play", "--headless", "--arena", "box", "--join", where, "--seconds", "0.5"]
+        r = runner.invoke(cli, args, env={"TANKTOOL_PASSWORD": "s3cret"})
+        assert r.exit_code == 0, r.output
+        assert "joined" in r.output and "s3cret" not in r.output
+        r = runner.invoke(cli, args, env={"TANKTOOL_PASSWORD": "wrong"})
+        _one_line_error(r, "wrong password")
+        # '-': typed at a prompt (here standard input, which is not a terminal)
+        r = runner.invoke(cli, args + ["--password", "-"], input="s3cret\n", env={"TANKTOOL_PASSWORD": ""})
+        assert r.exit_code == 0, r.output
+        assert "s3cret" not in r.output
+        r = runner.invoke(cli, args + ["--password", "-"], input="\n")
+        assert r.exit_code == 2 and "no password given" in r.output
+        # the command line still wins over the environment
+        r = runner.invoke(cli, args + ["--password", "s3cret"], env={"TANKTOOL_PASSWORD": "wrong"})
+        assert r.exit_code == 0, r.output
+    finally:
+        stop()
+    assert host.dropped["refused_password"] == 1
+
+
+def test_password_option_help_names_the_environment_variable():
+    r = CliRunner().invoke(cli, ["play", "--help"], terminal_width=200)
+    assert r.exit_code == 0 and "TANKTOOL_PASSWORD" in r.output and "'-'" in r.output
+
+
+def test_attacks_logged_at_v_one_line_per_kind(tmp_path):
+    """A host run with -v logs what it dropped: one line per kind with its count and
+    where from, however many packets; without -v, nothing."""
+    import os
+    import subprocess
+    import sys
+    import time
+    from collections import Counter
+    from pathlib import Path
+
+    from tanktool.net import protocol as P
+    from tanktool.net.peer import free_port
+
+    root = Path(__file__).resolve().parent.parent
+    env = dict(os.environ, PYTHONPATH=str(root))
+    results = {}
+    for verbose in (True, False):
+        port = free_port()
+        cmd = [sys.executable, "-m", "tanktool", *(["-v"] if verbose else []), "play", "--headless", "--arena",
+               "box", "--host", f"127.0.0.1:{port}", "--seconds", "4", "--report", str(tmp_path / "h.json")]
+        proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, cwd=root)
+        try:
+            deadline = time.monotonic() + 30
+            line = ""
+            while "hosting on" not in line and time.monotonic() < deadline:
+                line = proc.stdout.readline()
+            udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+            good = P.encode(P.State(3, 1.0, 9, 9, 0, 0, 0, 0, 100, True), 3, 5, 1.0)
+            for _ in range(200):
+                udp.sendto(b"\xff" * 40, ("127.0.0.1", port))      # bad magic
+                udp.sendto(good, ("127.0.0.1", port))             # nobody's number
+            udp.close()
+            silent = [socket.create_connection(("127.0.0.1", port), timeout=2) for _ in range(30)]
+            out, err = proc.communicate(timeout=60)
+            for s in silent:
+                s.close()
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+        assert proc.returncode == 0, err
+        results[verbose] = err
+    lines = [ln for ln in results[True].splitlines() if ln.startswith("network: ")]
+    # the first drops are logged at once, the rest at most every 5 s (and at the end):
+    # a line per kind each time, with the count since the last time
+    counts: Counter = Counter()
+    per_kind: Counter = Counter()
+    for ln in lines:
+        _, n, kind = ln.split()[:3]
+        counts[kind.rstrip(":")] += int(n)
+        per_kind[kind.rstrip(":")] += 1
+        assert " from 127.0.0.1" in ln
+    assert counts == {"magic": 200, "unknown": 200, "pending_timeout": 30}, lines
+    assert max(per_kind.values()) <= 2 and len(lines) <= 6, lines
+    assert "network: " not in results[False]
+    rep = json.loads((tmp_path / "h.json").read_text())
+    assert rep["network"]["dropped_reasons"]["magic"] == 200

@@ -6,26 +6,12 @@ from __future__ import annotations
 import socket
 
 import pytest
-from net_helpers import LOOPBACK, close_all, join, pump
+from net_helpers import LOOPBACK, join, peers, pump  # noqa: F401 (peers: the fixture)
+from net_helpers import session as _session
 
 from tanktool.errors import NetError
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer, parse_address
-
-
-@pytest.fixture
-def peers():
-    made: list[Peer] = []
-    yield made
-    close_all(made)
-
-
-def _session(peers, n: int, password: str | None = None) -> list[Peer]:
-    host = Peer.host((LOOPBACK, 0), "host", password)
-    peers.append(host)
-    for i in range(2, n + 1):
-        join(peers, host.tcp_address, f"peer{i}", password)
-    return peers
 
 
 def test_full_mesh_and_same_table(peers):
@@ -208,7 +194,7 @@ def test_exit_seen_only_by_the_host_reaches_everyone(peers):
     # a player that joins and leaves before it ever polls: its mesh links never got
     # past the challenge, so its EXIT reaches only the host; the host's TABLE takes it
     # out of every table
-    ghost = join(peers, peers[0].tcp_address, "ghost", settle=False)     # the ghost never polls
+    ghost = join(peers, peers[0].tcp_address, "ghost", settle=False, link_wait=0)     # the ghost never polls
     pump(peers, 0.1)
     assert ghost.number == 4 and all(4 in p.table for p in peers)
     assert all(4 not in p.links for p in peers[1:])           # only pending links at 2 and 3

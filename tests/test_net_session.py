@@ -288,3 +288,114 @@ def test_bots_run_on_the_host_and_survive_it(tmp_path):
             assert len(after) >= 2
             moved = max(math.hypot(a[0] - after[0][0], a[1] - after[0][1]) for a in after)
             assert moved > 0.5 or not all(a[2] for a in after)     # driven on (or dead, waiting to respawn)
+
+
+def test_password_session_under_attack_and_migration(tmp_path):
+    """A password session of separate processes (the password from TANKTOOL_PASSWORD, the
+    host at -v) under the attacks of issues 18 and 21: 200 connections that say nothing
+    (held open while a real player joins), floods of joins with the wrong password and
+    with the right one, datagrams without a MAC or sealed with a made-up key, to every
+    port.  Everyone still joins, sees everyone and drops none of the others' messages to
+    its own limiter; the host logs one line per kind; then the host is killed and player
+    2 takes over, the keys of the other pairs still holding, and takes a new player."""
+    from collections import Counter
+
+    from tanktool.net import auth, probe
+
+    env_pw = {"TANKTOOL_PASSWORD": "tank s3cret"}
+    procs: list[Proc] = []
+
+    def start(args: list[str], verbose: bool = False) -> Proc:
+        old = dict(os.environ)
+        os.environ.update(env_pw)
+        try:
+            pr = Proc((["-v"] if verbose else []) + args)
+        finally:
+            os.environ.clear()
+            os.environ.update(old)
+        procs.append(pr)
+        return pr
+
+    try:
+        port = free_port(LOOPBACK)
+        args, host_rep = _play(tmp_path, "host", "--host", f"{LOOPBACK}:{port}", seconds=300)
+        host = start(args, verbose=True)
+        host.wait_line(r"hosting on")
+        joiners = []
+        for i in (2, 3):
+            a, rep = _play(tmp_path, f"peer{i}", "--join", f"{LOOPBACK}:{port}", seconds=300)
+            joiners.append((start(a), rep))
+            joiners[-1][0].wait_line(r"as player \d")
+        addrs = {}
+        for pr, _ in joiners:
+            m = pr.wait_line(r"as player (\d) .*listening on [\d.]+:(\d+) \(udp (\d+)\)")
+            addrs[int(m.group(1))] = (int(m.group(2)), int(m.group(3)))
+        # 200 silent connections, held open while player 4 joins
+        silent = []
+        for _ in range(200):
+            try:
+                silent.append(socket.create_connection((LOOPBACK, port), timeout=3))
+            except OSError:
+                pass
+        a, rep4 = _play(tmp_path, "peer4", "--join", f"{LOOPBACK}:{port}", seconds=300)
+        joiners.append((start(a), rep4))
+        m = joiners[-1][0].wait_line(r"as player (4) .*listening on [\d.]+:(\d+) \(udp (\d+)\)", timeout=30)
+        addrs[4] = (int(m.group(2)), int(m.group(3)))
+        for s in silent:
+            s.close()
+        # floods of joins: with the password (the join limit), then a wrong one (cut off after 10)
+        t_flood = time.monotonic()
+        replies = Counter(f"pw {probe.join_once((LOOPBACK, port), 'tank s3cret')}" for _ in range(30))
+        flood_s = time.monotonic() - t_flood
+        replies += Counter(probe.join_once((LOOPBACK, port), "guess") for _ in range(20))
+        # datagrams to every UDP port: in the clear, sealed with a made-up key, garbage
+        forged = P.encode(P.State(2, 1.0, 999.0, 999.0, 0, 0, 0, 0, 100, True), 2, 10**9, time.time())
+        udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        for uport in [port] + [u for _, u in addrs.values()]:
+            for d in (forged, auth.seal(b"k" * 32, forged), b"\xff" * 60, forged[:20]):
+                for _ in range(50):
+                    udp.sendto(d, (LOOPBACK, uport))
+        udp.close()
+        time.sleep(2.0)
+        host.p.send_signal(signal.SIGINT)      # leaves (EXIT) and writes its last log lines
+        assert host.finish(60) == 0, host.err
+        for pr, _ in joiners:
+            pr.wait_line(r"host is now player 2")
+        late_args, late_rep = _play(tmp_path, "late", "--join", f"{LOOPBACK}:{addrs[2][0]}", seconds=3)
+        late = start(late_args)
+        assert late.finish(60) == 0, late.err
+        time.sleep(0.5)
+        for pr, _ in joiners:
+            pr.p.send_signal(signal.SIGINT)
+        assert [pr.finish(60) for pr, _ in joiners] == [0, 0, 0], [pr.err for pr, _ in joiners]
+        reports = [json.loads(rep.read_text()) for _, rep in joiners]
+        late_report = json.loads(late_rep.read_text())
+        host_err = host.err
+    finally:
+        for p in procs:
+            p.kill()
+    # the join limit: at most the burst of 10 (refilled since the real joins), then 1 a second
+    assert replies["pw NUMBER"] <= 10 + math.ceil(flood_s), (replies, flood_s)
+    assert replies["pw REFUSE 5"] >= 30 - 10 - math.ceil(flood_s), (replies, flood_s)
+    assert replies["REFUSE 2"] == 10 and replies["REFUSE 5"] == 10, replies         # wrong, then not checked
+    for rep in reports:
+        reasons = rep["network"]["dropped_reasons"]
+        assert reasons.get("rate", 0) == 0, reasons            # nobody's own limiter cut real traffic
+        assert reasons.get("stale", 0) == 0 and reasons.get("window", 0) == 0, reasons
+        assert reasons.get("bad_mac", 0) + reasons.get("impostor", 0) + reasons.get("unknown", 0) >= 100
+        assert rep["host_changes"][0]["host"] == 2
+        assert any(len(v["tanks"]) == 4 for v in rep["views"])
+        assert [x["reason"] for x in rep["left"] if x["name"] == "host"] == ["exit"]
+        for v in rep["views"]:
+            for x, z, _ in v["tanks"].values():
+                assert 0.0 <= x <= 60.0 and 0.0 <= z <= 60.0       # never at the forger's (999, 999)
+        assert rep["latency_ms"]["samples"] > 100
+    n, errors = _compare_views(reports + [late_report])
+    assert n > 50 and sorted(errors)[len(errors) // 2] < 1.5
+    assert late_report["me"] == 1 and late_report["host"] == 2
+    assert sorted(p["number"] for p in late_report["peers"]) == [1, 2, 3, 4]
+    # the host's -v log: drops by kind with counts, not a line per packet
+    lines = [ln for ln in host_err.splitlines() if ln.startswith("network: ")]
+    kinds = {ln.split()[2].rstrip(":") for ln in lines}
+    assert {"evicted", "refused_rate", "refused_password", "impostor"} <= kinds, host_err
+    assert len(lines) < 40, lines

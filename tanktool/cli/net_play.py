@@ -8,12 +8,18 @@ tank driven by your keys, until you quit; the window's start menu offers the sam
 (network: off/host/join, address).  With ``--headless`` (or no display) the local tank
 is driven by the scripted bot, for ``--seconds`` of real time, and ``--report`` writes
 the match report with ``peers``, ``host_changes`` and ``network`` counters.
+
+The session password can stay off the command line (where ``ps`` shows it to every
+local user): ``TANKTOOL_PASSWORD`` in the environment, or ``--password -`` to type it at
+a prompt that does not echo (read as one line from standard input when that is not a
+terminal).
 """
 
 from __future__ import annotations
 
 import json
 import signal
+import sys
 from pathlib import Path
 from typing import Any, Callable
 
@@ -22,12 +28,17 @@ import click
 from ..errors import NetError, TanktoolError
 
 DEFAULT_NET_SECONDS = 60.0
+#: the environment variable ``--password`` is read from when not given
+PASSWORD_ENV = "TANKTOOL_PASSWORD"
 
 
 def network_options(f: Callable) -> Callable:
     """``--host``, ``--join``, ``--name``, ``--password`` for ``tanktool play``."""
-    f = click.option("--password", default=None, metavar="TEXT",
-                     help="Session password (checked with an HMAC challenge; never sent).")(f)
+    f = click.option("--password", default=None, metavar="TEXT", envvar=PASSWORD_ENV, show_envvar=True,
+                     help="Session password (checked with an HMAC challenge, never sent; every datagram is "
+                          "authenticated with it).  '-' asks for it at a prompt that does not echo; without "
+                          f"the option, ${PASSWORD_ENV} is used.  On the command line other local users can "
+                          "see it (ps).")(f)
     f = click.option("--name", "player_name", default=None, metavar="NAME",
                      help="Your player name in a network session (1-24 characters).")(f)
     f = click.option("--join", "join", default=None, metavar="ADDR:PORT",
@@ -35,6 +46,23 @@ def network_options(f: Callable) -> Callable:
     f = click.option("--host", "host", default=None, metavar="[ADDR:]PORT",
                      help="Host a network session, listening on ADDR:PORT (ADDR defaults to 127.0.0.1).")(f)
     return f
+
+
+def resolve_password(password: str | None) -> str | None:
+    """The session password: as given, or (``-``) typed at a prompt without echo, or read
+    as one line from standard input when that is not a terminal.  Empty means none."""
+    if password != "-":
+        return password or None
+    try:
+        if sys.stdin is not None and sys.stdin.isatty():
+            text = click.prompt("session password", hide_input=True, err=True, default="", show_default=False)
+        else:
+            text = sys.stdin.readline().rstrip("\r\n") if sys.stdin is not None else ""
+    except (click.Abort, EOFError, KeyboardInterrupt):
+        raise click.UsageError("--password -: no password given at the prompt") from None
+    if not text:
+        raise click.UsageError("--password -: no password given (an empty line)")
+    return text
 
 
 def run_network_window(host: str | None, join: str | None, player_name: str | None, password: str | None,

@@ -102,10 +102,11 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --replay mine.ttr                   (watch it in the window)
     """
     if host is not None or join is not None:
-        from .net_play import run_network, run_network_window
+        from .net_play import resolve_password, run_network, run_network_window
 
         if record_path is not None or replay_path is not None:
             raise click.UsageError("network matches are not recorded: --record/--replay go without --host/--join")
+        password = resolve_password(password)      # '-': typed at a prompt, once for both paths below
 
         if not headless and seconds is not None and _window_possible():
             click.echo("warning: --seconds is ignored in a network match in the window (it lasts until you "

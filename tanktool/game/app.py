@@ -39,6 +39,7 @@ DEFAULT_ADDRESS = "127.0.0.1:5000"
 #: seconds a notice stays over the match
 NOTICE_S = 4.0
 ADDRESS_CHARS = set("0123456789.:abcdefghijklmnopqrstuvwxyz")
+MAX_PASSWORD = 64
 
 
 class NoDisplay(TanktoolError):
@@ -98,10 +99,12 @@ class Menu:
     #: network play: off, host a session (listening on ``address``), or join the one at ``address``
     network: Choice = field(default_factory=lambda: Choice("network", ["off", "host", "join"]))
     address: str = DEFAULT_ADDRESS
+    #: the network session's password ("" for none), typed into a field that shows only stars
+    password: str = ""
     cursor: int = 0
 
     ITEMS = ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen", "network", "address",
-             "bindings", "start", "quit")
+             "password", "bindings", "start", "quit")
     CHOICES = ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen", "network")
 
     def item(self) -> str:
@@ -211,8 +214,9 @@ class App:
         self.replay = replay
         self.replay_name = replay_name
         self.replay_done = False
-        #: typing into the menu's address field
+        #: typing into a menu field: ``field`` says which ("address" or "password")
         self.editing = False
+        self.field = "address"
         self._notice_seen, self._notice_t = "", 0.0
         self.player_name: str | None = None
         self.password: str | None = None
@@ -223,6 +227,15 @@ class App:
     def size(self) -> tuple[int, int]:
         w, h = (int(v) for v in str(self.menu.resolution.value).split("x"))
         return w, h
+
+    @property
+    def password(self) -> str | None:
+        """The network session's password: the menu's field (``--password`` fills it)."""
+        return self.menu.password or None
+
+    @password.setter
+    def password(self, value: str | None) -> None:
+        self.menu.password = value or ""
 
     def open_window(self) -> None:
         self.presenter = Presenter(self.size(), bool(self.menu.fullscreen.value), want_gl=True)
@@ -418,6 +431,17 @@ class App:
     def _handle_menu(self, event: Any) -> None:
         m = self.menu
         step = 0
+        if self.editing and self.field == "password":
+            if event.type == pygame.KEYDOWN:
+                if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_TAB):
+                    self.editing = False
+                elif event.key == pygame.K_BACKSPACE:
+                    m.password = m.password[:-1]
+                else:
+                    ch = getattr(event, "unicode", "") or ""
+                    if len(ch) == 1 and ch.isprintable() and len(m.password) < MAX_PASSWORD:
+                        m.password += ch
+            return
         if self.editing:
             if event.type == pygame.KEYDOWN:
                 if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_TAB):
@@ -457,8 +481,11 @@ class App:
             except TanktoolError as e:
                 self.notice = str(e)       # a broken bundle, nobody at the address: say so, stay in the menu
         elif item == "address":
-            self.editing = True
+            self.editing, self.field = True, "address"
             self.menu.address = ""
+        elif item == "password":
+            self.editing, self.field = True, "password"
+            self.menu.password = ""
         elif item == "bindings":
             self.state = "remap"
             self.remap_cursor = 0
@@ -602,8 +629,12 @@ class App:
                 if item == "start" and m.network.value != "off":
                     label = f"START: {m.network.value} {m.address}"
             elif item == "address":
-                field_text = m.address + ("_" if self.editing else "")
+                field_text = m.address + ("_" if self.editing and self.field == "address" else "")
                 label = f"{'address':<12}  [ {field_text} ]" + ("" if self.editing or i != m.cursor else "  Enter: type")
+            elif item == "password":
+                typing = self.editing and self.field == "password"
+                field_text = "*" * len(m.password) + ("_" if typing else "") if m.password or typing else "none"
+                label = f"{'password':<12}  [ {field_text} ]" + ("" if self.editing or i != m.cursor else "  Enter: type")
             else:
                 c = getattr(m, item)
                 v = c.value

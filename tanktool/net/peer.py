@@ -16,8 +16,11 @@ a vote.  The host's only duty is answering joins, so nothing else has to move.
 Safety: a number is bound to a TCP link (the host's, or one the joiner opened to the
 address in the host's table, or a HELLO whose number, epoch and IP match the table) and to
 the UDP address in the table; anything a link or address sends for another number is
-dropped and counted.  With a password, every link answers an HMAC-SHA256 challenge.
-Messages are size-checked by the protocol and rate-limited per link and per address.
+dropped and counted.  With a password, every link answers an HMAC-SHA256 challenge and
+every datagram carries a tag made with the key of its link (:mod:`.auth`).  Messages are
+size-checked by the protocol; states must carry sequence numbers within a window; links,
+tanks and joins are rate-limited; unidentified connections are capped per address, and a
+new one pushes out the oldest silent one (:mod:`.guard`).
 """
 
 from __future__ import annotations
@@ -31,20 +34,46 @@ import socket
 import time
 from collections import Counter, deque
 from dataclasses import dataclass, field, replace
-from hashlib import sha256
 from typing import Any, Callable
 
 from ..errors import NetError
 from . import protocol as P
+from .auth import TAG_SIZE, datagram_key, hello_mac, join_mac, seal, unseal
+from .guard import Bucket, Buckets, DropLog, JoinLimiter, SeqWindow
+
+__all__ = ["Peer", "NetEvent", "Link", "Bucket", "parse_address", "free_port", "join_mac", "hello_mac",
+           "percentile"]
 
 #: a peer silent this long has left (and if it hosted, the host migrates) [s]
 SILENCE = 3.0
-#: an accepted TCP connection must say JOIN or HELLO within this time [s]
-PENDING_TIMEOUT = 5.0
-MAX_PENDING = 16
-#: per link / address message rates: a tank state at 30 Hz, a few events
+#: an accepted TCP connection must say JOIN or HELLO within this time [s]: a real peer
+#: answers the challenge within a round trip (a joiner answers its mesh links' challenges
+#: before ``Peer.join`` returns)
+PENDING_TIMEOUT = 2.0
+#: a HELLO waits this long for the host's NEW_PLAYER to name its number [s]
+HELLO_WAIT = 5.0
+#: unidentified connections at once, and from one address; past either, a new connection
+#: closes the oldest silent one (of the busiest address), so silent connections cannot
+#: lock a real player out: it answers within a round trip, they never do
+MAX_PENDING = 64
+MAX_PENDING_PER_IP = 48
+#: connections accepted per poll, after the data of those already open has been read (so
+#: a new one is read before ACCEPTS_PER_POLL more can push it out)
+ACCEPTS_PER_POLL = 16
+LISTEN_BACKLOG = 128
+#: per link / per tank message rates: a tank state at 30 Hz, a few events
 TCP_RATE, TCP_BURST = 100.0, 200.0
 UDP_RATE, UDP_BURST = 90.0, 45.0
+#: joins (host): per address a burst that lets a whole LAN party (or a loopback test
+#: session) in at once, then one a second; overall, what many addresses together get
+JOIN_RATE, JOIN_BURST = 1.0, 10.0
+JOINS_RATE, JOINS_BURST = 5.0, 20.0
+#: wrong passwords per address before its answers are no longer even checked
+AUTH_FAIL_RATE, AUTH_FAIL_BURST = 1.0, 10.0
+#: how long ``Peer.join`` waits for its mesh links' challenges before it returns [s]
+JOIN_SETTLE = 1.0
+#: how long ``Peer.join`` keeps retrying a host that says "too many joins" [s]
+JOIN_BUSY_WAIT = 0.5
 MAX_OUTBUF = 256 * 1024
 LATENCY_SAMPLES = 200_000
 
@@ -93,30 +122,8 @@ def free_port(ip: str = "127.0.0.1") -> int:
     raise NetError(f"no port free for both TCP and UDP on {ip}")
 
 
-def join_mac(password: str, nonce: bytes, name: str) -> bytes:
-    return hmac.new(password.encode(), b"join" + nonce + name.encode(), sha256).digest()
-
-
-def hello_mac(password: str, nonce: bytes, number: int, epoch: int) -> bytes:
-    return hmac.new(password.encode(), b"hello" + nonce + bytes([number]) + epoch.to_bytes(4, "big"),
-                    sha256).digest()
-
-
-class Bucket:
-    """Token bucket: ``rate`` messages a second with bursts up to ``burst``."""
-
-    __slots__ = ("rate", "burst", "tokens", "last")
-
-    def __init__(self, rate: float, burst: float, now: float) -> None:
-        self.rate, self.burst, self.tokens, self.last = rate, burst, burst, now
-
-    def take(self, now: float) -> bool:
-        self.tokens = min(self.burst, self.tokens + (now - self.last) * self.rate)
-        self.last = now
-        if self.tokens >= 1.0:
-            self.tokens -= 1.0
-            return True
-        return False
+class _Busy(NetError):
+    """The host said "too many joins": ``Peer.join`` waits a little and asks again."""
 
 
 @dataclass
@@ -127,8 +134,10 @@ class Link:
     reader: P.StreamReader
     bucket: Bucket
     opened: float
+    addr: tuple = ("", 0)             # the other end (ip, port)
     nonce: bytes = b""
     number: int = 0                   # bound player number (0 while pending)
+    udp_key: bytes | None = None      # with a password: the key of this pair's datagrams
     hello: P.Message | None = None    # a HELLO waiting for the table to know its number
     out: bytearray = field(default_factory=bytearray)
     closing: bool = False             # close once ``out`` is flushed (after a refusal)
@@ -165,10 +174,14 @@ class Peer:
         self.pending: list[Link] = []
         self.departed: set[tuple[int, int]] = set()  # (number, epoch) that left
         self.last_heard: dict[int, float] = {}
-        self.last_state_seq: dict[int, int] = {}
-        self.udp_buckets: dict[int, Bucket] = {}
+        self.last_state_seq: dict[tuple[int, int], int] = {}
+        self.window = SeqWindow()                   # sequence numbers a sender's states may carry
+        self.state_buckets = Buckets(UDP_RATE, UDP_BURST)     # per (sender, tank)
+        now = clock()
+        self.joins = JoinLimiter((JOIN_RATE, JOIN_BURST), (JOINS_RATE, JOINS_BURST), now)
+        self.auth_failures = Buckets(AUTH_FAIL_RATE, AUTH_FAIL_BURST)
         self.counters: Counter = Counter()          # sent, received, bytes_sent, bytes_received
-        self.dropped: Counter = Counter()           # reason -> count
+        self.dropped: DropLog = DropLog()           # reason -> count (and where from, for -v)
         self.latencies: deque[float] = deque(maxlen=LATENCY_SAMPLES)
         self.host_changes: list[tuple[float, int]] = []
         self.events: list[NetEvent] = []
@@ -179,6 +192,7 @@ class Peer:
         self.udp: socket.socket | None = None
         self.closed = False
         self._backlog: list[P.Message] = []
+        self._pruned = now
 
     # ------------------------------------------------------------------ set-up
     def _listen(self, ip: str, port: int) -> None:
@@ -189,7 +203,7 @@ class Peer:
         udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             tcp.bind((ip, port))
-            tcp.listen(16)
+            tcp.listen(LISTEN_BACKLOG)
             try:
                 udp.bind((ip, tcp.getsockname()[1]))
             except OSError:
@@ -231,23 +245,49 @@ class Peer:
 
     @classmethod
     def join(cls, address: tuple[str, int], name: str, password: str | None = None, timeout: float = 5.0,
-             port: int = 0, **kw: Any) -> "Peer":
+             port: int = 0, link_wait: float = JOIN_SETTLE, **kw: Any) -> "Peer":
         """Join the session whose host (or any member, which redirects) is at ``address``.
 
         Listens on the interface that reaches the host, on ``port`` (0: any free one).
-        Raises NetError with one clear line if the host cannot be reached or refuses.
+        A host that says "too many joins" is asked again every 0.5 s for ``timeout``
+        seconds.  Before returning, waits up to ``link_wait`` seconds for the other members'
+        challenges and answers them, so the mesh links do not depend on how soon the
+        caller first polls.  Raises NetError with one clear line if the host cannot be
+        reached or refuses.
         """
         peer = cls(name, password, **kw)
+        busy_until = time.monotonic() + timeout
         try:
-            for _ in range(3):        # a member that is not the host names it: follow
-                redirect = peer._join_once(address, timeout, port)
+            redirects = 0
+            while True:
+                try:
+                    redirect = peer._join_once(address, timeout, port)
+                except _Busy as e:
+                    if time.monotonic() + JOIN_BUSY_WAIT > busy_until:
+                        raise NetError(str(e)) from None
+                    time.sleep(JOIN_BUSY_WAIT)
+                    continue
                 if redirect is None:
-                    return peer
+                    break
+                redirects += 1       # a member that is not the host names it: follow
+                if redirects >= 3:
+                    raise NetError(f"cannot join: redirected too many times (last {redirect[0]}:{redirect[1]})")
                 address = redirect
-            raise NetError(f"cannot join: redirected too many times (last {address[0]}:{address[1]})")
+            peer._settle(link_wait)
+            return peer
         except BaseException:
             peer.close(send_exit=False)
             raise
+
+    def _settle(self, seconds: float) -> None:
+        """Poll until every mesh link this joiner opened has had its challenge answered
+        (or failed), for at most ``seconds``; what happened waits for the next poll."""
+        end = time.monotonic() + seconds
+        while any(link.outgoing for link in self.links.values()):
+            left = end - time.monotonic()
+            if left <= 0:
+                break
+            self._service(min(left, 0.01))
 
     def _join_once(self, address: tuple[str, int], timeout: float, port: int) -> tuple[str, int] | None:
         where = f"{address[0]}:{address[1]}"
@@ -275,6 +315,8 @@ class Peer:
             raise
         if isinstance(msg.body, P.Refuse):
             sock.close()
+            if msg.body.code == P.RefuseCode.RATE:
+                raise _Busy(f"join refused by {where}: {msg.body.text}")
             if msg.body.code == P.RefuseCode.NOT_HOST:
                 try:
                     return parse_address(msg.body.text, need_host=True)
@@ -295,7 +337,10 @@ class Peer:
                 e = P.Entry(e.number, e.epoch, address[0], e.tcp_port, e.udp_port, e.name)   # reach it as dialled
             self.table[e.number] = e
         sock.setblocking(False)
-        link = Link(sock, reader, Bucket(TCP_RATE, TCP_BURST, now), now)
+        link = Link(sock, reader, Bucket(TCP_RATE, TCP_BURST, now), now, addr=address, nonce=b"")
+        if self.password:
+            link.udp_key = datagram_key(self.password, mac)
+        self.window.anchor(self.host_number, msg.seq, now)
         self._bind_link(link, self.host_number)
         # the joiner links to those in the table it was given; who joins after it (a
         # NEW_PLAYER maybe already in the backlog) links to it
@@ -321,8 +366,8 @@ class Peer:
             self.dropped["link_failed"] += 1      # it will time out of the table if really gone
             return
         now = self.clock()
-        link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now, outgoing=True,
-                    initiated=True)
+        link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now,
+                    addr=(e.ip, e.tcp_port), outgoing=True, initiated=True)
         self._bind_link(link, e.number)
 
     def _drain_backlog(self, link: Link) -> None:
@@ -405,7 +450,9 @@ class Peer:
 
     # ------------------------------------------------------------------ sending
     def send_state(self, state: P.State) -> None:
-        """A state of a tank I run to every other player, by UDP."""
+        """A state of a tank I run to every other player, by UDP (with a password, each
+        copy sealed with the key of that player's link; none goes to a player whose
+        link is not up yet)."""
         if self.udp is None:
             return
         self.counters["state_rounds"] += 1
@@ -413,14 +460,21 @@ class Peer:
         for n, e in self.table.items():
             if n == self.number or e.is_bot:
                 continue
+            out = data
+            if self.password:
+                link = self.links.get(n)
+                if link is None or link.udp_key is None:
+                    self.counters["states_unkeyed"] += 1
+                    continue
+                out = seal(link.udp_key, data)
             try:
-                self.udp.sendto(data, (e.ip, e.udp_port))
+                self.udp.sendto(out, (e.ip, e.udp_port))
             except OSError:
                 self.dropped["send_failed"] += 1
                 continue
             self.counters["sent"] += 1
             self.counters["states_sent"] += 1
-            self.counters["bytes_sent"] += len(data)
+            self.counters["bytes_sent"] += len(out)
 
     def send_event(self, body: P.Body) -> None:
         """A shot, hit or exit to every linked peer, by TCP."""
@@ -462,9 +516,15 @@ class Peer:
         first thing), check silences and pending links; return what happened."""
         if self.closed:
             return []
+        self._service(timeout)
+        out, self.events = self.events, []
+        return out
+
+    def _service(self, timeout: float) -> None:
+        accept = False
         for key, mask in self.sel.select(max(timeout, 0.0)):
             if key.data == "accept":
-                self._accept()
+                accept = True
             elif key.data == "udp":
                 self._read_udp()
             else:
@@ -475,32 +535,57 @@ class Peer:
                     self._flush(link)
                 if mask & selectors.EVENT_READ and link.sock.fileno() >= 0:
                     self._read_tcp(link)
+        # new connections last: one accepted at the previous poll has had its answer read
+        # before any newer one can push it out of the pending list
+        if accept:
+            self._accept()
         self._check_timeouts()
-        out, self.events = self.events, []
-        return out
 
     def _accept(self) -> None:
         assert self.tcp is not None
-        for _ in range(8):
+        for _ in range(ACCEPTS_PER_POLL):
             try:
-                sock, _addr = self.tcp.accept()
+                sock, addr = self.tcp.accept()
             except (BlockingIOError, InterruptedError):
                 return
             except OSError:
                 self.dropped["accept_failed"] += 1
                 return
-            if len(self.pending) >= MAX_PENDING:
+            self.dropped.source = addr[0]      # TCP: by address (each connection has its own port)
+            if not self._make_room(addr[0]):
                 self.dropped["too_many_pending"] += 1
                 sock.close()
                 continue
             sock.setblocking(False)
             sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
             now = self.clock()
-            link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now,
+            link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now, addr=addr,
                         nonce=os.urandom(P.NONCE_SIZE))
             self.pending.append(link)
             self.sel.register(sock, selectors.EVENT_READ, link)
             self._queue(link, self._pack(P.Challenge(link.nonce, self.password is not None)))
+
+    def _make_room(self, ip: str) -> bool:
+        """Room in the pending list for a connection from ``ip``: over the per-address
+        cap, that address's oldest pending connection goes; over the overall cap, the
+        busiest address's.  Refusals being flushed go first, then silent connections,
+        then HELLOs waiting for the table.  A real player answers its challenge within a
+        round trip; silent connections never do, so they cannot keep it out."""
+        mine = [link for link in self.pending if link.addr[0] == ip]
+        if len(mine) >= MAX_PENDING_PER_IP:
+            victims = mine
+        elif len(self.pending) >= MAX_PENDING:
+            busiest = Counter(link.addr[0] for link in self.pending).most_common(1)[0][0]
+            victims = [link for link in self.pending if link.addr[0] == busiest]
+        else:
+            return True
+        if not victims:
+            return False
+        victim = min(victims, key=lambda link: (not link.closing, link.hello is not None, link.opened))
+        self.dropped.source = victim.addr[0]
+        self.dropped["evicted"] += 1
+        self._close_link(victim)
+        return True
 
     def _read_tcp(self, link: Link) -> None:
         try:
@@ -509,6 +594,7 @@ class Peer:
             return
         except OSError:
             data = b""
+        self.dropped.source = link.addr[0]
         if not data:
             self._drop_link(link, "closed")
             return
@@ -539,11 +625,15 @@ class Peer:
             link.outgoing = False
             epoch = self.table[self.number].epoch
             mac = hello_mac(self.password, m.body.nonce, self.number, epoch) if self.password else bytes(P.MAC_SIZE)
+            if self.password:
+                link.udp_key = datagram_key(self.password, mac)
+            self.window.anchor(link.number, m.seq, now)
             self._queue(link, self._pack(P.Hello(epoch, mac)))
             return
         if m.sender != link.number:
             self.dropped["impostor"] += 1      # a peer speaks only for its own number
             return
+        self.window.anchor(link.number, m.seq, now)     # the link is authenticated: its numbers are real
         if isinstance(m.body, P.Refuse) and link.initiated:
             link.refused = True                # a duplicate link lost the tie-break
             return
@@ -585,20 +675,34 @@ class Peer:
 
     def _on_pending(self, link: Link, m: P.Message) -> None:
         body = m.body
-        if isinstance(body, P.Join):
-            if self.password and not hmac.compare_digest(body.mac, join_mac(self.password, link.nonce, body.name)):
+        now = self.clock()
+        ip = link.addr[0]
+        if isinstance(body, (P.Join, P.Hello)) and self.password:
+            # guesses from an address that keeps getting the password wrong are not
+            # even checked for a while (a right one would otherwise still get in)
+            if not self.auth_failures.has_token(ip, now):
+                self._refuse(link, P.RefuseCode.RATE, f"too many wrong passwords from {ip}: try again later")
+                return
+            if isinstance(body, P.Join):
+                good = join_mac(self.password, link.nonce, body.name)
+            else:
+                good = hello_mac(self.password, link.nonce, m.sender, body.epoch)
+            if not hmac.compare_digest(body.mac, good):
+                self.auth_failures.take(ip, now)
                 self._refuse(link, P.RefuseCode.PASSWORD, "wrong password")
                 return
+        if isinstance(body, P.Join):
             if not self.is_host:
                 h = self.table.get(self.host_number)
                 self._refuse(link, P.RefuseCode.NOT_HOST, f"{h.ip}:{h.tcp_port}" if h else "")
                 return
-            self._admit(link, body)
-        elif isinstance(body, P.Hello):
-            if self.password and not hmac.compare_digest(
-                    body.mac, hello_mac(self.password, link.nonce, m.sender, body.epoch)):
-                self._refuse(link, P.RefuseCode.PASSWORD, "wrong password")
+            if not self.joins.allow(ip, now):
+                # each join makes the host send every member the new table: a flood of
+                # joins would fill the members' rate limiters with the host's messages
+                self._refuse(link, P.RefuseCode.RATE, f"too many joins from {ip}: try again in a few seconds")
                 return
+            self._admit(link, m)
+        elif isinstance(body, P.Hello):
             link.hello = m
             self._try_hello(link)
         else:
@@ -607,7 +711,7 @@ class Peer:
     def _try_hello(self, link: Link) -> bool:
         """Bind a HELLO link when the table knows its number with that epoch and the
         address matches; otherwise it waits (the host's NEW_PLAYER may still be on
-        its way) until PENDING_TIMEOUT."""
+        its way) until HELLO_WAIT."""
         m = link.hello
         assert m is not None
         n = m.sender
@@ -631,10 +735,14 @@ class Peer:
             self._refuse(link, P.RefuseCode.BAD_REQUEST, f"player {n} is already linked")
             return False
         self.pending.remove(link)
+        if self.password:
+            link.udp_key = datagram_key(self.password, m.body.mac)
+        self.window.anchor(n, m.seq, self.clock())
         self._bind_link(link, n, registered=True)
         return True
 
-    def _admit(self, link: Link, join: P.Join) -> None:
+    def _admit(self, link: Link, m: P.Message) -> None:
+        join: P.Join = m.body
         free = [n for n in range(1, P.MAX_PLAYERS + 1) if n not in self.table]
         if not free:
             self._refuse(link, P.RefuseCode.FULL, f"session full: {P.MAX_PLAYERS} players already")
@@ -648,6 +756,9 @@ class Peer:
         epoch = max(e.epoch for e in self.table.values()) + 1
         self.table[n] = P.Entry(n, epoch, ip, join.tcp_port, join.udp_port, join.name)
         self.pending.remove(link)
+        if self.password:
+            link.udp_key = datagram_key(self.password, join.mac)
+        self.window.anchor(n, m.seq, self.clock())
         self._bind_link(link, n, registered=True)
         table = self._table()
         t = self.session_time()
@@ -712,46 +823,87 @@ class Peer:
                 self.dropped["udp_error"] += 1
                 return
             self.counters["bytes_received"] += len(data)
+            self.dropped.source = addr
+            if self.password:
+                data = self._unseal(data, addr)
+                if data is None:
+                    continue
             m = P.decode(data, self.dropped)
             if m is None:
                 continue
-            e = self.table.get(m.sender)
-            if e is None or e.is_bot or m.sender == self.number or addr != (e.ip, e.udp_port):
-                self.dropped["impostor" if e is not None else "unknown"] += 1
+            if self._from_member(m.sender, addr) is None:
                 continue
             if not isinstance(m.body, P.State):
                 self.dropped["unexpected"] += 1
                 continue
-            b = self.udp_buckets.get(m.sender)
-            if b is None:
-                b = self.udp_buckets[m.sender] = Bucket(UDP_RATE, UDP_BURST, now)
-            if not b.take(now):
-                self.dropped["rate"] += 1
-                continue
-            self.counters["received"] += 1
-            self.last_heard[m.sender] = now
-            self._on_state(m, now)
+            if self._on_state(m, now):
+                self.counters["received"] += 1
+                self.last_heard[m.sender] = now
 
-    def _on_state(self, m: P.Message, now: float) -> None:
+    def _from_member(self, sender: int, addr: tuple) -> P.Entry | None:
+        """The table entry of a datagram's sender if it came from that player's address;
+        otherwise None, counted as ``impostor`` (a known number) or ``unknown``."""
+        e = self.table.get(sender)
+        if e is None or e.is_bot or sender == self.number or addr != (e.ip, e.udp_port):
+            self.dropped["impostor" if e is not None else "unknown"] += 1
+            return None
+        return e
+
+    def _unseal(self, data: bytes, addr: tuple) -> bytes | None:
+        """A password session's datagram without its tag, once the tag checks out with
+        the key of its sender's link; None (counted) for anything else."""
+        if len(data) < P.HEADER.size + TAG_SIZE:
+            self.dropped["short"] += 1
+            return None
+        sender = data[4]                      # the header's sender byte
+        if self._from_member(sender, addr) is None:
+            return None
+        link = self.links.get(sender)
+        if link is None or link.udp_key is None:
+            self.dropped["no_key"] += 1
+            return None
+        message = unseal(link.udp_key, data)
+        if message is None:
+            self.dropped["bad_mac"] += 1
+        return message
+
+    def _on_state(self, m: P.Message, now: float) -> bool:
+        """Take a state (from UDP or TCP) if its sender runs that tank, its sequence
+        number is within the window and newer than the last of that tank, and the
+        tank is within its rate; True when taken."""
         if not self._may_speak(m.sender, m.body.tank) or m.body.tank == self.number:
             self.dropped["impostor"] += 1
-            return
+            return False
+        within = self.window.admits(m.sender, m.seq, now)
+        if not within:
+            self.dropped["no_anchor" if within is None else "window"] += 1
+            return False
         key = (m.sender, m.body.tank)
         if m.seq <= self.last_state_seq.get(key, -1):
             self.dropped["stale"] += 1        # latest sequence wins
-            return
+            return False
+        if not self.state_buckets.take(key, now):
+            self.dropped["rate"] += 1
+            return False
         self.last_state_seq[key] = m.seq
+        self.window.anchor(m.sender, m.seq, now)
         self.counters["states_received"] += 1
         self.latencies.append(now - m.timestamp)
         self.events.append(NetEvent("state", m.sender, m.body))
+        return True
 
     # ------------------------------------------------------------------ leaving
     def _check_timeouts(self) -> None:
         now = self.clock()
         for link in list(self.pending):
-            if now - link.opened > PENDING_TIMEOUT:
+            if now - link.opened > (HELLO_WAIT if link.hello is not None else PENDING_TIMEOUT):
+                self.dropped.source = link.addr[0]
                 self.dropped["pending_timeout"] += 1
                 self._close_link(link)
+        if now - self._pruned > 1.0:          # forget the buckets of addresses gone quiet
+            self._pruned = now
+            for buckets in (self.joins.addresses, self.auth_failures, self.state_buckets):
+                buckets.prune(now)
         for n in list(self.table):
             if n in self.table and n != self.number and not self.table[n].is_bot \
                     and now - self.last_heard.get(n, now) > self.silence:
@@ -790,7 +942,9 @@ class Peer:
         self.last_heard.pop(n, None)
         for key in [k for k in self.last_state_seq if n in k]:
             del self.last_state_seq[key]
-        self.udp_buckets.pop(n, None)
+        for key in [k for k in self.state_buckets.buckets if n in k]:
+            self.state_buckets.forget(key)
+        self.window.forget(n)
         if e is None:
             return
         self.departed.add((n, e.epoch))
@@ -852,6 +1006,7 @@ class Peer:
             "bytes_sent": self.counters["bytes_sent"], "bytes_received": self.counters["bytes_received"],
             "state_rounds": self.counters["state_rounds"],
             "states_sent": self.counters["states_sent"], "states_received": self.counters["states_received"],
+            "states_unkeyed": self.counters["states_unkeyed"],
             "dropped_reasons": dict(sorted(self.dropped.items())),
         }
 

@@ -63,6 +63,7 @@ class RefuseCode(enum.IntEnum):
     PASSWORD = 2
     NOT_HOST = 3
     BAD_REQUEST = 4
+    RATE = 5         # too many joins (or wrong passwords) from your address: try again later
 
 
 @dataclass(frozen=True, slots=True)

@@ -23,6 +23,7 @@ them and drives them on.
 
 from __future__ import annotations
 
+import logging
 import math
 import random
 import time
@@ -41,6 +42,11 @@ from .remote import INTERP_DELAY, RemoteTank
 STATE_HZ = 30.0
 #: a process that falls further behind than this skips steps rather than spiral [s]
 MAX_LAG = 0.25
+#: what the peer dropped or refused is logged (at ``-v``: one line per kind) as soon as
+#: it starts, then at most this often [s]
+DROP_LOG_INTERVAL = 5.0
+#: ``tanktool -v`` shows this logger's INFO lines
+log = logging.getLogger("tanktool.net")
 
 
 @dataclass
@@ -233,6 +239,8 @@ class NetMatch:
         self.next_view = math.floor(self.world.t) + 1
         self.skipped = 0
         self.stats_since = start
+        self.drop_log_since = start          # the span the next drop lines cover
+        self.drop_log_at = -math.inf         # when drop lines were last logged
 
     def pump(self, until: float | None = None, before_step: Callable[[], None] | None = None) -> list:
         """One turn of the real-time loop: read the network (waiting at most until the
@@ -267,7 +275,17 @@ class NetMatch:
             self.next_state += 1.0 / self.state_hz
             if now - self.next_state > MAX_LAG:
                 self.next_state = now
+        if peer.dropped.grown and now - self.drop_log_at >= DROP_LOG_INTERVAL:
+            self.log_drops()
         return events
+
+    def log_drops(self) -> None:
+        """Log (INFO, shown at ``-v``) one line per kind of message the peer dropped or
+        refused since the last call: attacks leave a trace, not a line per packet."""
+        now = time.monotonic()
+        for line in self.peer.dropped.lines(now - self.drop_log_since):
+            log.info(line)
+        self.drop_log_since = self.drop_log_at = now
 
     def run(self, seconds: float) -> dict[str, Any]:
         """Play ``seconds`` of real time; return the report."""
@@ -281,6 +299,8 @@ class NetMatch:
 
     def finish(self) -> dict[str, Any]:
         """The report of the match so far (``run`` ends with it)."""
+        if hasattr(self, "drop_log_at"):
+            self.log_drops()
         return self.report(time.monotonic() - self.started, self.skipped)
 
     # ------------------------------------------------------------------ report
