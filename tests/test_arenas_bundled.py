@@ -63,7 +63,18 @@ def test_bundle_is_playable(folder: Path):
     a = load_arena(folder)
     assert len(a.spawns) >= MIN_SPAWNS
     seg = a.walls.all_segments()
-    d = point_segment_distance(a.spawns[:, None, :2], seg[None, :, 0], seg[None, :, 1]).min(axis=1)
+    if a.walls.layered:  # clear of every wall of its own level (a deck's edge above does not count)
+        from tanktool.nav.navgrid import NavGrid
+
+        grid = NavGrid.load(folder / "navgrid.npz")
+        node = grid.nodes_of(a.spawns[:, :2])
+        hts = grid.heights()[:, node[:, 0], node[:, 1]]
+        level = np.nanargmin(np.where(np.isfinite(hts), np.abs(hts - a.spawns[:, 3]), np.inf), axis=0)
+        d = np.array([point_segment_distance(p[None], a.walls.segments[a.walls.level == lv][:, 0],
+                                             a.walls.segments[a.walls.level == lv][:, 1]).min()
+                      for p, lv in zip(a.spawns[:, :2], level)])
+    else:
+        d = point_segment_distance(a.spawns[:, None, :2], seg[None, :, 0], seg[None, :, 1]).min(axis=1)
     assert d.min() >= 2.5  # clear of every wall
     lo, hi = a.bounds
     assert ((a.spawns[:, :2] > lo) & (a.spawns[:, :2] < hi)).all()

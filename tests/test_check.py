@@ -100,11 +100,12 @@ def test_cli_unreadable_path_exits_2(tmp_path):
     assert "in 2 files" in res.output  # the readable paths are still checked
 
 
-def test_cli_without_a_path_checks_the_bundled_content_and_lists_rules():
+def test_cli_without_a_path_checks_the_bundled_content_and_lists_rules(root_dir):
     res = CliRunner().invoke(cli, ["check", "--strict"])
     assert res.exit_code == 0, res.output
     assert "note: no PATH given: checking the bundled content" in res.output
-    assert res.output.strip().splitlines()[-1] == "0 errors, 0 warnings in 5 files"
+    n = len(list((root_dir / "arenas").glob("*/arena.toml"))) + len(list((root_dir / "vehicles").glob("*/vehicle.toml")))
+    assert res.output.strip().splitlines()[-1] == f"0 errors, 0 warnings in {n} files"
     res = CliRunner().invoke(cli, ["check", "--rules"])
     assert res.exit_code == 0
     assert all(code in res.output for code in RULES)
@@ -272,7 +273,7 @@ def test_spawns_keep_their_manifest_index_when_one_is_malformed(tmp_path):
     head, rest = text.split("spawns = [\n", 1)
     toml.write_text(head + 'spawns = [\n    "not a spawn",\n' + rest)
     codes = sorted((d.code, d.message.split(" at ")[0]) for d in run_check([arena]).diagnostics)
-    assert codes == [("A302", "spawn 9"), ("B102", "spawn 0 must be [x, z, heading_rad] with 3 finite numbers, got 'not a spawn'")]
+    assert codes == [("A302", "spawn 9"), ("B102", "spawn 0 must be [x, z, heading_rad] or [x, z, heading_rad, y] with finite numbers, got 'not a spawn'")]
 
 
 def test_a_spawn_behind_a_narrow_door_is_unreachable(tmp_path):
@@ -348,7 +349,8 @@ def test_an_arena_alone_is_checked_against_the_bundled_vehicles(tmp_path, root_d
     room = _small_room(tmp_path, monkeypatch)
     report = run_check([room])
     # too small for the bundled tanks (A303); made for a scout, it has few spawns (A305)
-    assert {d.code for d in report.diagnostics} == {"A303", "A305"}
+    # and its surface was found for the scout's headroom (A312)
+    assert {d.code for d in report.diagnostics} == {"A303", "A305", "A312"}
     assert all("vehicle 'heavy'" in d.message for d in report.diagnostics if d.code == "A303")
     (note,) = report.notes
     assert note.startswith("note: arena 'room' checked against the bundled vehicles 'heavy', 'light' in ")

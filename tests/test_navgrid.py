@@ -86,6 +86,10 @@ def test_fast_classifier_equals_2002_reference(name, walls):
 @pytest.mark.parametrize("path", BUNDLED, ids=[p.parent.name for p in BUNDLED])
 def test_bundled_arenas_both_classifiers_agree(path):
     walls = read_walls(path)
+    if walls.layered:
+        # walls in blocks per level open onto each other (a ramp onto a deck): the 2002
+        # free-space count is not defined there; the surface decides (tests/test_walkable.py)
+        pytest.skip("a layered arena: its walls do not close up")
     span = float(np.max(walls.bounds[1] - walls.bounds[0]))
     cell = span / 60  # a coarse grid: the reference is slow
     origin, shape, X, Z = _nodes(walls, cell)

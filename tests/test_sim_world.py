@@ -190,7 +190,8 @@ def _soak_arenas():
         toml = p / "arena.toml"
         from tanktool.formats.bundle import read_toml
 
-        sp = np.asarray(read_toml(toml).get("spawns", []), float).reshape(-1, 3)
+        raw = read_toml(toml).get("spawns", [])
+        sp = np.asarray([s[:3] for s in raw], float).reshape(-1, 3)
         if len(sp) >= 8:
             out.append((p.name, read_walls(p / "walls.txt"), sp))
     return out

@@ -10,6 +10,10 @@ source model:
 * ``arenas/maze/maze.obj``      -- a 104 x 104 m maze of 13 m cells (12 m passages),
                                    a seeded depth-first maze with extra openings so it
                                    has loops
+* ``arenas/hills/hills.obj``    -- 120 x 120 m of rolling terrain inside a wall, rocks
+* ``arenas/fort/fort.obj``      -- a walled yard with a fort whose roof is a second floor
+                                   on ramps, a gate passage under it, a bridged sunken road
+  (both from tools/make_levels.py)
 * ``arenas/paper2002/paper2002.3ds`` -- the 2002 paper's arena (table 3.4.4.1 starts
   ``0 0 0 200 / 0 200 50 200 / 50 200 50 300 / 50 300 0 300 / 0 300 0 450 /
   0 450 50 500 / 50 500 200 500``), completed symmetrically into a closed 250 x 500
@@ -43,6 +47,12 @@ COLOURS = {
     "wall": (0.62, 0.36, 0.27),
     "crate": (0.55, 0.42, 0.22),
     "block": (0.45, 0.47, 0.55),
+    # the generated levels' kinds (tools/make_levels.py)
+    "ground": (0.42, 0.45, 0.38),
+    "grass": (0.38, 0.52, 0.30),
+    "rock": (0.50, 0.48, 0.45),
+    "deck": (0.55, 0.42, 0.22),
+    "ramp": (0.60, 0.55, 0.40),
 }
 
 #: the 2002 paper's free-space outline, completed (paper units); x right, z up
@@ -212,11 +222,26 @@ def write_3ds_model(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]]) -
     write_3ds(path, objects)
 
 
+def _generated(name: str):
+    """A level of tools/make_levels.py as named parts."""
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        import make_levels
+    finally:
+        sys.path.remove(str(ROOT / "tools"))
+
+    def parts() -> list[tuple[str, str, trimesh.Trimesh]]:
+        return [(f"{kind}{k:02d}", kind, mesh) for k, (kind, mesh) in enumerate(make_levels.LEVELS[name]())]
+    return parts
+
+
 #: name -> (author function, source file name, import-arena parameters)
 ARENAS = {
     "box": (model_box, "box.obj", {"up": "y"}),
     "maze": (model_maze, "maze.obj", {"up": "y"}),
     "paper2002": (model_paper2002, "paper2002.3ds", {"up": "z"}),
+    "hills": (_generated("hills"), "hills.obj", {"up": "y"}),
+    "fort": (_generated("fort"), "fort.obj", {"up": "y"}),
 }
 
 

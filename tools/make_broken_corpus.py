@@ -396,6 +396,108 @@ def make_cases() -> None:
            [line_of(c / "vehicles/tank/vehicle.toml", "footprint_radius")])
 
 
+# ------------------------------------------------------- levels and the navigation grid
+GRID_ORIGIN = (-1.0, -1.0)
+GRID_CELL = 1.0
+GRID_SHAPE = (42, 42)
+
+
+def grid_nodes() -> tuple[np.ndarray, np.ndarray]:
+    """(z, x) of every node of the corpus grid (cell centres), each (nz, nx)."""
+    zs = GRID_ORIGIN[1] + (np.arange(GRID_SHAPE[0]) + 0.5) * GRID_CELL
+    xs = GRID_ORIGIN[0] + (np.arange(GRID_SHAPE[1]) + 0.5) * GRID_CELL
+    return np.meshgrid(zs, xs, indexing="ij")
+
+
+def free_nodes(margin: float = 2.5) -> np.ndarray:
+    """Nodes of the clean room at ``margin`` from its walls and block."""
+    z, x = grid_nodes()
+    inside = (x > margin) & (x < ROOM - margin) & (z > margin) & (z < ROOM - margin)
+    b0, c0, b1, c1 = BLOCK
+    block = (x > b0 - margin) & (x < b1 + margin) & (z > c0 - margin) & (z < c1 + margin)
+    return inside & ~block
+
+
+def write_grid(bundle: Path, valid: np.ndarray, reachable: np.ndarray | None = None,
+               height: np.ndarray | None = None) -> None:
+    """navgrid.npz from a hand-made (L, nz, nx) mask, its hash added to arena.toml."""
+    from tanktool.formats.bundle import read_toml
+    from tanktool.nav.navgrid import NavGrid, layered_runs, links_from_valid
+
+    v = np.asarray(valid, dtype=bool)
+    v = v[None] if v.ndim == 2 else v
+    link = links_from_valid(v)
+    ri, rt, ci, ct = layered_runs(v, link)
+    reach = v.copy() if reachable is None else np.asarray(reachable, dtype=bool).reshape(v.shape)
+    h = np.where(v, 0.0, np.nan) if height is None else np.where(v, height, np.nan)
+    arrays = [v, ri, rt, ci, ct, reach & v]
+    if v.shape[0] == 1:
+        arrays, h, link = [a[0] for a in arrays], h[0], link[0]
+    grid = NavGrid(np.array(GRID_ORIGIN), GRID_CELL, GRID_SHAPE, *arrays, 2.5, height=h, link=link)
+    (bundle / "navgrid.npz").write_bytes(grid.to_bytes())
+    doc = read_toml(bundle / "arena.toml")
+    doc["derived"]["navgrid.npz"] = sha256_file(bundle / "navgrid.npz")
+    (bundle / "arena.toml").write_text(dumps_toml(doc))
+
+
+def layered_walls(segs, dirs) -> str:
+    """The clean room's walls as region 0 of level 0, and a deck's edge as region 1 of
+    level 1 (a walls file in blocks)."""
+    deck, ddirs = loop(rect(28, 28, 36, 36), True)
+    wl = WallList(np.array(segs + deck, dtype=np.float64), np.array(dirs + ddirs), aux_rectangle(-1.0, -1.0, ROOM + 1, ROOM + 1),
+                  level=[0] * len(segs) + [1] * len(deck), region=[0] * len(segs) + [1] * len(deck),
+                  regions={0: (0, 0.0, 0.0), 1: (1, 4.0, 4.0)})
+    return format_walls(wl, header="check corpus: two levels")
+
+
+def make_level_cases() -> None:
+    """A309 - A315: the walkable levels and the navigation grid."""
+    segs, dirs = base_walls()
+    walkable = {"cell": GRID_CELL, "cell_height": 0.1, "max_slope": 35.0, "climb": 0.9, "headroom": 2.5}
+
+    def case(code: str, name: str, spawns=None, walls_txt=None, vehicle=True, headroom=2.5):
+        c = BROKEN / f"{code}_{name}"
+        b = c / "arenas" / name
+        write_arena(b, segs, dirs, spawns=spawns, walls_txt=walls_txt,
+                    toml_edit=lambda d: d.update(walkable={**walkable, "headroom": headroom}))
+        if vehicle:
+            write_vehicle(c / "vehicles" / "tank")
+        return c, b
+
+    free = free_nodes()
+    c, b = case("A309", "no_usable_grid")
+    write_grid(b, np.zeros_like(free))
+    expect(c, "A309", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml", [line_of(b / "arena.toml", "[navgrid]")])
+    c, b = case("A310", "unreachable_level")
+    deck = np.zeros_like(free)
+    deck[30:35, 30:35] = True
+    write_grid(b, np.stack([free, deck]), np.stack([free, np.zeros_like(free)]), np.stack([0 * free, 4 + 0 * free]))
+    expect(c, "A310", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml", [line_of(b / "arena.toml", "[navgrid]")])
+    c, b = case("A311", "spawn_on_island", SPAWNS[:7] + [[31.5, 31.5, 0]])
+    z, x = grid_nodes()
+    ring = (np.abs(x - 31.5) <= 3) & (np.abs(z - 31.5) <= 3) & ~((np.abs(x - 31.5) <= 1) & (np.abs(z - 31.5) <= 1))
+    write_grid(b, free & ~ring | ((np.abs(x - 31.5) <= 1) & (np.abs(z - 31.5) <= 1)))
+    expect(c, "A311", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml", [spawn_line(b / "arena.toml", 7)])
+    c, b = case("A312", "low_headroom", headroom=1.0)
+    expect(c, "A312", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml", [line_of(b / "arena.toml", "headroom = ")])
+    c, b = case("A313", "spawn_on_slope")
+    slope = np.where(x > 30, (x - 30) * np.tan(np.radians(28)), 0.0)  # 28 deg east of x = 30, under spawn 1
+    write_grid(b, free, height=slope)
+    expect(c, "A313", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml", [spawn_line(b / "arena.toml", 1)])
+    two = layered_walls(segs, dirs)
+    c, b = case("A314", "spawn_off_grid", walls_txt=two)
+    hole = (np.abs(x - 5) <= 3) & (np.abs(z - 20) <= 3)  # around spawn 5 at (5, 20)
+    deck = np.zeros_like(free)
+    deck[31:35, 31:35] = True
+    write_grid(b, np.stack([free & ~hole, deck]), height=np.stack([0 * free, 4 + 0 * free]))
+    expect(c, "A314", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml", [spawn_line(b / "arena.toml", 5)])
+    c, b = case("A315", "spawns_apart", walls_txt=two)
+    cut = (np.abs(z - 27.5) <= 1.0)  # the grid cut in two along z = 27.5: spawns 2 and 4 beyond it
+    write_grid(b, np.stack([free & ~cut, deck]), height=np.stack([0 * free, 4 + 0 * free]))
+    expect(c, "A315", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml",
+           [spawn_line(b / "arena.toml", 2), spawn_line(b / "arena.toml", 4)])
+
+
 def main() -> int:
     for d in (BROKEN, CLEAN):
         if d.exists():
@@ -403,6 +505,7 @@ def main() -> int:
     write_arena(CLEAN / "arenas" / "yard")
     write_vehicle(CLEAN / "vehicles" / "tank")
     make_cases()
+    make_level_cases()
     print(f"wrote {len(list(BROKEN.iterdir()))} cases under {BROKEN.relative_to(ROOT)} and {CLEAN.relative_to(ROOT)}")
     return 0
 

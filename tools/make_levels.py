@@ -3,7 +3,8 @@
     .venv/bin/python tools/make_levels.py OUT_DIR [--seed N]
 
 writes one .obj (Y up, metres) per kind into OUT_DIR; the tests and bench/walkable.py
-call the functions directly.  Every level is built from trimesh primitives and
+call the functions directly (each returns its parts, ``(kind, mesh)`` pairs; ``level(name)``
+joins them into one mesh).  Every level is built from trimesh primitives and
 height-field grids, seeded, so a seed gives the same file:
 
 * ``rolling_terrain``  hills and hollows (5,000+ triangles), some slopes too steep
@@ -87,7 +88,7 @@ def walled_yard(w: float, d: float, wall_h: float = 3.0, t: float = 1.0, slab: f
             ("wall", box(0, t, t, d - t, 0, wall_h)), ("wall", box(w - t, t, w, d - t, 0, wall_h))]
 
 
-def rolling_terrain(size: float = 90.0, n: int = 52, amp: float = 3.5, seed: int = 1) -> trimesh.Trimesh:
+def rolling_terrain(size: float = 90.0, n: int = 52, amp: float = 3.5, seed: int = 1) -> list:
     """Hills and hollows over ``size`` x ``size`` m: ``2 (n - 1)^2`` triangles of a sum of
     seeded sine waves, plus a ridge steeper than a tank climbs."""
     rng = np.random.default_rng(seed)
@@ -101,10 +102,10 @@ def rolling_terrain(size: float = 90.0, n: int = 52, amp: float = 3.5, seed: int
     h *= amp / max(np.abs(h).max(), 1e-9)
     # a steep ridge across one corner (about 50 degrees)
     ridge = np.clip(8.0 - np.abs((X - 0.75 * size) + (Z - 0.75 * size)) * 1.2, 0, None)
-    return join([("grass", heightfield_mesh(xs, xs, h + ridge))])
+    return [("grass", heightfield_mesh(xs, xs, h + ridge))]
 
 
-def ramps_and_decks(seed: int = 0) -> trimesh.Trimesh:
+def ramps_and_decks(seed: int = 0) -> list:
     """A 70 x 50 m walled yard; a 24 x 20 m deck 4 m up on a solid block; two 16 m ramps
     (14 degrees) lead up to it from the yard; a low crate on the deck."""
     parts = walled_yard(70, 50)
@@ -112,10 +113,10 @@ def ramps_and_decks(seed: int = 0) -> trimesh.Trimesh:
               ("ramp", ramp(24, 17, 40, 24, 0.0, 4.0, "+x")),
               ("ramp", ramp(52, 35, 60, 49, 0.0, 4.0, "-z")),
               ("wall", box(48, 22, 52, 26, 4.0, 6.0))]
-    return join(parts)
+    return parts
 
 
-def bridge(seed: int = 0) -> trimesh.Trimesh:
+def bridge(seed: int = 0) -> list:
     """An 80 x 60 m yard cut by a 12 m passage at ground level (x 34 - 46); a 5 m
     plateau on each side, each with a ramp up from the ground; a bridge deck (top 5 m,
     0.5 m thick) joins the plateaus over the passage: under it the passage, on it the
@@ -125,10 +126,10 @@ def bridge(seed: int = 0) -> trimesh.Trimesh:
               ("deck", box(34, 26, 46, 34, 4.5, 5.0)),
               ("ramp", ramp(3, 1, 13, 16, 0.0, 5.0, "+z")),
               ("ramp", ramp(67, 44, 77, 59, 0.0, 5.0, "-z"))]
-    return join(parts)
+    return parts
 
 
-def bumpy_floor(seed: int = 3, bumps: int = 120) -> trimesh.Trimesh:
+def bumpy_floor(seed: int = 3, bumps: int = 120) -> list:
     """A 60 x 60 m walled yard with ``bumps`` seeded boxes 10 cm high, 0.5 - 2 m wide."""
     rng = np.random.default_rng(seed)
     parts = walled_yard(60, 60)
@@ -136,17 +137,17 @@ def bumpy_floor(seed: int = 3, bumps: int = 120) -> trimesh.Trimesh:
         x, z = rng.uniform(4, 56, 2)
         w, d = rng.uniform(0.5, 2.0, 2)
         parts.append(("rock", box(x, z, x + w, z + d, 0, 0.1)))
-    return join(parts)
+    return parts
 
 
-def tiny_room() -> trimesh.Trimesh:
+def tiny_room() -> list:
     """A 3 x 3 m room with 2.5 m walls: no bundled tank fits in it."""
-    return join([("ground", box(0, 0, 3.6, 3.6, -0.2, 0)), ("wall", box(0, 0, 3.6, 0.3, 0, 2.5)),
-                 ("wall", box(0, 3.3, 3.6, 3.6, 0, 2.5)), ("wall", box(0, 0.3, 0.3, 3.3, 0, 2.5)),
-                 ("wall", box(3.3, 0.3, 3.6, 3.3, 0, 2.5))])
+    return [("ground", box(0, 0, 3.6, 3.6, -0.2, 0)), ("wall", box(0, 0, 3.6, 0.3, 0, 2.5)),
+            ("wall", box(0, 3.3, 3.6, 3.6, 0, 2.5)), ("wall", box(0, 0.3, 0.3, 3.3, 0, 2.5)),
+            ("wall", box(3.3, 0.3, 3.6, 3.3, 0, 2.5))]
 
 
-def two_storeys(seed: int = 0) -> trimesh.Trimesh:
+def two_storeys(seed: int = 0) -> list:
     """A 60 x 40 m walled ground floor under a 0.5 m slab at 5 m (40 x 40 m, on four
     pillars), a long ramp up to it from the open end: the upper floor lies over the
     ground floor."""
@@ -155,10 +156,10 @@ def two_storeys(seed: int = 0) -> trimesh.Trimesh:
     for x, z in ((14, 5), (14, 33), (44, 5), (44, 33)):
         parts.append(("wall", box(x, z, x + 2, z + 2, 0, 4.5)))
     parts.append(("ramp", ramp(50, 10, 80, 30, 0.0, 5.0, "-x")))
-    return join(parts)
+    return parts
 
 
-def hills(seed: int = 7) -> trimesh.Trimesh:
+def hills(seed: int = 7) -> list:
     """The bundled 'hills': 120 x 120 m of rolling terrain inside a wall, with rocks."""
     rng = np.random.default_rng(seed)
     size, n = 120.0, 61
@@ -180,14 +181,14 @@ def hills(seed: int = 7) -> trimesh.Trimesh:
         w, d = rng.uniform(3, 6, 2)
         y = float(np.interp(x, xs, h[int(z / size * (n - 1))]))
         parts.append(("rock", box(x, z, x + w, z + d, y - 1.0, y + 3.0)))
-    return join(parts)
+    return parts
 
 
-def fort(seed: int = 0) -> trimesh.Trimesh:
+def fort(seed: int = 0) -> list:
     """The bundled 'fort': a 100 x 100 m walled yard; in it a 40 x 40 m fort 5 m high
     whose roof is a second floor with a parapet, reached by two ramps; a gate passage
     runs through the fort at ground level under the roof; a bridge crosses a sunken
-    road (2.5 m deep) west of the fort."""
+    road (2.5 m deep, 7 m wide) west of the fort."""
     parts = walled_yard(100, 100)
     # the fort: four corner blocks around a cross-shaped gate passage, a roof slab on top
     fx0, fz0, fx1, fz1, top = 50.0, 30.0, 90.0, 70.0, 5.0
@@ -199,19 +200,24 @@ def fort(seed: int = 0) -> trimesh.Trimesh:
     parts.append(("deck", box(fx0, fz0, fx1, fz1, top - 0.5, top)))
     # parapet on the roof's north and south edges
     parts += [("wall", box(fx0, fz1 - 0.8, fx1, fz1, top, top + 1.2)), ("wall", box(fx0, fz0, fx1, fz0 + 0.8, top, top + 1.2))]
-    # ramps up to the roof along its west side, from the yard
-    parts += [("ramp", ramp(22, 30, 50, 40, 0.0, top, "+x")), ("ramp", ramp(22, 60, 50, 70, 0.0, top, "+x"))]
+    # two wide ramps up to the roof along its west side, from the yard
+    parts += [("ramp", ramp(24, 30, 50, 44, 0.0, top, "+x")), ("ramp", ramp(24, 56, 50, 70, 0.0, top, "+x"))]
     # a sunken road west of the fort, across the whole yard, bridged in the middle
     parts = [p for p in parts if p[0] != "ground"]
-    parts += [("ground", box(0, 0, 8, 100, -0.5, 0)), ("ground", box(16, 0, 100, 100, -0.5, 0)),
-              ("ground", box(8, 0, 16, 100, -3.0, -2.5)),
-              ("deck", box(8, 45, 16, 55, -0.5, 0))]
-    return join(parts)
+    parts += [("ground", box(0, 0, 12, 100, -0.5, 0)), ("ground", box(19, 0, 100, 100, -0.5, 0)),
+              ("ground", box(12, 0, 19, 100, -3.0, -2.5)),
+              ("deck", box(12, 44, 19, 56, -0.5, 0))]
+    return parts
+
+
+def level(name: str, **kw) -> trimesh.Trimesh:
+    """One generated level as a single mesh (parts painted by kind)."""
+    return join(LEVELS[name](**kw))
 
 
 LEVELS = {
     "rolling_terrain": rolling_terrain, "ramps_and_decks": ramps_and_decks, "bridge": bridge,
-    "bumpy_floor": bumpy_floor, "tiny_room": tiny_room, "two_storeys": two_storeys,
+    "bumpy_floor": bumpy_floor, "tiny_room": tiny_room, "two_storeys": two_storeys, "hills": hills, "fort": fort,
 }
 
 
@@ -228,7 +234,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=None)
     a = ap.parse_args(argv)
     for name, fn in LEVELS.items():
-        mesh = fn(a.seed) if a.seed is not None and name != "tiny_room" else fn()
+        mesh = join(fn(seed=a.seed) if a.seed is not None and name != "tiny_room" else fn())
         p = write_obj(mesh, a.out / f"{name}.obj")
         print(f"{p}: {len(mesh.faces)} triangles")
     return 0

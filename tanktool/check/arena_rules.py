@@ -24,6 +24,7 @@ from ..formats.walls_txt import WallList
 from ..geometry.hull import min_width
 from .diagnostics import Diagnostic, diag, fmt_xz
 from .freespace import UNBOUNDED, FreeSpace, analyse
+from .level_rules import block_wall_rules, level_rules
 from .manifest import Manifest, file_rules, safe_file
 from .walls_rules import bare_walls_leaks, check_walls, leak_diagnostics
 from .walls_scan import scan_walls_file
@@ -43,6 +44,7 @@ class VehicleSize:
     line: int = 0
     footprint: np.ndarray | None = None   # (k, 2) convex footprint (x forward, z right), vehicle frame
     width: float = 0.0                    # narrowest extent of the footprint, m
+    height: float = 0.0                   # hull height, m (0: unknown)
 
     def __post_init__(self) -> None:
         if self.footprint is not None and len(self.footprint) >= 3:
@@ -82,28 +84,30 @@ def check_walls_file(path: Path) -> list[Diagnostic]:
 
 # ----------------------------------------------------------------- arena bundles
 def _spawns(man: Manifest, out: list[Diagnostic]) -> tuple[np.ndarray, list[int], np.ndarray]:
-    """The well-formed spawn points (k, 3), their manifest lines and their indices in
-    the manifest's list (messages name spawns by that index)."""
+    """The well-formed spawn points (k, 4) ``[x, z, heading, y]`` (y NaN when the
+    manifest gives only three numbers), their manifest lines and their indices in the
+    manifest's list (messages name spawns by that index)."""
     raw = man.get("", "spawns")
     if raw is None:
         out.append(man.missing("", "spawns", "is missing (a list of [x, z, heading_rad])"))
-        return np.zeros((0, 3)), [], np.zeros(0, np.int64)
+        return np.zeros((0, 4)), [], np.zeros(0, np.int64)
     if not isinstance(raw, list):
         out.append(man.missing("", "spawns", f"must be a list of [x, z, heading_rad], got {raw!r}"))
-        return np.zeros((0, 3)), [], np.zeros(0, np.int64)
+        return np.zeros((0, 4)), [], np.zeros(0, np.int64)
     lines = man.lines.items("", "spawns", len(raw))
     rows, keep, ids = [], [], []
     for i, s in enumerate(raw):
-        ok = (isinstance(s, list) and len(s) == 3
+        ok = (isinstance(s, list) and len(s) in (3, 4)
               and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in s))
         if not ok:
             out.append(diag("B102", str(man.path), lines[i],
-                            f"spawn {i} must be [x, z, heading_rad] with 3 finite numbers, got {s!r}"))
+                            f"spawn {i} must be [x, z, heading_rad] or [x, z, heading_rad, y] with finite numbers, "
+                            f"got {s!r}"))
             continue
-        rows.append([float(v) for v in s])
+        rows.append([float(v) for v in s] + ([math.nan] if len(s) == 3 else []))
         keep.append(lines[i])
         ids.append(i)
-    return np.array(rows, dtype=np.float64).reshape(-1, 3), keep, np.array(ids, dtype=np.int64)
+    return np.array(rows, dtype=np.float64).reshape(-1, 4), keep, np.array(ids, dtype=np.int64)
 
 
 def check_arena(bundle: Path, vehicles: list[VehicleSize], model_rules: bool = True) -> tuple[list[Diagnostic], ArenaInfo]:
@@ -118,28 +122,38 @@ def check_arena(bundle: Path, vehicles: list[VehicleSize], model_rules: bool = T
     info.name = name if isinstance(name, str) and name else bundle.name
     out += file_rules(man, bundle, ("walls.txt",))
 
-    spawns, spawn_lines, info.ids = _spawns(man, out)
+    spawns4, spawn_lines, info.ids = _spawns(man, out)
+    spawns, spawn_y = spawns4[:, :3], spawns4[:, 3]
     info.spawns = spawns
     wname = man.string("walls", "file", out, default="walls.txt")
     wpath = safe_file(bundle, wname) if wname else None
+    layered = False
     if wpath is None or not wpath.is_file():
         if wname and not any(d.code == "B202" and repr(wname) in d.message for d in out):
             out.append(diag("B202", str(man.path), man.lines.key("walls", "file"), f"walls file {wname!r} is missing"))
     else:
         walls, syntax = scan_walls_file(wpath)
-        fs = analyse(walls)
-        info.fs = fs
-        apply_spawn_vote(fs, spawns)
-        out += syntax + check_walls(walls, fs, str(wpath))
-        out += spawn_rules(fs, spawns, spawn_lines, man, str(wpath), vehicles, info)
+        layered = walls.layered
+        if layered:
+            # walls in blocks per level and region: they do not close up on their own (a
+            # ramp opens onto the deck above); the grid says where tanks go (level_rules)
+            out += syntax + block_wall_rules(walls, str(wpath), 1e-6 * max(1.0, float(np.abs(walls.bounds).max())))
+        else:
+            fs = analyse(walls)
+            info.fs = fs
+            apply_spawn_vote(fs, spawns)
+            out += syntax + check_walls(walls, fs, str(wpath))
+            out += spawn_rules(fs, spawns, spawn_lines, man, str(wpath), vehicles, info)
     if len(spawns) < MIN_SPAWNS and man.get("", "spawns") is not None:
         out.append(diag("A305", str(man.path), man.lines.key("", "spawns"),
                         f"{len(spawns)} spawn points; a full match needs {MIN_SPAWNS}"))
     if model_rules:
-        region = None
-        if info.fs is not None and info.good.any():
-            region = info.fs.region(np.unique(info.faces[info.good]))
-        out += floor_rules(man, bundle, region)
+        out += level_rules(man, bundle, spawns, spawn_y, spawn_lines, info.ids, vehicles, layered)
+        if man.get("walkable", "headroom") is None:  # a flat 2002 arena: its floor must be flat
+            region = None
+            if info.fs is not None and info.good.any():
+                region = info.fs.region(np.unique(info.faces[info.good]))
+            out += floor_rules(man, bundle, region)
     return out, info
 
 

@@ -47,6 +47,13 @@ RULES: dict[str, Rule] = {r.code: r for r in [
     Rule("A306", WARNING, "a passage is narrower than the largest bundled vehicle", "widen the passage or accept that big tanks cannot use it"),
     Rule("A307", WARNING, "free space that cannot be reached from the spawn points (an island)", "connect it, fill it in, or flip its walls if it is meant to be solid"),
     Rule("A308", WARNING, "the floor is not flat", "flatten the model's floor: vehicles drive on the plane floor_y"),
+    Rule("A309", ERROR, "the navigation grid has no node a tank can use", "make room for the largest vehicle, or rebuild the grid (build-navgrid) with its clearance"),
+    Rule("A310", WARNING, "a level of the navigation grid cannot be reached from the spawn points", "join it with a ramp or steps within the climb, or remove it"),
+    Rule("A311", WARNING, "a spawn point stands on a small island of the navigation grid", "move the spawn point onto the main part of the arena"),
+    Rule("A312", ERROR, "the walkable surface was found for less headroom than a vehicle is tall", "re-import the arena with --headroom at least the tallest vehicle's height"),
+    Rule("A313", WARNING, "the ground under a spawn point is uneven", "move the spawn point to level ground"),
+    Rule("A314", ERROR, "a spawn point is on no node of the navigation grid", "move the spawn point onto the walkable surface, clear of the walls"),
+    Rule("A315", ERROR, "a spawn point cannot be reached from the others over the navigation grid", "join the parts with a ramp, or move the spawn point"),
     # bundle files
     Rule("B101", ERROR, "the bundle's manifest (arena.toml / vehicle.toml) cannot be read", "fix the TOML syntax, or rebuild the bundle"),
     Rule("B102", ERROR, "a manifest key is missing or has the wrong type", "add the key with a value of the right type, or rebuild the bundle"),

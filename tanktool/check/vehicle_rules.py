@@ -358,7 +358,7 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
     if hull is not None:
         size = VehicleSize(name, float(np.max(np.hypot(hull[:, 0], hull[:, 2]))), mpath,
                            man.lines.key("", "footprint_radius") or man.lines.key("hull", "file"),
-                           footprint=convex_hull_2d(hull[:, [0, 2]]))
+                           footprint=convex_hull_2d(hull[:, [0, 2]]), height=float(np.ptp(hull[:, 1])))
     else:
         r = man.get("", "footprint_radius")
         if isinstance(r, (int, float)) and not isinstance(r, bool) and math.isfinite(r) and r > 0:

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..formats.walls_txt import AUX_MARKER, WallList, _is_enclosing_rectangle
+from ..errors import FormatError
+from ..formats.walls_txt import _MARKER_RE, AUX_MARKER, WallList, _is_enclosing_rectangle, _parse_marker
 from .diagnostics import Diagnostic, diag
 
 MAX_COORD = 1e6  # m
@@ -25,10 +26,21 @@ def scan_walls_text(text: str, path: str) -> tuple[WallList, list[Diagnostic]]:
     segs: list[list[float]] = []
     dirs: list[int] = []
     lines: list[int] = []
+    levels: list[int] = []
+    region_of: list[int] = []
+    regions: dict = {}
+    current = (0, 0)
     aux_start: int | None = None
     marker_line = 0
     for lineno, raw in enumerate(text.splitlines(), start=1):
         stripped = raw.strip()
+        if _MARKER_RE.match(stripped) and aux_start is None:
+            try:
+                current = _parse_marker(stripped, f"{path}:{lineno}", regions)
+            except FormatError as e:
+                out.append(diag("A101", path, lineno, str(e).split(": ", 1)[-1].split(": ", 1)[-1],
+                                "write '# level L region R y LO HI' (region numbers unique in the file)"))
+            continue
         if stripped.lower().startswith(AUX_MARKER):
             if aux_start is not None:
                 out.append(diag("A101", path, lineno, f"a second '{AUX_MARKER}' marker (the first is on line {marker_line})",
@@ -66,27 +78,35 @@ def scan_walls_text(text: str, path: str) -> tuple[WallList, list[Diagnostic]]:
         segs.append(vals)
         dirs.append(int(d))
         lines.append(lineno)
+        levels.append(current[0])
+        region_of.append(current[1])
     seg = np.array(segs, dtype=np.float64).reshape(-1, 2, 2)
     direction = np.array(dirs, dtype=np.int8)
     line_arr = np.array(lines, dtype=np.int64)
+    lev = np.array(levels, dtype=np.int64)
+    reg = np.array(region_of, dtype=np.int64)
+
+    def wl(sl: slice, aux=None) -> WallList:
+        return WallList(seg[sl], direction[sl], aux, line_arr[sl], path, lev[sl], reg[sl], regions)
+
     if aux_start is not None:
         n_aux = len(seg) - aux_start
         if n_aux != 4:
             out.append(diag("A104", path, marker_line,
                             f"expected 4 auxiliary walls after '{AUX_MARKER}', got {n_aux}"))
             # keep every wall as a wall: the checks below still see the arena's shape
-            return WallList(seg, direction, None, line_arr, path), out
+            return wl(slice(None)), out
         aux = seg[aux_start:]
         if not _is_enclosing_rectangle(aux, seg[:aux_start]):
             out.append(diag("A105", path, int(line_arr[aux_start]),
                             "the auxiliary walls must form an axis-aligned rectangle enclosing every wall"))
-        return WallList(seg[:aux_start], direction[:aux_start], aux, line_arr[:aux_start], path), out
+        return wl(slice(None, aux_start), aux), out
     if len(seg) >= 4 and _is_enclosing_rectangle(seg[-4:], seg[:-4]):
-        return WallList(seg[:-4], direction[:-4], seg[-4:], line_arr[:-4], path), out
+        return wl(slice(None, -4), seg[-4:]), out
     last = int(line_arr[-1]) if len(line_arr) else 0
     out.append(diag("A104", path, last,
                     f"no '{AUX_MARKER}' marker, and the last 4 walls are not a rectangle enclosing the others"))
-    return WallList(seg, direction, None, line_arr, path), out
+    return wl(slice(None)), out
 
 
 def scan_walls_file(path: str | Path) -> tuple[WallList, list[Diagnostic]]:

@@ -242,7 +242,9 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
         if p is not None and not p.parent.is_dir():
             raise ArenaError(f"{p}: folder {p.parent} does not exist")
 
-    loose = open_ends(target.walls)
+    # walls in blocks per level open onto each other (a ramp's top onto the deck): their
+    # ends need not close up, the surface says where the free space is
+    loose = open_ends(target.walls) if not target.walls.layered else []
     if len(loose) and not is_quiet():
         x, z = loose[0]
         click.echo(

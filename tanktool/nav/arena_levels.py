@@ -117,6 +117,27 @@ def _components(grid: NavGrid) -> tuple[np.ndarray, int]:
     return labels, int(k)
 
 
+#: spawn points prefer ground no steeper than this (degrees), and no rougher than half
+#: the climb around the plane under the tank's footprint
+SPAWN_SLOPE = 10.0
+
+
+def ground_under(height: np.ndarray, node: tuple[int, int, int], cell: float, radius: float) -> tuple[float, float]:
+    """(slope in degrees, largest step off that slope in metres) of the ground within
+    ``radius`` of a node, on its level: the least-squares plane through the heights."""
+    lv, i, j = node
+    r = max(1, int(math.ceil(radius / cell)))
+    win = height[lv, max(0, i - r):i + r + 1, max(0, j - r):j + r + 1]
+    ii, jj = np.nonzero(np.isfinite(win))
+    if len(ii) < 3:
+        return 0.0, 0.0
+    y = win[ii, jj]
+    A = np.column_stack([jj * cell, ii * cell, np.ones(len(ii))])
+    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
+    slope = math.degrees(math.atan(math.hypot(coef[0], coef[1])))
+    return slope, float(np.abs(A @ coef - y).max())
+
+
 def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarray,
                   count: int = SPAWN_COUNT) -> np.ndarray:
     """Spawn points ``[x, z, heading, y]`` where the largest tank fits (see the module
@@ -132,7 +153,7 @@ def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarra
     floor_c = fleet.radius + SPAWN_MARGIN
     chosen = None
     for c in sorted({max(SPAWN_CLEARANCE, floor_c), floor_c}, reverse=True):
-        pts, ys = [], []
+        pts, ys, level = [], [], []
         for r in lw.regions:
             cand = spawn_candidates(r.free, c)
             if len(cand) == 0:
@@ -142,8 +163,19 @@ def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarra
             keep = lab == best
             pts.append(cand[keep])
             ys.append(height[r.level, node[keep, 0], node[keep, 1]])
+            level.append(np.full(int(keep.sum()), r.level))
         pts = np.concatenate(pts) if pts else np.zeros((0, 2))
         ys = np.concatenate(ys) if ys else np.zeros(0)
+        level = np.concatenate(level) if level else np.zeros(0, dtype=np.int64)
+        if len(pts) and not np.isnan(height[np.isfinite(height)]).all() and np.nanmax(height) - np.nanmin(height) > 0.2:
+            # level ground first: a tank spawned on a slope rolls
+            node = grid.nodes_of(pts)
+            ground = [ground_under(height, (int(lv), int(a), int(b)), grid.cell, fleet.radius)
+                      for lv, (a, b) in zip(level, node)]
+            flat = np.array([slope <= SPAWN_SLOPE and rough <= 0.5 * surface_climb(grid) for slope, rough in ground],
+                            dtype=bool)
+            if flat.sum() >= min(count, len(pts)) or flat.sum() >= 2:
+                pts, ys = pts[flat], ys[flat]
         chosen = (pts, ys)
         if len(pts) >= count:
             break
@@ -156,6 +188,13 @@ def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarra
     idx = spread(pts, count, fleet.length, start)
     p = pts[idx]
     return np.column_stack([p, facing_centre(p, bounds), ys[idx]])
+
+
+def surface_climb(grid: NavGrid) -> float:
+    """The climb the grid was built with (recorded on it by tank_grid), else the default."""
+    from .walkable import CLIMB
+
+    return float(getattr(grid, "climb", CLIMB))
 
 
 def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParams, fleet: Fleet,
@@ -186,6 +225,7 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
     step("walls")
     t0 = time.perf_counter()
     grid = tank_grid(surface, lw, fleet.radius)
+    grid.climb = params.climb
     t["grid"] = time.perf_counter() - t0
     step("grid")
     if not grid.valid.any():

@@ -43,6 +43,8 @@ MARGIN = 2.5
 #: ... but not over cells of the region this much higher than the floor (m): terrain
 #: and ramps rising from it, which the cut would cross
 ABOVE = 0.3
+#: a thin wall of a higher cut within this of one already found is the same wall (m)
+THIN_MERGE = 0.15
 #: flat floors smaller than this (m^2) keep the cells' outline (stair treads)
 MIN_EXACT_AREA = 4.0
 #: gap between the walls' extent and the auxiliary rectangle (m)
@@ -125,7 +127,7 @@ class ExactCuts:
         self.cache: dict[float, tuple] = {}
 
     def at(self, h: float, box: tuple[float, float, float, float], base: float | None = None):
-        """(free polygon, thin-wall chains) of a floor at height ``h``, exact inside
+        """(free polygon, thin-wall chains per cut, lowest cut first) of a floor at height ``h``, exact inside
         ``box`` (xmin, zmin, xmax, zmax): only the floor faces overlapping it and the
         cut loops reaching into it are used (a multi-storey model has many floors).
 
@@ -160,7 +162,7 @@ class ExactCuts:
                 nodes = nodes.reshape(-1, 2)
             solid, ch, _ = cut.cross_sections(seg, nrm, nodes, tol, floor_poly)
             solids.append(solid)
-            chains += ch
+            chains.append(ch)
         solid = shapely.union_all(solids)
         free = shapely.set_precision(shapely.difference(floor_poly, solid), tol)
         self.cache[key] = (free, chains)
@@ -289,9 +291,10 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
                     E, chains = cuts.at(float(flat_h[c]), box, base)
                     exact_parts.append(shapely.intersection(E, M))
                     removed.append(shapely.difference(M, E))
-                    if chains:
-                        near = shapely.intersects(np.array(chains, dtype=object), shapely.box(*box))
-                        chains_in.append(([ch for ch, k in zip(chains, near) if k], exact_parts[-1]))
+                    for step in chains:
+                        if step:
+                            near = shapely.intersects(np.array(step, dtype=object), shapely.box(*box))
+                            chains_in.append(([ch for ch, k in zip(step, near) if k], exact_parts[-1]))
                     used_h.append((float(flat_h[c]), float(mask.sum() * cell * cell)))
             R = shapely.difference(V, shapely.union_all(removed)) if removed else V
             if exact_parts:
@@ -309,10 +312,15 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
                 portal_len += float(np.hypot(*(pieces[portal, 1] - pieces[portal, 0]).T).sum())
                 outline = _rejoin(pieces, owner, ~portal)
             thin = []
-            for chains, free in chains_in:
+            taken = None  # thin walls so far: a higher cut through the same slanted face
+            for chains, free in chains_in:  # finds them again a few cm aside
+                if taken is not None:
+                    free = shapely.difference(free, taken)
                 t = cut.thin_walls(chains, free, tolerance)
                 if len(t):
                     thin.append(t)
+                    near = shapely.buffer(shapely.multilinestrings(list(t)), THIN_MERGE, cap_style="flat")
+                    taken = near if taken is None else shapely.union(taken, near)
             thin = _unique_segments(np.concatenate(thin), tolerance) if thin else np.zeros((0, 2, 2))
             segs = np.concatenate([outline, thin, thin[:, ::-1]]) if len(thin) else outline
             thin_total += 2 * len(thin)

@@ -231,9 +231,10 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
         cur = lv[idx]
         votes = np.stack([(nl == nl[:, d:d + 1]).sum(axis=1) for d in range(4)], axis=1)
         votes = np.where(nl >= 0, votes, -1)
-        best = np.take_along_axis(nl, votes.argmax(axis=1)[:, None], axis=1)[:, 0]
-        mine = (nl == cur[:, None]).sum(axis=1)
         top = votes.max(axis=1)
+        # of the levels with the most votes, the highest
+        best = np.where(votes == top[:, None], nl, -1).max(axis=1)
+        mine = (nl == cur[:, None]).sum(axis=1)
         # more neighbours there, or as many and it is the higher level (a tie at the
         # corner of a deck's patch over a pillar resolves upwards)
         move = (best >= 0) & (best != cur) & ((top > mine) | ((top == mine) & (best > cur)))

@@ -92,7 +92,8 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
 
     path = _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
     bundle = load_arena(path)
-    spawns = np.asarray(bundle.spawns, dtype=np.float64).reshape(-1, 3)
+    spawns = np.asarray(bundle.spawns, dtype=np.float64)
+    spawns = spawns.reshape(len(spawns), -1)[:, :3] if spawns.size else np.zeros((0, 3))
     return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path), np.asarray(bundle.bounds, float))
 
 
