@@ -158,6 +158,9 @@ def _wants_verbose(args: list[str]) -> bool:
 
 def main(argv: list[str] | None = None) -> None:
     """Console-script entry point: click's own handling plus a short line for bugs."""
+    from ..memory import keep_freed_memory
+
+    keep_freed_memory()  # numpy's large temporaries reused, not faulted in again (tanktool/memory.py)
     args = sys.argv[1:] if argv is None else argv
     try:
         cli.main(args=args, prog_name="tanktool")

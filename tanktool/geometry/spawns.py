@@ -49,19 +49,34 @@ def spawn_candidates(free, clearance: float) -> np.ndarray:
     return pts
 
 
-def spread(pts: np.ndarray, count: int, min_separation: float = 0.0, start: np.ndarray | None = None) -> np.ndarray:
+def spread(pts: np.ndarray, count: int, min_separation: float = 0.0, start: np.ndarray | None = None,
+           accept=None) -> np.ndarray:
     """Indices of up to ``count`` candidates by farthest-point sampling: the first is the
     candidate nearest ``start`` (default their centroid), each next the one farthest
-    from all chosen so far, while that is at least ``min_separation`` away."""
+    from all chosen so far, while that is at least ``min_separation`` away.
+    ``accept(i)`` may refuse a candidate when it comes up (it is then skipped)."""
     if len(pts) == 0:
         return np.zeros(0, dtype=np.int64)
     centre = pts.mean(axis=0) if start is None else np.asarray(start, dtype=np.float64)
-    chosen = [int(np.argmin(((pts - centre) ** 2).sum(axis=1)))]
-    dist = ((pts - pts[chosen[0]]) ** 2).sum(axis=1)
-    for _ in range(count - 1):
-        k = int(np.argmax(dist))
-        if dist[k] < min_separation * min_separation:
+    alive = np.ones(len(pts), dtype=bool)
+    order = np.argsort(((pts - centre) ** 2).sum(axis=1), kind="stable")
+    chosen: list[int] = []
+    for k in order:  # the first: the acceptable candidate nearest the start
+        if accept is None or accept(int(k)):
+            chosen.append(int(k))
             break
+        alive[k] = False
+    if not chosen:
+        return np.zeros(0, dtype=np.int64)
+    dist = ((pts - pts[chosen[0]]) ** 2).sum(axis=1)
+    while len(chosen) < count:
+        d = np.where(alive, dist, -1.0)
+        k = int(np.argmax(d))
+        if d[k] < min_separation * min_separation or d[k] < 0:
+            break
+        if accept is not None and not accept(k):
+            alive[k] = False
+            continue
         chosen.append(k)
         dist = np.minimum(dist, ((pts - pts[k]) ** 2).sum(axis=1))
     return np.array(chosen, dtype=np.int64)

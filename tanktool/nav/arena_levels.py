@@ -167,25 +167,26 @@ def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarra
         pts = np.concatenate(pts) if pts else np.zeros((0, 2))
         ys = np.concatenate(ys) if ys else np.zeros(0)
         level = np.concatenate(level) if level else np.zeros(0, dtype=np.int64)
-        if len(pts) and not np.isnan(height[np.isfinite(height)]).all() and np.nanmax(height) - np.nanmin(height) > 0.2:
-            # level ground first: a tank spawned on a slope rolls
-            node = grid.nodes_of(pts)
-            ground = [ground_under(height, (int(lv), int(a), int(b)), grid.cell, fleet.radius)
-                      for lv, (a, b) in zip(level, node)]
-            flat = np.array([slope <= SPAWN_SLOPE and rough <= 0.5 * surface_climb(grid) for slope, rough in ground],
-                            dtype=bool)
-            if flat.sum() >= min(count, len(pts)) or flat.sum() >= 2:
-                pts, ys = pts[flat], ys[flat]
-        chosen = (pts, ys)
+        chosen = (pts, ys, level)
         if len(pts) >= count:
             break
-    pts, ys = chosen
+    pts, ys, level = chosen
     if len(pts) == 0:
         raise ArenaError(f"no place where the largest bundled tank fits: {fleet.radius_of} (footprint radius "
                          f"{fleet.radius:.2f} m) needs {floor_c:.2f} m from every wall for a spawn point")
     region = shapely.union_all([r.free for r in lw.regions])
     start = np.asarray(shapely.get_coordinates(shapely.centroid(region))[0])
-    idx = spread(pts, count, fleet.length, start)
+    node = grid.nodes_of(pts)
+    climb = surface_climb(grid)
+
+    def level_ground(k: int) -> bool:  # a tank spawned on a slope rolls off
+        slope, rough = ground_under(height, (int(level[k]), int(node[k, 0]), int(node[k, 1])), grid.cell,
+                                    fleet.radius)
+        return slope <= SPAWN_SLOPE and rough <= 0.5 * climb
+
+    idx = spread(pts, count, fleet.length, start, accept=level_ground)
+    if len(idx) < min(count, 2):  # no level ground enough: the best there is
+        idx = spread(pts, count, fleet.length, start)
     p = pts[idx]
     return np.column_stack([p, facing_centre(p, bounds), ys[idx]])
 

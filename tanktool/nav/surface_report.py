@@ -17,6 +17,8 @@ import numpy as np
 
 from .walkable import Surface, WalkableParams
 
+#: areas under this (m^2) are not worth a line of the report
+MIN_REPORTED = 1.0
 #: faces steeper than this are walls, not slopes (n_y below cos 80 degrees)
 WALL_NY = math.cos(math.radians(80.0))
 
@@ -70,22 +72,22 @@ def left_out(surface: Surface, vertices: np.ndarray, faces: np.ndarray, params: 
         return np.stack([hf.origin[0] + (j + 0.5) * hf.cs, hf.origin[2] + (i + 0.5) * hf.cs], axis=1)
 
     sel, area = steep_faces(vertices, faces, params.max_slope)
-    if len(sel) and area.sum() > 0.5 * cell2:
+    if len(sel) and area.sum() >= MIN_REPORTED:
         c = vertices[faces[sel]].mean(axis=1)[:, [0, 2]]
         out.append(LeftOut(f"too steep (over {params.max_slope:g} deg)", float(area.sum()), len(sel), _spot(c, area)))
     low = low_headroom(surface, vertices, faces)
-    if low.any():
+    if low.sum() * cell2 >= MIN_REPORTED:
         out.append(LeftOut(f"under too little headroom (below {params.headroom:g} m)", float(low.sum() * cell2),
                            int(low.sum()), _spot(centres(hf.col[low]))))
     lost = unreachable(surface, radius, vertices, faces)
-    if lost.any():
+    if lost.sum() * cell2 >= MIN_REPORTED:
         labels, sizes = np.unique(surface.region[lost], return_counts=True)
         big = labels[int(np.argmax(sizes))]
         m = surface.region == big
         out.append(LeftOut("unreachable", float(lost.sum() * cell2), len(labels), _spot(centres(surface.col[m])),
                            float(np.median(surface.y[m]))))
     small = too_small(surface, radius)
-    if small.any():
+    if small.sum() * cell2 >= MIN_REPORTED:
         out.append(LeftOut(f"too small for a tank (footprint radius {radius:.2f} m)", float(small.sum() * cell2),
                            int(small.sum()), _spot(centres(surface.col[small]))))
     return out

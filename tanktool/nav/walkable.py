@@ -224,33 +224,44 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
     if link is None or level.max() == 0:
         return level
     lv = np.append(level, -1)
+    pos = np.full(len(level) + 1, -1, dtype=np.int64)  # span -> its row in idx
+    pos[idx] = np.arange(len(idx))
     nb = np.where(link[idx] >= 0, link[idx], len(level))
     col_rank = np.searchsorted(np.unique(c), c)
+    active = (lv[nb] != lv[idx][:, None]).any(axis=1)  # only spans at a level's border can move
     for _ in range(rounds):
-        nl = lv[nb]  # (k, 4) levels of the linked neighbours
-        cur = lv[idx]
+        a = np.flatnonzero(active)
+        if len(a) == 0:
+            break
+        nl = lv[nb[a]]  # (k, 4) levels of the linked neighbours
+        cur = lv[idx[a]]
         votes = np.stack([(nl == nl[:, d:d + 1]).sum(axis=1) for d in range(4)], axis=1)
         votes = np.where(nl >= 0, votes, -1)
         top = votes.max(axis=1)
         # of the levels with the most votes, the highest
         best = np.where(votes == top[:, None], nl, -1).max(axis=1)
         mine = (nl == cur[:, None]).sum(axis=1)
-        # more neighbours there, or as many and it is the higher level (a tie at the
-        # corner of a deck's patch over a pillar resolves upwards)
-        move = (best >= 0) & (best != cur) & ((top > mine) | ((top == mine) & (best > cur)))
+        # more neighbours there, or as many (at least two) and it is the higher level: a
+        # tie at the corner of a deck's patch over a pillar resolves upwards, but a
+        # corridor one cell wide (one neighbour each way) stays where it is
+        move = (best >= 0) & (best != cur) & ((top > mine) | ((top == mine) & (top >= 2) & (best > cur)))
         if not move.any():
             break
         # the new level must be free in the column: no other kept span there holds it,
         # and of two spans of one column moving to the same level in a round, neither does
-        cand = np.flatnonzero(move)
-        key = col_rank * 256 + np.where(move, best, cur)
-        taken = np.zeros(len(idx), dtype=bool)
+        cand = a[move]
+        key = col_rank * 256 + lv[idx]
+        key[cand] = col_rank[cand] * 256 + best[move]
         uniq, counts = np.unique(key, return_counts=True)
-        taken[cand] = counts[np.searchsorted(uniq, key[cand])] > 1
-        ok = cand[~taken[cand]]
+        taken = counts[np.searchsorted(uniq, key[cand])] > 1
+        ok = cand[~taken]
         if len(ok) == 0:
             break
-        lv[idx[ok]] = best[ok]
+        lv[idx[ok]] = best[move][~taken]
+        active[:] = False
+        near = pos[nb[ok]].ravel()
+        active[near[near >= 0]] = True
+        active[ok] = True
     level = lv[:-1]
     # levels numbered from 0 without gaps, in order of height
     used = np.unique(level[idx])
