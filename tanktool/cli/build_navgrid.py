@@ -90,7 +90,10 @@ def _layered(target: Target, params, clearance: float, bounds, shape):
 
     mesh = load_model(target.model, up="y")
     origin = np.asarray(bounds, dtype=np.float64)[0]
-    seeds = None if target.spawns is None else np.asarray(target.spawns)[:, :2]
+    seeds = None
+    if target.spawns is not None:  # [x, z] and the spawn's height when the manifest has it
+        sp = np.asarray(target.spawns, dtype=np.float64)
+        seeds = sp[:, [0, 1, 3]] if sp.shape[1] >= 4 else sp[:, :2]
     surface = walkable_surface(mesh.vertices, mesh.faces, params, clearance, origin_xz=origin, shape=shape,
                                seeds=seeds)
     if not surface.main.any():

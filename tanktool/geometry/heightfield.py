@@ -270,32 +270,34 @@ def _rows(X: list, Z: list, Y: list, nz: int, nx: int) -> _Rows:
         inv_ac = np.where(zc > za, 1.0 / (zc - za), 0.0)
         inv_ab = np.where(zb > za, 1.0 / (zb - za), 0.0)
         inv_bc = np.where(zc > zb, 1.0 / (zc - zb), 0.0)
-    r0, r1 = _line_ranges(za, zc, nz)
+    # the triangle's own rows [r0t, r1t], and the part of them on the grid [r0, r1]
+    r0t = np.floor(za)
+    r1t = np.where(zc > za, np.ceil(zc) - 1, r0t)
+    r0 = np.maximum(r0t, 0)
+    r1 = np.minimum(r1t, nz - 1)
     nrow = np.maximum(r1 - r0 + 1, 0).astype(np.int64)
-    # sections at the lines r0 + 1 .. r1 (inside the triangle's z range)
-    nline = np.maximum(nrow - 1, 0)
+    # sections at the lines r0 .. r1 + 1 of each triangle (those past its ends unused)
+    nline = np.where(nrow > 0, nrow + 1, 0)
     tl = np.repeat(np.arange(len(za)), nline)
-    L = np.repeat(r0 + 1, nline) + _ramp(nline)
+    L = np.repeat(r0, nline) + _ramp(nline)
     t = (L - za[tl]) * inv_ac[tl]
     lx = xa[tl] + t * (xc - xa)[tl]
     ly = ya[tl] + t * (yc - ya)[tl]
     lower = L <= zb[tl]
-    base = np.where(lower, 0, 1)  # the short side's edge: a-b below b, b-c above
     zs = np.where(lower, za[tl], zb[tl])
     inv = np.where(lower, inv_ab[tl], inv_bc[tl])
     t = (L - zs) * inv
     sx = np.where(lower, xa[tl], xb[tl]) + t * np.where(lower, (xb - xa)[tl], (xc - xb)[tl])
     sy = np.where(lower, ya[tl], yb[tl]) + t * np.where(lower, (yb - ya)[tl], (yc - yb)[tl])
-    del base
-    # pairs: row r's low line is section (r - r0 - 1) of its triangle, its high line the next
+    # pairs: row r's low line is section (r - r0) of its triangle, its high line the next;
+    # the triangle's first row has vertex a for its low line, its last row vertex c
     tri = np.repeat(np.arange(len(za)), nrow)
     k = _ramp(nrow)
     row = np.repeat(r0.astype(np.int64), nrow) + k
-    loff = np.repeat(np.cumsum(nline) - nline, nrow) + k  # index of the high line's section
-    first = k == 0
-    last = k == np.repeat(nrow - 1, nrow)
-    lo_i = np.maximum(loff - 1, 0)
-    hi_i = np.minimum(loff, max(len(L) - 1, 0))
+    lo_i = np.repeat(np.cumsum(nline) - nline, nrow) + k
+    hi_i = lo_i + 1
+    first = row == r0t[tri]
+    last = row == r1t[tri]
     if len(L) == 0:
         lx = ly = sx = sy = np.zeros(1)
         lo_i = hi_i = np.zeros(len(tri), dtype=np.int64)
@@ -492,6 +494,10 @@ def _merge(col, smin, smax, walk, flat, thr):
     of its top.  One sort of packed int64 keys (column, bottom, top, flags): a
     value sort is several times faster than an argsort.
     """
+    if len(col) == 0:
+        e = np.zeros(0, dtype=np.int64)
+        b = np.zeros(0, dtype=bool)
+        return e, e, e, b, b, b
     key = (col.astype(np.int64) << 34) | (smin << 18) | (smax << 2) | (walk.astype(np.int64) << 1) | flat
     key.sort()
     col = key >> 34

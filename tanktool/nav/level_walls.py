@@ -123,6 +123,11 @@ class ExactCuts:
         ny = n[:, 1] / np.maximum(np.linalg.norm(n, axis=1), 1e-300)
         keep = ny >= min_ny
         self.up = up[keep]
+        # the faces a cut may meet: not the walkable slopes (a cut through a hillside or
+        # a ramp is a contour line, not a wall: the tank drives up it)
+        walk = np.zeros(len(faces), dtype=bool)
+        walk[self.up] = True
+        self.cut_faces = faces[~walk]
         self.low = tri[keep, :, 1].min(axis=1)
         self.cache: dict[float, tuple] = {}
 
@@ -150,7 +155,7 @@ class ExactCuts:
         solids, chains = [], []
         for k, dh in enumerate(self.steps):
             y = cut._plane_clear_of_vertices(v, (base if k == 0 else h) + dh, self.merge)
-            seg, nrm, nodes = cut.slice_mesh(v, f, y, self.merge)
+            seg, nrm, nodes = cut.slice_mesh(v, self.cut_faces, y, self.merge)
             if len(seg):
                 # whole loops only: the components of the cut with a segment in the box
                 comp = cut._components(nodes)

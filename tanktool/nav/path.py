@@ -212,3 +212,97 @@ def find_path(
     pts = grid.centres(np.array(kept))
     return np.concatenate([np.asarray(start, dtype=np.float64)[None], pts[1:-1], np.asarray(goal, dtype=np.float64)[None]]) \
         if len(pts) >= 2 else np.array([start, goal], dtype=np.float64)
+
+
+Node3 = tuple[int, int, int]
+
+
+def layered_moves(grid: NavGrid) -> tuple[np.ndarray, list[tuple[int, int, float]]]:
+    """Move table of a layered grid: for each node (flat index over (L, nz, nx)) the
+    target of each of the 8 moves (-1: not allowed), and the moves' (di, dj, cost).
+
+    A straight move follows the node's link; a diagonal one needs both of its two
+    straight paths (d then e, e then d) to exist and to end on the same node (no corner
+    cutting, and no cutting between levels)."""
+    from .navgrid import STEPS
+
+    valid = grid.layered("valid")
+    link = grid.links().astype(np.int64)
+    L, nz, nx = valid.shape
+    n = valid.size
+    flat = np.arange(n).reshape(L, nz, nx)
+    steps = list(STEPS.values())  # +x, +z, -x, -z
+    target = np.full((n, 8), -1, dtype=np.int64)
+    li, ii, jj = np.nonzero(valid)
+    src = flat[li, ii, jj]
+    straight = []
+    for d, (di, dj) in enumerate(steps):
+        t = link[li, ii, jj, d]
+        a, b = ii + di, jj + dj
+        ok = (t >= 0) & (a >= 0) & (a < nz) & (b >= 0) & (b < nx)
+        ok[ok] = valid[t[ok], a[ok], b[ok]]
+        tgt = np.full(len(src), -1, dtype=np.int64)
+        tgt[ok] = flat[t[ok], a[ok], b[ok]]
+        target[src, d] = tgt
+        straight.append(tgt)
+    moves = [(di, dj, 1.0) for di, dj in steps]
+    for k, (d, e) in enumerate(((0, 1), (1, 2), (2, 3), (3, 0))):
+        first, second = target[:, d], target[:, e]
+        via_d = np.where(first >= 0, target[np.maximum(first, 0), e], -1)
+        via_e = np.where(second >= 0, target[np.maximum(second, 0), d], -1)
+        target[:, 4 + k] = np.where((via_d >= 0) & (via_d == via_e), via_d, -1)
+        moves.append((steps[d][0] + steps[e][0], steps[d][1] + steps[e][1], _SQRT2))
+    return target, moves
+
+
+def astar_layered(grid: NavGrid, start: Node3, goal: Node3) -> list[Node3]:
+    """Shortest path of valid nodes ``(level, i, j)`` across levels (ramps, steps,
+    decks), 8-connected along the grid's links; ``[]`` when there is none.  The octile
+    distance over (i, j) is the heuristic (a change of level costs nothing extra), so
+    the path is optimal."""
+    valid = grid.layered("valid")
+    L, nz, nx = valid.shape
+    for n in (start, goal):
+        if not (0 <= n[0] < L and 0 <= n[1] < nz and 0 <= n[2] < nx):
+            raise ValueError(f"node {n} is outside the {L} x {nz} x {nx} grid")
+    if not (valid[start] and valid[goal]):
+        return []
+    target, moves = layered_moves(grid)
+    cost = [m[2] for m in moves]
+    per = nz * nx
+    s = start[0] * per + start[1] * nx + start[2]
+    g = goal[0] * per + goal[1] * nx + goal[2]
+    gi, gj = goal[1], goal[2]
+    k2 = _SQRT2 - 2.0
+    table = target.tolist()
+
+    def h(m: int) -> float:
+        r = m % per
+        di = abs(r // nx - gi)
+        dj = abs(r % nx - gj)
+        return di + dj + k2 * (di if di < dj else dj)
+
+    best = {s: 0.0}
+    came: dict[int, int] = {}
+    closed: set[int] = set()
+    heap = [(h(s), 0.0, s)]
+    while heap:
+        _, gc, m = heapq.heappop(heap)
+        if m == g:
+            out = [m]
+            while m in came:
+                m = came[m]
+                out.append(m)
+            return [(v // per, (v % per) // nx, v % nx) for v in reversed(out)]
+        if m in closed:
+            continue
+        closed.add(m)
+        for k, t in enumerate(table[m]):
+            if t < 0 or t in closed:
+                continue
+            ng = gc + cost[k]
+            if ng < best.get(t, math.inf):
+                best[t] = ng
+                came[t] = m
+                heapq.heappush(heap, (ng + h(t), ng, t))
+    return []

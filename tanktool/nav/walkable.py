@@ -326,20 +326,29 @@ def build_surface(hf: Heightfield, headroom: float, climb: float, max_clearance:
 
 
 def _main_region(hf: Heightfield, col, floor, region, seeds) -> np.ndarray:
+    """The played region: the regions of the spans under the seed points (``[x, z]``
+    or ``[x, z, y]``: the span nearest across, then nearest in height; without a height
+    the largest region among the column's spans), else the largest region."""
     if len(col) == 0:
         return np.zeros(0, dtype=bool)
+    sizes = np.bincount(region)
     if seeds is not None and len(seeds):
         nz, nx = hf.shape
-        s = np.asarray(seeds, dtype=np.float64).reshape(-1, 2)
+        s = np.asarray(seeds, dtype=np.float64).reshape(len(seeds), -1)
         sj = np.clip(np.floor((s[:, 0] - hf.origin[0]) / hf.cs), 0, nx - 1).astype(np.int64)
         si = np.clip(np.floor((s[:, 1] - hf.origin[2]) / hf.cs), 0, nz - 1).astype(np.int64)
         i, j = np.divmod(col, nx)
+        y = hf.origin[1] + floor * hf.ch
         picked = []
-        for a, b in zip(si, sj):
+        for k, (a, b) in enumerate(zip(si, sj)):
             d = (i - a) ** 2 + (j - b) ** 2
-            picked.append(region[int(np.argmin(d))])
+            near = np.flatnonzero(d == d.min())
+            if s.shape[1] >= 3 and np.isfinite(s[k, -1]):
+                pick = near[int(np.argmin(np.abs(y[near] - s[k, -1])))]
+            else:
+                pick = near[int(np.argmax(sizes[region[near]]))]
+            picked.append(region[pick])
         return np.isin(region, picked)
-    sizes = np.bincount(region)
     return region == int(np.argmax(sizes))
 
 
