@@ -194,17 +194,24 @@ def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
 
 
 def components(link: np.ndarray) -> np.ndarray:
-    """Connected-component label of each span over its links."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
+    """Connected-component label of each span over its links (the smallest span index
+    in its component): min-label propagation along the links with pointer jumping,
+    rounds until nothing changes (a few dozen even on large open areas)."""
     n = len(link)
-    src = np.repeat(np.arange(n), 4)
-    dst = link.reshape(-1)
-    ok = dst >= 0
-    graph = coo_matrix((np.ones(int(ok.sum()), dtype=np.int8), (src[ok], dst[ok])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
-    return label.astype(np.int64)
+    label = np.arange(n, dtype=np.int64)
+    if n == 0:
+        return label
+    nb = [np.where(link[:, d] >= 0, link[:, d], label) for d in range(4)]
+    while True:
+        new = label.copy()
+        for a in nb:  # both ways along each link (a link need not have its reverse)
+            np.minimum(new, new[a], out=new)
+            np.minimum.at(new, a, new)
+        new = new[new]
+        new = new[new]
+        if np.array_equal(new, label):
+            return label
+        label = new
 
 
 def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = None, rounds: int = 64) -> np.ndarray:
@@ -357,18 +364,18 @@ def surface_layers(surface: Surface) -> tuple[np.ndarray, np.ndarray, np.ndarray
     clearance in metres, span index or -1)."""
     nz, nx = surface.shape
     L = max(surface.levels, 1)
-    exists = np.zeros((L, nz, nx), dtype=bool)
-    height = np.full((L, nz, nx), np.nan)
-    clear = np.zeros((L, nz, nx))
-    span = np.full((L, nz, nx), -1, dtype=np.int64)
     m = np.flatnonzero(surface.level >= 0)
-    i, j = np.divmod(surface.col[m], nx)
-    lv = surface.level[m]
-    exists[lv, i, j] = True
-    height[lv, i, j] = surface.y[m]
-    clear[lv, i, j] = surface.clearance[m]
-    span[lv, i, j] = m
-    return exists, height, clear, span
+    at = surface.level[m] * (nz * nx) + surface.col[m]  # flat index into (L, nz, nx)
+    exists = np.zeros(L * nz * nx, dtype=bool)
+    height = np.full(L * nz * nx, np.nan)
+    clear = np.zeros(L * nz * nx)
+    span = np.full(L * nz * nx, -1, dtype=np.int64)
+    exists[at] = True
+    height[at] = surface.y[m]
+    clear[at] = surface.clearance[m]
+    span[at] = m
+    shape = (L, nz, nx)
+    return exists.reshape(shape), height.reshape(shape), clear.reshape(shape), span.reshape(shape)
 
 
 def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray, seeds: np.ndarray | None = None,
@@ -388,16 +395,22 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
     else:
         valid = exists & ~too_close
     L, nz, nx = valid.shape
-    link = np.full((L, nz, nx, 4), -1, dtype=np.int8)
+    # each valid node's span, and the node its link reaches: flat indices throughout
+    per = nz * nx
+    node = np.flatnonzero(valid)
+    sp = span.ravel()[node]
+    vflat = valid.ravel()
+    link = np.full((L * per, 4), -1, dtype=np.int8)
     lv_of = np.append(surface.level, -1)  # span -1 (no link) -> level -1
-    for d, (di, dj) in enumerate(DIRS):
-        l_, i_, j_ = np.nonzero(valid)
-        t = surface.link[span[l_, i_, j_], d]
+    col_of = np.append(surface.col, 0)
+    for d in range(4):
+        t = surface.link[sp, d]
         tl = lv_of[t]
-        ii, jj = i_ + di, j_ + dj
+        target = tl * per + col_of[t]
         ok = tl >= 0
-        ok[ok] = valid[tl[ok], ii[ok], jj[ok]]
-        link[l_[ok], i_[ok], j_[ok], d] = tl[ok]
+        ok[ok] = vflat[target[ok]]
+        link[node[ok], d] = tl[ok]
+    link = link.reshape(L, nz, nx, 4)
     ri, rt, ci, ct = layered_runs(valid, link)
     cell = surface.hf.cs
     seeds_n: list = []
