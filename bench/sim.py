@@ -1,7 +1,9 @@
 """Simulation speed: 8 tanks with their shells in each bundled arena, beside pymunk.
 
 For every bundled arena (or, when none is bundled yet, a 120 m x 90 m box with a few
-obstacles built here) this runs a headless match of 8 scripted bots and times
+obstacles built here; 'hills' is terrain, 'fort' has two levels: tanks there stand on
+the ground's surface, tilt with it and shells meet the model's triangles) this runs a
+headless match of 8 scripted bots and times
 ``World.step`` alone and the whole match loop (bots deciding at 10 Hz included).  In
 the same process, pymunk (Chipmunk2D, C) steps an equivalent scene: 8 box bodies of
 the same size and mass driven by changing forces and torques inside 4 static walls.
@@ -47,12 +49,12 @@ def arenas():
     for name in found:
         info = load_match_arena(ROOT / "arenas" / name)
         if len(info.spawns) >= 8:
-            out.append((info.name, info.walls, info.spawns))
-    return out or [_builtin_arena()]
+            out.append((info.name, info.walls, info.spawns, info.ground))
+    return out or [(*_builtin_arena(), None)]
 
 
-def bench_ours(walls, spawns, spec: TankSpec, steps: int, seed: int) -> dict:
-    world = World(walls, [spec] * 8, spawns, seed=seed)
+def bench_ours(walls, spawns, spec: TankSpec, steps: int, seed: int, ground=None) -> dict:
+    world = World(walls, [spec] * 8, spawns, seed=seed, ground=ground)
     drivers = make_drivers(world)
     tanks = world.tanks
     step_time = 0.0
@@ -121,10 +123,12 @@ def main(argv: list[str] | None = None) -> int:
     spec = load_tank_spec(vref)
     peer = bench_pymunk(args.steps, args.seed, spec=spec)
     rows = []
-    for name, walls, spawns in arenas():
-        ours = bench_ours(walls, spawns, spec, args.steps, args.seed)
+    for name, walls, spawns, ground in arenas():
+        ours = bench_ours(walls, spawns, spec, args.steps, args.seed, ground)
         rows.append({
             "arena": name,
+            "levels": int(ground.levels) if ground is not None else 1,
+            "relief": ground is not None,
             "walls": int(len(walls.all_segments())),
             "steps_per_s": round(ours["step_per_s"], 1),
             "match_steps_per_s": round(ours["match_per_s"], 1),

@@ -25,8 +25,9 @@ TOL = 0.02   # m a hull point may sit past a wall line at the end of a step (SLO
 
 
 def _arenas():
+    """The flat arenas: walls of one plane (arenas with levels: tests/test_sim_ground.py)."""
     out = [("box-fixture", box_arena()[0]), ("maze-fixture", maze_arena()[0])]
-    out += [(p.name, read_walls(p / "walls.txt")) for p in bundled_arenas()]
+    out += [(p.name, w) for p in bundled_arenas() for w in [read_walls(p / "walls.txt")] if not w.layered]
     return out
 
 

@@ -100,7 +100,7 @@ class GameSession:
             raise TanktoolError("a match needs at least one tank")
         names = (["you"] if player else []) + [f"bot{i + 1}" for i in range(bots)]
         self.world = World(self.info.walls, [self.spec] * n, self.info.spawns, seed=seed, names=names,
-                           bounds=self.info.bounds)
+                           bounds=self.info.bounds, ground=getattr(self.info, "ground", None))
         self.player = 0 if player else None
         if drivers is not None:
             if len(drivers) != bots:

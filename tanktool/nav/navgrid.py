@@ -64,11 +64,13 @@ class NavGrid:
     row_index / row_total: 1-based position of the node in its row run of valid
     nodes, and that run's length (0 for invalid nodes); col_* the same for columns.
     Runs are counted per level and break where two neighbours are not linked.
-    height: world y of the surface at each node (NaN where there is no node).
+    height: world y of the walkable surface at each node (NaN where there is none);
+    a node may be invalid (a tank does not fit there) and still have a height.
     link: ``valid.shape + (4,)`` int8, the level of the node reached by each step of
     STEPS (+x, +z, -x, -z), -1 where the step is blocked (a wall, a drop-off, a slope
-    too steep, another level out of the climb).  None on grids made from walls alone:
-    then neighbours on the same level are linked whenever both are valid.
+    too steep, another level out of the climb), between nodes of the surface valid or
+    not.  None on grids made from walls alone: then neighbours on the same level are
+    linked whenever both are valid.
     """
 
     origin: np.ndarray

@@ -382,9 +382,10 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
                       too_close: np.ndarray | None = None):
     """The layered navigation grid of a surface (cell = the heightfield's cell).
 
-    A node is valid where the main region has a span whose clearance (the voxel
-    chamfer distance, or, when ``too_close`` (L, nz, nx) is given, the exact distance to
-    the level's walls) is at least ``clearance``.  ``seeds`` (k, 2+) spawn points
+    There is a node wherever the main region has a span (its height and links are
+    kept); it is valid where that span's clearance (the voxel chamfer distance, or, when
+    ``too_close`` (L, nz, nx) is given, the exact distance to the level's walls) is at
+    least ``clearance``.  ``seeds`` (k, 2+) spawn points
     ``[x, z, ...]`` mark the reachable nodes (all valid nodes when None).
     """
     from .navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3
@@ -395,11 +396,13 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
     else:
         valid = exists & ~too_close
     L, nz, nx = valid.shape
-    # each valid node's span, and the node its link reaches: flat indices throughout
+    # each node's span, and the node its link reaches: flat indices throughout.  Links
+    # and heights are kept for every node of the surface, valid (a tank fits) or not:
+    # the simulation drives on all of it; runs, reachability and paths use valid nodes.
     per = nz * nx
-    node = np.flatnonzero(valid)
+    node = np.flatnonzero(exists)
     sp = span.ravel()[node]
-    vflat = valid.ravel()
+    vflat = exists.ravel()
     link = np.full((L * per, 4), -1, dtype=np.int8)
     lv_of = np.append(surface.level, -1)  # span -1 (no link) -> level -1
     col_of = np.append(surface.col, 0)
@@ -426,7 +429,6 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
         reachable = layered_reachable(valid, link, seeds_n) if seeds_n else np.zeros_like(valid)
     else:
         reachable = valid.copy()
-    height = np.where(valid, height, np.nan)
     arrays = [valid, ri, rt, ci, ct, reachable]
     if L == 1:
         arrays = [a[0] for a in arrays]

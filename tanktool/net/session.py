@@ -83,7 +83,7 @@ class NetMatch:
     def __post_init__(self) -> None:
         names = [f"p{n}" for n in range(1, P.MAX_PLAYERS + 1)]
         self.world = World(self.arena.walls, [self.spec] * P.MAX_PLAYERS, self.arena.spawns, seed=self.seed,
-                           names=names, bounds=self.arena.bounds)
+                           names=names, bounds=self.arena.bounds, ground=getattr(self.arena, "ground", None))
         self.me = self.world.tanks[self.peer.number - 1]
         self.world.t = self.peer.session_time()
         for t in self.world.tanks:
@@ -153,7 +153,7 @@ class NetMatch:
         saved = (tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s)
         tank.x, tank.z, tank.heading, tank.vx, tank.vz = shot.x, shot.z, shot.heading, shot.vx, shot.vz
         tank.c, tank.s = math.cos(shot.heading), math.sin(shot.heading)
-        self.world.shells.append(fire(tank, self.world.walls))
+        self.world.shells.append(fire(tank, self.world.walls, self.world.ground))
         tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s = saved
 
     def _on_net(self, events: list) -> None:

@@ -218,12 +218,15 @@ def _find_key(d: dict, key: str) -> Any:
 
 
 class Tank:
-    """The moving state of one tank.  ``x, z`` is its centre of mass."""
+    """The moving state of one tank.  ``x, z`` is its centre of mass; ``y`` the height
+    of the ground under it (the base of its hull), ``level`` the navigation grid's
+    level it drives on, ``pitch`` (nose up) and ``roll`` (right side down) its tilt
+    from that ground (all 0 on a flat arena)."""
 
     __slots__ = ("index", "name", "spec", "x", "z", "heading", "vx", "vz", "omega",
                  "c", "s", "hp", "alive", "respawn_at", "reload", "kills", "deaths", "shots",
                  "hits", "wall_bumps", "distance", "touching_wall", "wall_cache",
-                 "fx", "fz", "torque", "intent")
+                 "fx", "fz", "torque", "intent", "y", "level", "pitch", "roll")
 
     def __init__(self, index: int, spec: TankSpec, x: float, z: float, heading: float,
                  name: str | None = None) -> None:
@@ -243,6 +246,9 @@ class Tank:
         self.wall_cache: tuple[float, float, list[int]] | None = None
         self.fx = self.fz = self.torque = 0.0
         self.intent = (0.0, 0.0, 0.0, False)
+        self.y = 0.0
+        self.level = 0
+        self.pitch = self.roll = 0.0
 
     # --- frames -------------------------------------------------------------------
     def to_world(self, lx: float, lz: float) -> tuple[float, float]:

@@ -356,7 +356,7 @@ def _endpoint_contact(tank: Tank, lx: float, lz: float, ex: float, ez: float) ->
 
 def _sphere_world(t: Tank, i: int) -> tuple[float, float, float, float]:
     sx, sy, sz, r = t.spec.spheres[i]
-    return (t.x + sx * t.c - sz * t.s, sy, t.z + sx * t.s + sz * t.c, r)
+    return (t.x + sx * t.c - sz * t.s, t.y + sy, t.z + sx * t.s + sz * t.c, r)
 
 
 def tank_contact(A: Tank, B: Tank) -> Contact | None:

@@ -35,9 +35,10 @@ TRAIL_PERIOD = 0.25
 class ArenaInfo:
     name: str
     walls: Any                    # WallList
-    spawns: np.ndarray            # (k, 3) [x, z, heading]
+    spawns: np.ndarray            # (k, 3) [x, z, heading], or (k, 4) with the ground's height y
     path: Path | None
     bounds: np.ndarray | None = None
+    ground: Any = None            # sim.ground.Ground, None on a flat arena
 
 
 @dataclass
@@ -90,11 +91,14 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
     """Walls, spawn points and bounds of an arena bundle (name or folder)."""
     from ..arena import load_arena
 
+    from .ground import load_ground
+
     path = _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
     bundle = load_arena(path)
     spawns = np.asarray(bundle.spawns, dtype=np.float64)
-    spawns = spawns.reshape(len(spawns), -1)[:, :3] if spawns.size else np.zeros((0, 3))
-    return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path), np.asarray(bundle.bounds, float))
+    spawns = spawns.reshape(len(spawns), -1) if spawns.size else np.zeros((0, 3))
+    return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path), np.asarray(bundle.bounds, float),
+                     load_ground(bundle))
 
 
 def load_tank_spec(ref: str | Path | None) -> TankSpec:
@@ -145,7 +149,7 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
         raise TanktoolError(f"--seconds must be a positive number, got {seconds}")
     names = [f"bot{i + 1}" for i in range(bots)]
     world = World(arena.walls, [spec] * bots, arena.spawns, seed=seed, dt=dt, integrator=integrator, names=names,
-                  bounds=arena.bounds)
+                  bounds=arena.bounds, ground=arena.ground)
     drivers = make_bots(world, bot, difficulty)
     if wrap_drivers is not None:
         drivers = wrap_drivers(world, drivers)

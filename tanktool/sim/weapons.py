@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .body import Tank
 from .collide import WallSet
 
@@ -23,7 +25,7 @@ class Shell:
     to the first wall on its line (inf when none is in range)."""
 
     __slots__ = ("owner", "x", "y", "z", "vx", "vy", "vz", "px", "py", "pz",
-                 "ox", "oz", "ux", "uz", "wall_dist", "wall", "damage", "alive")
+                 "ox", "oz", "ux", "uz", "wall_dist", "wall", "damage", "alive", "age", "stop_at")
 
     def __init__(self, owner: int, x: float, y: float, z: float, vx: float, vy: float, vz: float,
                  damage: float) -> None:
@@ -38,6 +40,8 @@ class Shell:
         self.wall = -1
         self.damage = damage
         self.alive = True
+        self.age = 0.0                               # seconds in flight
+        self.stop_at = math.nan                      # on a ground: when it meets the model [s] (inf: never)
 
     def flight_time(self) -> float:
         """Seconds until the shell reaches the floor (y = 0) if nothing stops it."""
@@ -48,15 +52,31 @@ class Shell:
         return (x - self.ox) * self.ux + (z - self.oz) * self.uz
 
 
-def fire(tank: Tank, walls: WallSet) -> Shell:
+#: a shell's flight is tested against the model in chords of this duration [s]
+CHORD = 0.05
+#: and for at most this long
+MAX_FLIGHT = 6.0
+
+
+def fire(tank: Tank, walls: WallSet, ground=None) -> Shell:
     """A shell leaving ``tank``'s gun now.
 
     It starts above the tank's centre of mass at muzzle height rather than at the
     muzzle, so a tank pressed against a wall cannot shoot through it; the owner is
-    never hit by its own shell.
+    never hit by its own shell.  On a ground (``sim.ground.Ground`` with the model) it
+    leaves at the hull's pitch from the tank's height, and where its flight first meets
+    the model (terrain, decks, ceilings, walls) is found once, now, along chords of its
+    parabola: no speed carries it through.
     """
     spec = tank.spec
     v = spec.shell_speed
+    if ground is not None and ground.mesh is not None:
+        cp, sp = math.cos(tank.pitch), math.sin(tank.pitch)
+        vx = v * cp * tank.c + tank.vx
+        vz = v * cp * tank.s + tank.vz
+        shell = Shell(tank.index, tank.x, tank.y + spec.muzzle_local[1], tank.z, vx, v * sp, vz, spec.shell_damage)
+        shell.stop_at = _meets_model(shell, ground.mesh)
+        return shell
     vx = v * tank.c + tank.vx
     vz = v * tank.s + tank.vz
     shell = Shell(tank.index, tank.x, spec.muzzle_local[1], tank.z, vx, 0.0, vz, spec.shell_damage)
@@ -70,8 +90,34 @@ def fire(tank: Tank, walls: WallSet) -> Shell:
     return shell
 
 
+#: chords tested together (a shell hits most things within the first few)
+CHUNK = 8
+
+
+def _meets_model(shell: Shell, mesh) -> float:
+    """Seconds until the shell's flight first meets the model (inf: never, within
+    MAX_FLIGHT or before it falls below the model's lowest point).  The flight is
+    tested CHUNK chords at a time, from the muzzle on, so a shell that hits early costs
+    little."""
+    n = int(MAX_FLIGHT / CHORD)
+    t = np.arange(n + 1) * CHORD
+    y = shell.y + shell.vy * t - 0.5 * GRAVITY * t * t
+    below = np.flatnonzero(y < mesh.y_min - 1.0)
+    if len(below):
+        n = int(below[0])
+        t, y = t[:n + 1], y[:n + 1]
+    pts = np.column_stack([shell.x + shell.vx * t, y, shell.z + shell.vz * t])
+    for k0 in range(0, len(pts) - 1, CHUNK):
+        hit = mesh.first_hit_path(pts[k0:k0 + CHUNK + 1])
+        if hit is not None:
+            k, f = hit
+            return float(t[k0 + k] + f * CHORD)
+    return math.inf
+
+
 def fly(shell: Shell, dt: float) -> None:
     """Move a shell through one step (exact under constant gravity)."""
+    shell.age += dt
     shell.px, shell.py, shell.pz = shell.x, shell.y, shell.z
     shell.x += shell.vx * dt
     shell.z += shell.vz * dt
@@ -79,9 +125,15 @@ def fly(shell: Shell, dt: float) -> None:
     shell.vy -= GRAVITY * dt
 
 
-def stop_fraction(shell: Shell) -> tuple[float, str]:
+def stop_fraction(shell: Shell, dt: float | None = None) -> tuple[float, str]:
     """Where along this step's flight the shell meets a wall or the floor:
-    (fraction in [0, 1], "wall" | "floor"), or (inf, "") when it flies on."""
+    (fraction in [0, 1], "wall" | "floor"), or (inf, "") when it flies on.  On a ground
+    ``dt``, this step's length, places the meeting with the model found at firing."""
+    if not math.isnan(shell.stop_at):  # fired on a ground: the model, found at firing
+        if shell.age >= shell.stop_at:
+            step = dt if dt else shell.age
+            return min(max(1.0 - (shell.age - shell.stop_at) / step, 0.0), 1.0), "ground"
+        return math.inf, ""
     best, what = math.inf, ""
     d0 = shell.travelled(shell.px, shell.pz)
     d1 = shell.travelled(shell.x, shell.z)

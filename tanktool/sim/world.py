@@ -32,7 +32,7 @@ from ..nav.quadtree import WallQuadtree
 from .collide import QuadtreeIndex, WallIndex, WallSet, shell_hits_tank, tank_contact, wall_contacts
 from .commands import Command
 from .resolve import SLOP, correct_walls, pair_impulse, separate_pair, wall_impulse
-from .weapons import Shell, fire, fly, stop_fraction
+from .weapons import GRAVITY, Shell, fire, fly, stop_fraction
 
 DT = 1.0 / 120.0
 INTEGRATORS = ("semi-implicit", "euler")
@@ -91,13 +91,18 @@ class World:
     wall_index : the wall quadtree (``nav.quadtree.WallQuadtree``, built here by default
                  with leaves of about 12 m, or ``quadtree_depth``) or any object with
                  exact ``query_point`` and ``query_segment``
+    ground : an arena's ``sim.ground.Ground`` (relief, several levels), or None for a
+             flat one-floor arena (the 2002 simulation).  With a ground, tanks stand on
+             its surface (height, pitch and roll from it, gravity along its slopes), move
+             between levels along its links and never leave it, collide with the walls of
+             their own level only, and shells and sight meet the model's triangles.
     """
 
     def __init__(self, walls: Any, specs: Sequence[TankSpec], spawns: Any, *, seed: int = 0,
                  dt: float = DT, integrator: str = "semi-implicit", wall_index: WallIndex | None = None,
                  names: Sequence[str] | None = None, respawn_delay: float = 3.0,
                  max_iterations: int = 8, wall_slack: float = 2.0, quadtree_depth: int | None = None,
-                 bounds: Any = None) -> None:
+                 bounds: Any = None, ground: Any = None) -> None:
         if integrator not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
         if not (dt > 0 and math.isfinite(dt)):
@@ -124,7 +129,16 @@ class World:
         if hasattr(wall_index, "child") and hasattr(wall_index, "box"):
             wall_index = QuadtreeIndex(wall_index)   # same buckets, plain-Python lookups
         self.walls = WallSet(segments, wall_index)
-        self.spawns = [tuple(float(v) for v in row) for row in np.asarray(spawns, dtype=np.float64).reshape(-1, 3)]
+        self.ground = ground
+        sp = np.asarray(spawns, dtype=np.float64)
+        sp = sp.reshape(len(sp), -1) if sp.size else np.zeros((0, 3))
+        self.spawns = [tuple(float(v) for v in row[:3]) for row in sp]
+        # the height of the surface under each spawn (which level it stands on), if given
+        self.spawn_y = [float(row[3]) if len(row) > 3 and math.isfinite(row[3]) else None for row in sp]
+        self.level_walls: list[WallSet] = []
+        self._wall_y: list[list[tuple[float, float]]] = []
+        if ground is not None:
+            self._build_level_walls(walls, segments)
         if len(self.spawns) < len(specs):
             raise ArenaError(f"the arena has {len(self.spawns)} spawn points, {len(specs)} tanks asked for")
         self.seed = int(seed)
@@ -141,6 +155,7 @@ class World:
             x, z, h = self.spawns[order[i]]
             t = Tank(i, spec, 0.0, 0.0, h, name=names[i] if names else None)
             t.place(x, z, h)
+            self._stand(t, self.spawn_y[order[i]])
             self.tanks.append(t)
         self.shells: list[Shell] = []
         self.t = 0.0
@@ -157,6 +172,7 @@ class World:
         events: list[Event] = []
         self.steps += 1
         self.t += dt
+        self._step_dt = dt
         self.initialise_objects(dt, events)
         self.direction(commands)
         self.forces(dt, events)
@@ -173,11 +189,13 @@ class World:
     def state(self) -> tuple:
         """Every number that evolves, for determinism checks and snapshots."""
         return (self.steps, self.t,
-                tuple((t.x, t.z, t.heading, t.vx, t.vz, t.omega, t.hp, t.alive, t.reload) for t in self.tanks),
+                tuple((t.x, t.z, t.heading, t.vx, t.vz, t.omega, t.hp, t.alive, t.reload, t.y, t.level)
+                      for t in self.tanks),
                 tuple((s.owner, s.x, s.y, s.z, s.vx, s.vy, s.vz) for s in self.shells))
 
     _TANK_FIELDS = ("x", "z", "heading", "vx", "vz", "omega", "hp", "alive", "respawn_at", "reload",
-                    "kills", "deaths", "shots", "hits", "wall_bumps", "distance", "touching_wall")
+                    "kills", "deaths", "shots", "hits", "wall_bumps", "distance", "touching_wall",
+                    "y", "level", "pitch", "roll")
 
     def snapshot(self) -> dict[str, Any]:
         """Everything needed to continue this world exactly (plain data: for network
@@ -196,7 +214,8 @@ class World:
         self.rng.setstate(snap["rng"])
         for t, d in zip(self.tanks, snap["tanks"]):
             for f in self._TANK_FIELDS:
-                setattr(t, f, d[f])
+                if f in d:  # snapshots from before tanks had heights lack the last four
+                    setattr(t, f, d[f])
             t.c, t.s = math.cos(t.heading), math.sin(t.heading)
             t.wall_cache = None
         self.shells = []
@@ -272,10 +291,18 @@ class World:
                 fr += sp.strafe_force * s * (0.0 if fade < 0.0 else 1.0 if fade > 1.0 else fade)
             t.fx = ff * c - fr * sn
             t.fz = ff * sn + fr * c
+            if self.ground is not None and (t.pitch != 0.0 or t.roll != 0.0):
+                # gravity along the slope: on a plane of gradient G the horizontal pull is
+                # g G / (1 + |G|^2) downhill (g sin(theta) cos(theta))
+                gf, gr = math.tan(t.pitch), -math.tan(t.roll)   # rise along forward, along right
+                gx, gz = gf * c - gr * sn, gf * sn + gr * c
+                k = -m * GRAVITY / (1.0 + gx * gx + gz * gz)
+                t.fx += k * gx
+                t.fz += k * gz
             turn_drag = min(sp.turn_drag, sp.inertia * inv_dt)
             t.torque = sp.turn_torque * r - turn_drag * t.omega
             if want_fire and t.reload <= 0.0:
-                shell = fire(t, self.walls)
+                shell = fire(t, self.walls, self.ground)
                 self.shells.append(shell)
                 t.reload = sp.fire_interval
                 t.shots += 1
@@ -301,6 +328,8 @@ class World:
                 t.vz += az * dt
                 t.omega += alpha * dt
                 dx, dz, dh = t.vx * dt, t.vz * dt, t.omega * dt
+            if self.ground is not None:
+                dx, dz = self._keep_on_ground(t, dx, dz)
             t.x += dx
             t.z += dz
             h = t.heading + dh
@@ -322,9 +351,11 @@ class World:
             if not t.alive:
                 continue
             t.c, t.s = math.cos(t.heading), math.sin(t.heading)
+            if self.ground is not None:
+                self._tilt(t)
             wc = t.wall_cache
-            if wc is None or (t.x - wc[0]) ** 2 + (t.z - wc[1]) ** 2 > slack * slack:
-                t.wall_cache = (t.x, t.z, self.walls.near(t.x, t.z, t.spec.radius + slack))
+            if wc is None or (t.x - wc[0]) ** 2 + (t.z - wc[1]) ** 2 > slack * slack or wc[3] != t.level:
+                t.wall_cache = self._wall_candidates(t, slack)
 
     # ------------------------------------------------------------------ 6
     def detect_collisions(self, which: Any, with_shells: bool = False) -> "Collisions":
@@ -338,11 +369,12 @@ class World:
             t = tanks[i]
             if not t.alive:
                 continue
-            if t.wall_cache is None or (t.x - t.wall_cache[0]) ** 2 + (t.z - t.wall_cache[1]) ** 2 > self.wall_slack ** 2:
-                t.wall_cache = (t.x, t.z, self.walls.near(t.x, t.z, t.spec.radius + self.wall_slack))
-            cand = t.wall_cache[2]
+            wc = t.wall_cache
+            if wc is None or (t.x - wc[0]) ** 2 + (t.z - wc[1]) ** 2 > self.wall_slack ** 2 or wc[3] != t.level:
+                t.wall_cache = wc = self._wall_candidates(t, self.wall_slack)
+            cand = wc[2]
             if cand:
-                found = wall_contacts(t, self.walls, cand)
+                found = wall_contacts(t, self.walls_of(t), cand)
                 if found:
                     walls.append((i, found))
         pairs: list[tuple[int, int, tuple]] = []
@@ -362,13 +394,15 @@ class World:
                 rr = reach[i] + reach[j]
                 if dx * dx + dz * dz > rr * rr:
                     continue
+                if a.y + a.spec.height < b.y or b.y + b.spec.height < a.y:
+                    continue  # one on a bridge, one under it
                 c = tank_contact(a, b)
                 if c is not None:
                     pairs.append((i, j, c))
         shells: list[tuple[Shell, int, float, str]] = []
         if with_shells:
             for s in self.shells:
-                f, what = stop_fraction(s)
+                f, what = stop_fraction(s, getattr(self, "_step_dt", self.dt))
                 victim = -1
                 sx, sz = 0.5 * (s.px + s.x), 0.5 * (s.pz + s.z)
                 half = 0.5 * math.hypot(s.x - s.px, s.z - s.pz)
@@ -469,7 +503,9 @@ class World:
         live = [o for o in self.tanks if o.alive and o is not t]
         free, best, best_d = [], None, -1.0
         for k, (x, z, h) in enumerate(self.spawns):
-            d = min((math.hypot(o.x - x, o.z - z) - o.spec.radius for o in live), default=math.inf)
+            y = self.spawn_y[k]
+            d = min((math.hypot(o.x - x, o.z - z) - o.spec.radius for o in live
+                     if y is None or abs(o.y - y) < o.spec.height + t.spec.height), default=math.inf)
             if d > t.spec.radius + 1.0:
                 free.append(k)
             if d > best_d:
@@ -477,10 +513,96 @@ class World:
         k = self.rng.choice(free) if free else best
         x, z, h = self.spawns[k]
         t.place(x, z, h)
+        self._stand(t, self.spawn_y[k])
         t.hp = t.spec.hit_points
         t.alive = True
         t.reload = 0.0
         events.append(Event(self.steps, self.t, "respawn", t.index, x, z))
+
+    # ------------------------------------------------------------------ the ground
+    def _build_level_walls(self, walls: Any, segments: np.ndarray) -> None:
+        """One wall set per level (its walls and the auxiliary rectangle), and the
+        height range of the region each wall bounds (a wall stops only the tanks on its
+        own surface: not one on a deck above it)."""
+        level = np.asarray(getattr(walls, "level", np.zeros(0)), dtype=np.int64)
+        region = np.asarray(getattr(walls, "region", np.zeros(0)), dtype=np.int64)
+        seg = np.asarray(getattr(walls, "segments", segments), dtype=np.float64).reshape(-1, 2, 2)
+        regions = getattr(walls, "regions", None) or {}
+        aux = segments[len(seg):]
+        for lv in range(max(self.ground.levels, int(level.max()) + 1 if len(level) else 1)):
+            sel = np.flatnonzero(level == lv) if len(level) == len(seg) else np.arange(len(seg))
+            ys = []
+            for k in sel:
+                r = regions.get(int(region[k])) if len(region) == len(seg) else None
+                lo, hi = (r[1], r[2]) if r is not None and math.isfinite(r[1]) and math.isfinite(r[2]) \
+                    else (-math.inf, math.inf)
+                ys.append((lo, hi))
+            ys += [(-math.inf, math.inf)] * len(aux)
+            part = np.concatenate([seg[sel], aux]) if len(sel) else aux
+            tree = WallQuadtree.build(part, self.bounds, depth=3) if len(part) else None
+            self.level_walls.append(WallSet(part, QuadtreeIndex(tree) if tree is not None else None))
+            self._wall_y.append(ys)
+
+    def walls_of(self, t: Tank) -> WallSet:
+        """The walls a tank can hit: its level's (all walls on a flat arena)."""
+        if self.ground is None or not self.level_walls:
+            return self.walls
+        return self.level_walls[min(max(t.level, 0), len(self.level_walls) - 1)]
+
+    def _wall_candidates(self, t: Tank, slack: float) -> tuple:
+        """(x, z, walls within reach, level) of a tank: on a ground, only the walls of its
+        level whose region lies within the climb of its height."""
+        ws = self.walls_of(t)
+        cand = ws.near(t.x, t.z, t.spec.radius + slack)
+        if self.ground is not None and self.level_walls:
+            ys = self._wall_y[min(max(t.level, 0), len(self._wall_y) - 1)]
+            tol = self.ground.climb + t.spec.height
+            cand = [k for k in cand if ys[k][0] - tol <= t.y <= ys[k][1] + tol]
+        return (t.x, t.z, cand, t.level)
+
+    def _stand(self, t: Tank, y: float | None) -> None:
+        """Put a tank on the ground under it: its level (the one nearest ``y``), height
+        and tilt."""
+        g = self.ground
+        if g is None:
+            return
+        lv = g.near_level(t.x, t.z, y) if y is not None else g.locate(t.x, t.z)
+        if lv < 0:
+            lv = g.locate(t.x, t.z, y)
+        t.level = max(lv, 0)
+        self._tilt(t)
+
+    def _tilt(self, t: Tank) -> None:
+        bx0, bz0, bx1, bz1 = t.spec.box
+        t.y, t.pitch, t.roll = self.ground.tilt(t.x, t.z, t.level, t.c, t.s, 0.5 * (bx1 - bx0), 0.5 * (bz1 - bz0))
+
+    def _keep_on_ground(self, t: Tank, dx: float, dz: float) -> tuple[float, float]:
+        """The part of a move (dx, dz) that keeps the tank's centre on the walkable
+        surface: into a cell its node links to (the tank's level follows the link), else
+        along one axis only (sliding along the edge), else not at all; velocity into a
+        refused direction is taken away."""
+        g = self.ground
+        i0, j0 = g.cell_of(t.x, t.z)
+        i1, j1 = g.cell_of(t.x + dx, t.z + dz)
+        if (i0, j0) == (i1, j1):
+            return dx, dz
+        lv = g.follow(t.level, i0, j0, i1, j1)
+        if lv >= 0:
+            t.level = lv
+            return dx, dz
+        # refused: slide along whichever axis is still open
+        for keep_x in (abs(dx) >= abs(dz), abs(dx) < abs(dz)):
+            ii, jj = g.cell_of(t.x + (dx if keep_x else 0.0), t.z + (0.0 if keep_x else dz))
+            lv = g.follow(t.level, i0, j0, ii, jj)
+            if lv >= 0:
+                t.level = lv
+                if keep_x:
+                    t.vz = 0.0
+                    return dx, 0.0
+                t.vx = 0.0
+                return 0.0, dz
+        t.vx = t.vz = 0.0
+        return 0.0, 0.0
 
 
 class Collisions:
