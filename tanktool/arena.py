@@ -267,9 +267,14 @@ def import_arena(
         raise ArenaError(f"{model}: {e}") from None
     walls = result.walls.walls
     spawns = result.spawns
+    fits = result.fleet or fleet
+    if result.too_big:
+        remark(f"{model}: {'; '.join(f'{n} {w}' for n, w in result.too_big)}: the spawns and the navigation "
+               f"grid are for {fits.radius_of} (footprint radius {fits.radius:.2f} m), and play refuses the "
+               f"larger vehicles here")
     if len(spawns) < MIN_SPAWNS:
-        remark(f"{model}: room for only {len(spawns)} spawn point(s) where the largest bundled tank "
-               f"({fleet.radius_of}) fits, at least {fleet.length:.1f} m apart")
+        remark(f"{model}: room for only {len(spawns)} spawn point(s) where the largest bundled tank that fits "
+               f"({fits.radius_of}) fits, at least {fits.length:.1f} m apart")
 
     src_up = up or default_up(fmt)
     nav["cell"] = float(params.cell)
@@ -304,6 +309,8 @@ def import_arena(
             "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
                       "count": len(walls)},
             "walkable": params.as_toml(),
+            "vehicles": {"largest": fits.radius_of, "radius": _r(fits.radius),
+                         "too_big": [n for n, _ in result.too_big]},
             "levels": [{"level": x.level, "area": _r(x.area, 1), "y": [_r(x.y_lo, 3), _r(x.y_hi, 3)],
                         "regions": x.regions} for x in lv],
             "navgrid": nav,

@@ -28,6 +28,16 @@ class Fleet:
     length_of: str = "built-in default"
     height_of: str = "built-in default"
     names: list[str] = field(default_factory=list)
+    #: (name, footprint radius, length) of every vehicle, the largest radius first
+    sizes: list[tuple[str, float, float]] = field(default_factory=list)
+
+    def down_to(self, name: str, radius: float, length: float) -> "Fleet":
+        """The fleet an arena too small for its larger vehicles keeps: the same
+        headroom, the radius and length of vehicle ``name`` and those smaller."""
+        rest = [s for s in self.sizes if s[1] <= radius]
+        longest = max(rest, key=lambda s: s[2]) if rest else (name, radius, length)
+        return Fleet(radius, longest[2], self.height, name, longest[0], self.height_of,
+                     [s[0] for s in rest], rest)
 
 
 def bundled_fleet(folder: Path | None = None, warn: Callable[[str], None] | None = None) -> Fleet:
@@ -63,4 +73,6 @@ def bundled_fleet(folder: Path | None = None, warn: Callable[[str], None] | None
             if height > fleet.height:
                 fleet.height, fleet.height_of = height, v.name
         fleet.names.append(v.name)
+        fleet.sizes.append((v.name, r, length))
+    fleet.sizes.sort(key=lambda s: (-s[1], s[0]))
     return fleet

@@ -118,7 +118,7 @@ def _bad_inputs(tmp_path: Path) -> dict[str, tuple[Path, str]]:
     empty3ds = tmp_path / "empty.3ds"
     empty3ds.write_bytes(b"")
     block = tmp_path / "block.obj"
-    trimesh.util.concatenate([_box(0, 0, 10, 10, -1, 0), _box(0, 0, 10, 10, 0, 5)]).export(block)
+    trimesh.util.concatenate([_box(0, 0, 4, 4, -1, 0), _box(0, 0, 4, 4, 0, 5)]).export(block)
     wall = tmp_path / "wall.obj"
     wall.write_text("v 0 0 0\nv 1 0 0\nv 1 3 0\nf 1 2 3\n")
     return {
@@ -126,7 +126,7 @@ def _bad_inputs(tmp_path: Path) -> dict[str, tuple[Path, str]]:
         "not a model": (text, "no triangles"),
         "nan": (nan, "not finite"),
         "empty 3ds": (empty3ds, "empty"),
-        "no free space": (block, "no place where the largest bundled tank fits"),
+        "no free space": (block, "no place where any bundled tank fits"),
         "no floor": (wall, "no surface a tank can stand on"),
         "unknown kind": (tmp_path / "notes.txt", "no such file"),
     }

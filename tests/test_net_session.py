@@ -112,7 +112,7 @@ def _compare_views(reports: list[dict]) -> tuple[int, list[float]]:
                 ta = va.get(v["t"])
                 if ta is None:
                     continue
-                for n, (x, z, alive) in v["tanks"].items():
+                for n, (x, z, alive, *_) in v["tanks"].items():
                     if n in ta and alive and ta[n][2]:
                         errors.append(math.hypot(x - ta[n][0], z - ta[n][1]))
     return len(errors), errors
@@ -240,7 +240,7 @@ def test_garbage_and_impostor_changed_nothing(scenario):
         reasons = net["dropped_reasons"]
         assert reasons.get("impostor", 0) + reasons.get("unknown", 0) >= 1
         for v in rep["views"]:
-            for x, z, _ in v["tanks"].values():
+            for x, z, *_ in v["tanks"].values():
                 assert 0.0 <= x <= 60.0 and 0.0 <= z <= 60.0      # never at the impostor's (999, 999)
 
 
@@ -387,7 +387,7 @@ def test_password_session_under_attack_and_migration(tmp_path):
         assert any(len(v["tanks"]) == 4 for v in rep["views"])
         assert [x["reason"] for x in rep["left"] if x["name"] == "host"] == ["exit"]
         for v in rep["views"]:
-            for x, z, _ in v["tanks"].values():
+            for x, z, *_ in v["tanks"].values():
                 assert 0.0 <= x <= 60.0 and 0.0 <= z <= 60.0       # never at the forger's (999, 999)
         assert rep["latency_ms"]["samples"] > 100
     n, errors = _compare_views(reports + [late_report])
@@ -399,3 +399,44 @@ def test_password_session_under_attack_and_migration(tmp_path):
     kinds = {ln.split()[2].rstrip(":") for ln in lines}
     assert {"evicted", "refused_rate", "refused_password", "impostor"} <= kinds, host_err
     assert len(lines) < 40, lines
+
+
+def test_two_peers_on_the_fort_agree_on_heights(tmp_path):
+    """On a layered arena (the fort: a roof over a gate passage, ramps, a bridge) a
+    remote tank stands at the same height, on the same level, as where its own peer
+    has it: states carry (x, z) and each peer puts the tank on its ground."""
+    procs: list[Proc] = []
+    try:
+        port = free_port(LOOPBACK)
+        args, rep_h = _play(tmp_path, "host", "--host", f"{LOOPBACK}:{port}", "--bots", "2", seconds=300)
+        args[args.index("box")] = "fort"
+        host = Proc(args)
+        procs.append(host)
+        host.wait_line(r"hosting on")
+        a, rep_j = _play(tmp_path, "peer", "--join", f"{LOOPBACK}:{port}", seconds=300)
+        a[a.index("box")] = "fort"
+        joiner = Proc(a)
+        procs.append(joiner)
+        joiner.wait_line(r"as player \d")
+        time.sleep(8.0)
+        joiner.p.send_signal(signal.SIGINT)
+        assert joiner.finish(60) == 0, joiner.err
+        host.p.send_signal(signal.SIGINT)
+        assert host.finish(60) == 0, host.err
+        reports = [json.loads(r.read_text()) for r in (rep_h, rep_j)]
+    finally:
+        for p in procs:
+            p.kill()
+    seen = {}
+    for rep in reports:
+        for v in rep["views"]:
+            for n, (x, z, alive, y) in v["tanks"].items():
+                if alive:
+                    seen.setdefault((v["t"], n), []).append((x, z, y))
+    pairs = [p for p in seen.values() if len(p) == 2]
+    assert len(pairs) >= 10
+    dy = sorted(abs(a[2] - b[2]) for a, b in pairs)
+    dxz = sorted(math.hypot(a[0] - b[0], a[1] - b[1]) for a, b in pairs)
+    assert dxz[len(dxz) // 2] < 1.5
+    # heights follow positions: as close as the positions allow (ramps rise 1 in 5)
+    assert dy[len(dy) // 2] < 0.5 and dy[-1] < 2.0, dy

@@ -14,6 +14,8 @@ height-field grids, seeded, so a seed gives the same file:
 * ``tiny_room``        a 3 x 3 m room: too small for any bundled tank
 * ``two_storeys``      a building whose upper floor covers the ground floor, stairs of ramps
 * ``hills`` / ``fort`` the bundled arenas of the same names (tools/make_arena_models.py)
+* ``corridor``, ``islands``, ``narrow_deck``: degenerate arenas (one corridor, platforms
+  apart from each other, a catwalk in the air) the agents must cope with
 """
 
 from __future__ import annotations
@@ -170,9 +172,10 @@ def hills(seed: int = 7) -> list:
         kx, kz = rng.uniform(0.025, 0.08, 2)
         ph = rng.uniform(0, 2 * math.pi, 2)
         h += rng.uniform(0.5, 1.0) * np.sin(kx * X + ph[0]) * np.cos(kz * Z + ph[1])
-    h = (h - h.min()) / max(h.max() - h.min(), 1e-9) * 7.0  # 0 .. 7 m, slopes under 20 degrees
+    h = (h - h.min()) / max(h.max() - h.min(), 1e-9) * 6.0  # 0 .. 6 m
     edge = np.minimum.reduce([X, Z, size - X, size - Z])
-    h *= np.clip(edge / 10.0, 0, 1)  # flat along the wall
+    e = np.clip(edge / 25.0, 0, 1)
+    h *= e * e * (3 - 2 * e)  # flat along the wall, easing in over 25 m: slopes under 20 degrees
     parts = [("grass", heightfield_mesh(xs, xs, h)),
              ("wall", box(-1, -1, size + 1, 0, -1, 4)), ("wall", box(-1, size, size + 1, size + 1, -1, 4)),
              ("wall", box(-1, 0, 0, size, -1, 4)), ("wall", box(size, 0, size + 1, size, -1, 4))]
@@ -210,6 +213,34 @@ def fort(seed: int = 0) -> list:
     return parts
 
 
+def corridor(length: float = 80.0, width: float = 7.5) -> list:
+    """One walled corridor ``width`` m wide (the light tank fits, the heavy one does not)."""
+    return [("ground", box(0, 0, length, width + 2, -0.5, 0)),
+            ("wall", box(0, 0, length, 1, 0, 3)), ("wall", box(0, width + 1, length, width + 2, 0, 3)),
+            ("wall", box(0, 1, 1, width + 1, 0, 3)), ("wall", box(length - 1, 1, length, width + 1, 0, 3))]
+
+
+def islands(seed: int = 2, count: int = 7) -> list:
+    """Flat platforms 3 m up in the air, seeded, 8 - 16 m across, at least 4 m apart,
+    nothing else: the largest is the arena, the others are left out."""
+    rng = np.random.default_rng(seed)
+    parts: list = []
+    placed: list = []
+    while len(placed) < count:
+        w, d = rng.uniform(8, 16, 2)
+        x, z = rng.uniform(0, 90 - w), rng.uniform(0, 90 - d)
+        if all(x > a1 + 4 or x + w < a0 - 4 or z > b1 + 4 or z + d < b0 - 4 for a0, b0, a1, b1 in placed):
+            placed.append((x, z, x + w, z + d))
+            parts.append(("deck", box(x, z, x + w, z + d, 2.5, 3.0)))
+    return parts
+
+
+def narrow_deck(length: float = 60.0, width: float = 7.5) -> list:
+    """Only a deck ``width`` m wide, 5 m up in the air (a catwalk): nothing else to
+    drive on."""
+    return [("deck", box(0, 0, length, width, 4.5, 5.0))]
+
+
 def level(name: str, **kw) -> trimesh.Trimesh:
     """One generated level as a single mesh (parts painted by kind)."""
     return join(LEVELS[name](**kw))
@@ -218,6 +249,7 @@ def level(name: str, **kw) -> trimesh.Trimesh:
 LEVELS = {
     "rolling_terrain": rolling_terrain, "ramps_and_decks": ramps_and_decks, "bridge": bridge,
     "bumpy_floor": bumpy_floor, "tiny_room": tiny_room, "two_storeys": two_storeys, "hills": hills, "fort": fort,
+    "corridor": corridor, "islands": islands, "narrow_deck": narrow_deck,
 }
 
 

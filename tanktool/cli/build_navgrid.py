@@ -109,9 +109,15 @@ def _layered(target: Target, params, clearance: float, bounds, shape):
 
 
 def default_clearance(target: Target) -> tuple[float, str]:
-    """The footprint radius of the largest bundled vehicle, else arena.toml's value."""
+    """The footprint radius of the largest bundled vehicle (of those that fit in the
+    arena, when import-arena found the larger ones fit nowhere: arena.toml
+    [vehicles]), else arena.toml's value."""
     from ..formats.bundle import read_toml
 
+    fits = target.toml.get("vehicles", {})
+    r = fits.get("radius") if isinstance(fits, dict) else None
+    if fits.get("too_big") and isinstance(r, (int, float)) and not isinstance(r, bool) and math.isfinite(r) and r > 0:
+        return float(r), f"footprint radius of vehicle '{fits.get('largest')}', the largest that fits"
     best: tuple[float, str] | None = None
     for vt in sorted(VEHICLES_DIR.glob("*/vehicle.toml")):
         try:

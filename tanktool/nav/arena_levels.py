@@ -5,13 +5,14 @@ The one place ``import-arena`` asks "where can a tank be?":
 1. the walkable surface (:mod:`tanktool.nav.walkable`) on a grid over the model;
 2. its walls per level and region (:mod:`tanktool.nav.level_walls`);
 3. a navigation grid at the largest bundled tank's footprint radius, measured to
-   those walls exactly: where that tank fits;
+   those walls exactly: where that tank fits (where it fits nowhere, the next
+   smaller vehicle's, down to the smallest: the arena is then for those only);
 4. spawn points where it fits, on the largest part of the grid it can drive around
    in, at least a tank's length apart (tanktool.geometry.spawns);
 5. per level its area and height range, and what was left out and why
    (:mod:`tanktool.nav.surface_report`).
 
-A model where no tank fits anywhere is refused (ArenaError).
+A model where no bundled tank fits anywhere is refused (ArenaError).
 """
 
 from __future__ import annotations
@@ -61,6 +62,8 @@ class ArenaLevels:
     vertices: np.ndarray | None = None  # the model (world frame), for pictures of steep faces
     faces: np.ndarray | None = None
     timings: dict[str, float] = field(default_factory=dict)
+    fleet: Fleet | None = None  # the vehicles the grid and spawns are for (the largest that fit)
+    too_big: list[tuple[str, str]] = field(default_factory=list)  # (vehicle, why) the arena is not for
 
     @property
     def free(self):
@@ -225,19 +228,44 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
     t["walls"] = time.perf_counter() - t0
     step("walls")
     t0 = time.perf_counter()
-    grid = tank_grid(surface, lw, fleet.radius)
-    grid.climb = params.climb
+    # the largest vehicle that fits: the grid and spawns are made for it (an arena too
+    # narrow for the heavy tank still plays with the light one; play refuses the others)
+    tries = [(n, r, ln) for n, r, ln in fleet.sizes] or [(fleet.radius_of, fleet.radius, fleet.length)]
+    found = None  # (grid, spawns, fleet) of the largest vehicle that fits
+    problem = ""
+    why: dict[str, str] = {}  # vehicle -> why the arena is not for it
+    for k, (name, radius, length) in enumerate(tries):
+        if k and radius >= tries[k - 1][1]:
+            continue
+        fl = fleet if k == 0 else fleet.down_to(name, radius, length)
+        g = tank_grid(surface, lw, radius)
+        g.climb = params.climb
+        if not g.valid.any():
+            problem = problem or _no_fit(surface, name, radius)
+            why[name] = f"fits nowhere (it needs a circle of {2 * radius:.2f} m)"
+            continue
+        try:
+            sp = choose_spawns(lw, g, fl, lw.walls.bounds, spawn_count)
+        except ArenaError as e:
+            problem = problem or str(e)
+            why[name] = "has room for no spawn point"
+            continue
+        if found is None or len(found[1]) < 2 <= len(sp):
+            found = (g, sp, fl)
+        if len(found[1]) >= 2:  # room for a duel; else a smaller vehicle may have more
+            break
+        why[name] = f"has room for only {len(sp)} spawn point"
     t["grid"] = time.perf_counter() - t0
     step("grid")
-    if not grid.valid.any():
-        widest = 2 * float(np.nanmax(np.where(surface.main, surface.clearance, 0.0)))
-        raise ArenaError(
-            f"no place where the largest bundled tank fits: {fleet.radius_of} needs a circle of "
-            f"{2 * fleet.radius:.2f} m, the walkable surface's widest spot is about {widest:.2f} m across "
-            f"(wrong --scale?)")
-    t0 = time.perf_counter()
-    spawns = choose_spawns(lw, grid, fleet, lw.walls.bounds, spawn_count)
-    t["spawns"] = time.perf_counter() - t0
+    if found is None:
+        if len(tries) == 1:
+            raise ArenaError(problem)
+        name, radius, _ = tries[-1]
+        raise ArenaError(f"no place where any bundled tank fits (the largest bundled tank, {tries[0][0]}, nor "
+                         f"the smallest): {_no_fit(surface, name, radius)}")
+    grid, spawns, fleet = found
+    too_big = [(n, why.get(n, "fits nowhere")) for n, r, _ in tries if r > fleet.radius]
+    t["spawns"] = 0.0
     step("spawns")
     t0 = time.perf_counter()
     levels = []
@@ -252,7 +280,14 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
     floor_y = _floor_y(lw, surface)
     t["report"] = time.perf_counter() - t0
     step("report")
-    return ArenaLevels(surface, params, lw, grid, spawns, levels, report, floor_y, flat, vertices, faces, t)
+    return ArenaLevels(surface, params, lw, grid, spawns, levels, report, floor_y, flat, vertices, faces, t,
+                       fleet, too_big)
+
+
+def _no_fit(surface: Surface, name: str, radius: float) -> str:
+    widest = 2 * float(np.nanmax(np.where(surface.main, surface.clearance, 0.0)))
+    return (f"no place where {name} fits: it needs a circle of {2 * radius:.2f} m, the walkable surface's "
+            f"widest spot is about {widest:.2f} m across (wrong --scale?)")
 
 
 def _floor_y(lw: LevelWalls, surface: Surface) -> float:

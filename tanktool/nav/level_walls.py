@@ -9,7 +9,8 @@ the level joined by links that stay on the level).  For each region:
 * where the region is flat (cells whose surface is a horizontal face at a height
   ``h`` shared by horizontal faces of the model), the exact free space ``E_h`` of
   today's 2002 cut replaces the cells near them (``M_h``: those cells grown by
-  ``MARGIN`` cells): the outline of the faces on the floor minus the model's cross
+  ``MARGIN`` cells, less the region's other cells: terrain or a ramp rising from the
+  floor or coming up to a deck is no obstacle of it): the outline of the faces on the floor minus the model's cross
   sections at ``h`` plus the cut height and at steps up to the headroom (overhangs);
   so a flat one-floor arena keeps exactly the walls of the cut, and a flat deck of a
   multi-level arena gets exact walls too;
@@ -18,7 +19,10 @@ the level joined by links that stay on the level).  For each region:
   pieces of half a cell; a piece across which the region's cells link to a cell of
   another level (the top of a ramp onto a deck) is a *portal*, not a wall;
 * open chains of the exact cut (zero-thickness walls) inside ``E_h & M_h`` are thin
-  walls, both ways.
+  walls, both ways;
+* so are *ledges*: edges between two cells of the region that do not link (a ramp's
+  side high above the ground beside it, a step too high across terrain), which the
+  outline passes by because both cells are in the region.  A drop-off is a wall.
 """
 
 from __future__ import annotations
@@ -40,9 +44,6 @@ SIMPLIFY = 0.6
 #: the foot of a steep obstacle (free below the cut, too low for a tank in the cells)
 #: can be two cells wide
 MARGIN = 2.5
-#: ... but not over cells of the region this much higher than the floor (m): terrain
-#: and ramps rising from it, which the cut would cross
-ABOVE = 0.3
 #: a thin wall of a higher cut within this of one already found is the same wall (m)
 THIN_MERGE = 0.15
 #: flat floors smaller than this (m^2) keep the cells' outline (stair treads)
@@ -263,6 +264,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
             V = shapely.simplify(V, SIMPLIFY * cell, preserve_topology=True)
             exact_parts, removed, chains_in = [], [], []
             used_h = []
+            floor = np.zeros_like(cells)  # cells of the exact floors (their walls are the cut's)
             flat_cells = cells & span_flat[level]
             if flat_cells.any() and len(flat_h):
                 hy = height[level][flat_cells]
@@ -286,11 +288,14 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
                     # the rims of steep obstacles standing on this floor (walkable only
                     # because they rise less than the climb) belong to it too
                     mask |= rim & (np.abs(height[level] - flat_h[c]) <= climb_m)
+                    floor |= mask
                     sub, sub_origin = _crop(mask, _mask_box(mask, origin, cell, MARGIN + 1), origin, cell)
                     M = shapely.buffer(cells_polygon(sub, sub_origin, cell, tolerance), MARGIN * cell,
                                        join_style="mitre")
                     box = M.bounds
-                    rising = _crop(cells & ~mask & (height[level] > flat_h[c] + ABOVE), box, origin, cell)
+                    # the region's other cells (terrain, ramps rising from the floor or
+                    # coming up to a deck) are no obstacle of this floor: their outline stays
+                    rising = _crop(cells & ~mask, box, origin, cell)
                     if rising is not None:
                         M = shapely.difference(M, cells_polygon(rising[0], rising[1], cell, tolerance))
                     E, chains = cuts.at(float(flat_h[c]), box, base)
@@ -327,6 +332,9 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
                     near = shapely.buffer(shapely.multilinestrings(list(t)), THIN_MERGE, cap_style="flat")
                     taken = near if taken is None else shapely.union(taken, near)
             thin = _unique_segments(np.concatenate(thin), tolerance) if thin else np.zeros((0, 2, 2))
+            ledges = ledge_walls(cells, same[level], origin, cell, cells & ~floor)
+            if len(ledges):
+                thin = np.concatenate([thin, ledges])
             segs = np.concatenate([outline, thin, thin[:, ::-1]]) if len(thin) else outline
             thin_total += 2 * len(thin)
             out_seg.append(segs)
@@ -345,6 +353,48 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     hi = pts.max(axis=0) + AUX_MARGIN
     walls.aux = aux_rectangle(lo[0], lo[1], hi[0], hi[1])
     return LevelWalls(walls, regions, thin_total, portal_len)
+
+
+def ledge_walls(cells: np.ndarray, same: np.ndarray, origin: np.ndarray, cell: float,
+                loose: np.ndarray | None = None) -> np.ndarray:
+    """Walls across the *ledges* of a region: between two of its cells side by side
+    that do not link (a ramp's side high above the ground beside it, a step too high
+    across terrain), and along the middle of a one-cell gap between two of its cells
+    (Recast's ledge filter takes the rim of a ramp's side off the surface).  The
+    region's outline misses both, as the cells on either side are in it and the exact
+    floor beside a ramp reaches up to its side.  Only where one side at least is in
+    ``loose`` (cells off the exact floors, whose cut draws their walls; default all).
+    Runs along a row or column are one segment each; (k, 2, 2), one way."""
+    out = []
+    loose = cells if loose is None else loose
+    for axis in (1, 0):  # lines across +x (x = const), then across +z (z = const)
+        c = cells if axis == 1 else cells.T
+        lo_ = loose if axis == 1 else loose.T
+        sm = same if axis == 1 else same.transpose(1, 0, 2)
+        fwd_d, back_d = (0, 2) if axis == 1 else (1, 3)
+        n = c.shape[1]
+        edges = []
+        if n >= 2:   # neighbours not linked: the line between column k and k + 1
+            e = c[:, :-1] & c[:, 1:] & ~(sm[:, :-1, fwd_d] & sm[:, 1:, back_d]) & (lo_[:, :-1] | lo_[:, 1:])
+            edges.append((e, 1.0))
+        if n >= 3:   # a one-cell gap: the line through the middle of column k + 1
+            e = c[:, :-2] & ~c[:, 1:-1] & c[:, 2:] & (lo_[:, :-2] | lo_[:, 2:])
+            edges.append((e, 1.5))
+        for e, shift in edges:
+            if not e.any():
+                continue
+            lines = e.T                                 # rows: the lines, along them the runs
+            pad = np.zeros((lines.shape[0], lines.shape[1] + 2), dtype=np.int8)
+            pad[:, 1:-1] = lines
+            dif = np.diff(pad, axis=1)
+            line, start = np.nonzero(dif == 1)
+            _, stop = np.nonzero(dif == -1)
+            pos = (line + shift) * cell
+            lo, hi = start * cell, stop * cell
+            a = np.column_stack([pos, lo]) if axis == 1 else np.column_stack([lo, pos])
+            b = np.column_stack([pos, hi]) if axis == 1 else np.column_stack([hi, pos])
+            out.append(np.stack([a, b], axis=1) + origin)
+    return np.concatenate(out) if out else np.zeros((0, 2, 2))
 
 
 def _unique_segments(seg: np.ndarray, tolerance: float) -> np.ndarray:

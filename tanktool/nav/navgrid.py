@@ -86,6 +86,7 @@ class NavGrid:
     spawn_nodes: list[Node] = field(default_factory=list)
     height: np.ndarray | None = None
     link: np.ndarray | None = None
+    layers: "NavGrid | None" = None  # a 2-D projection's layered grid (the agents' on a ground); not saved
 
     # ------------------------------------------------------------ levels
     @property

@@ -143,6 +143,9 @@ class NetMatch:
             tank.x, tank.z, tank.heading = s.x, s.z, s.heading
             tank.vx, tank.vz, tank.omega = s.vx, s.vz, s.omega
             tank.c, tank.s = math.cos(s.heading), math.sin(s.heading)
+            # on a ground: height, level and tilt from where it now is, on the level
+            # nearest its last height (states carry no height: the path is continuous)
+            self.world.stand(tank, tank.y)
             tank.hp = s.hp
             tank.alive = s.alive
             tank.respawn_at = math.inf
@@ -150,11 +153,14 @@ class NetMatch:
     def _remote_shot(self, shot: P.Shot) -> None:
         """Launch a remote tank's shell from the pose it fired from."""
         tank = self.world.tanks[shot.tank - 1]
-        saved = (tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s)
+        saved = (tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s, tank.y, tank.level, tank.pitch,
+                 tank.roll)
         tank.x, tank.z, tank.heading, tank.vx, tank.vz = shot.x, shot.z, shot.heading, shot.vx, shot.vz
         tank.c, tank.s = math.cos(shot.heading), math.sin(shot.heading)
+        self.world.stand(tank, tank.y)    # the height and pitch it fired at
         self.world.shells.append(fire(tank, self.world.walls, self.world.ground))
-        tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s = saved
+        (tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s, tank.y, tank.level, tank.pitch,
+         tank.roll) = saved
 
     def _on_net(self, events: list) -> None:
         for ev in events:
@@ -197,7 +203,7 @@ class NetMatch:
         tanks = {}
         for n in sorted(self.peer.table):
             t = self.world.tanks[n - 1]
-            tanks[str(n)] = [round(t.x, 3), round(t.z, 3), bool(t.alive)]
+            tanks[str(n)] = [round(t.x, 3), round(t.z, 3), bool(t.alive), round(t.y, 3)]
         self.views.append({"t": second, "tanks": tanks})
 
     def step(self) -> list:

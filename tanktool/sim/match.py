@@ -190,7 +190,8 @@ def make_report(world: World, arena: str, vehicle: str, seed: int, events: list)
         tanks.append({
             "name": t.name, "vehicle": t.spec.name, "kills": t.kills, "deaths": t.deaths,
             "shots": t.shots, "hits": t.hits, "wall_bumps": t.wall_bumps,
-            "distance": _r(t.distance, 2), "position": [_r(x), _r(z)], "heading": _r(t.heading, 4),
+            "distance": _r(t.distance, 2), "position": [_r(x), _r(z)], "height": _r(t.y),
+            "heading": _r(t.heading, 4),
             "hit_points": _r(max(t.hp, 0.0), 2), "alive": t.alive,
         })
     ranking = sorted(tanks, key=lambda d: (-d["kills"], d["deaths"], names.index(d["name"])))

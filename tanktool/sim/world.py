@@ -39,6 +39,8 @@ INTEGRATORS = ("semi-implicit", "euler")
 EVENT_KINDS = ("shot", "hit", "kill", "wall_bump", "respawn")
 #: a wall contact after this long without one counts as a new bump [s]
 BUMP_GAP = 0.25
+#: eye height over the surface of a point of sight given without one [m]
+EYE = 1.2
 TWO_PI = 2.0 * math.pi
 #: the engine's pull fades from full to nothing over the last 1/FADE of the top speed
 FADE = 20.0
@@ -155,7 +157,7 @@ class World:
             x, z, h = self.spawns[order[i]]
             t = Tank(i, spec, 0.0, 0.0, h, name=names[i] if names else None)
             t.place(x, z, h)
-            self._stand(t, self.spawn_y[order[i]])
+            self.stand(t, self.spawn_y[order[i]])
             self.tanks.append(t)
         self.shells: list[Shell] = []
         self.t = 0.0
@@ -179,7 +181,12 @@ class World:
         self.integrate(dt)
         self.vertices()
         collisions = self.detect_collisions(range(len(self.tanks)), with_shells=True)
+        if self.ground is None:
+            self.resolve_collisions(collisions, events)
+            return events
+        before = [(t.x, t.z) for t in self.tanks]
         self.resolve_collisions(collisions, events)
+        self._contain(before)
         return events
 
     @property
@@ -513,7 +520,7 @@ class World:
         k = self.rng.choice(free) if free else best
         x, z, h = self.spawns[k]
         t.place(x, z, h)
-        self._stand(t, self.spawn_y[k])
+        self.stand(t, self.spawn_y[k])
         t.hp = t.spec.hit_points
         t.alive = True
         t.reload = 0.0
@@ -543,6 +550,29 @@ class World:
             self.level_walls.append(WallSet(part, QuadtreeIndex(tree) if tree is not None else None))
             self._wall_y.append(ys)
 
+    def eye(self, t: Tank) -> float:
+        """World y a tank looks from (and is seen at): its gun's height over its base."""
+        return t.y + t.spec.muzzle_local[1]
+
+    def line_blocked(self, ax: float, az: float, bx: float, bz: float,
+                     ay: float | None = None, by: float | None = None) -> bool:
+        """Whether a line of sight from (ax, ay, az) to (bx, by, bz) is blocked: by a
+        wall on a flat arena (the 2002 walls, infinitely tall; heights unused), by the
+        model's solid on a ground (terrain, decks, ceilings, walls; a height left out is
+        eye height over the lowest surface there)."""
+        g = self.ground
+        if g is None or g.mesh is None:
+            return self.walls.blocked(ax, az, bx, bz)
+        if ay is None:
+            ay = g.height(ax, az, max(g.locate(ax, az), 0)) + EYE
+        if by is None:
+            by = g.height(bx, bz, max(g.locate(bx, bz), 0)) + EYE
+        return g.solids.blocked((ax, ay, az), (bx, by, bz))
+
+    def sees(self, a: Tank, b: Tank) -> bool:
+        """Whether nothing stands between two tanks' eyes (range and cone aside)."""
+        return not self.line_blocked(a.x, a.z, b.x, b.z, self.eye(a), self.eye(b))
+
     def walls_of(self, t: Tank) -> WallSet:
         """The walls a tank can hit: its level's (all walls on a flat arena)."""
         if self.ground is None or not self.level_walls:
@@ -560,9 +590,11 @@ class World:
             cand = [k for k in cand if ys[k][0] - tol <= t.y <= ys[k][1] + tol]
         return (t.x, t.z, cand, t.level)
 
-    def _stand(self, t: Tank, y: float | None) -> None:
+    def stand(self, t: Tank, y: float | None) -> None:
         """Put a tank on the ground under it: its level (the one nearest ``y``), height
-        and tilt."""
+        and tilt (nothing on a flat arena).  For a tank placed from outside the step (a
+        network peer's state, a test): the nearest level to where it was keeps it on
+        its deck or under it."""
         g = self.ground
         if g is None:
             return
@@ -575,6 +607,20 @@ class World:
     def _tilt(self, t: Tank) -> None:
         bx0, bz0, bx1, bz1 = t.spec.box
         t.y, t.pitch, t.roll = self.ground.tilt(t.x, t.z, t.level, t.c, t.s, 0.5 * (bx1 - bx0), 0.5 * (bz1 - bz0))
+
+    def _contain(self, before: list[tuple[float, float]]) -> None:
+        """After the collision pushes: a push that would carry a tank's centre off the
+        walkable surface keeps only its part along the surface (containment wins over
+        the push, as a wall would), and a moved tank stands at its new place."""
+        for t, (x0, z0) in zip(self.tanks, before):
+            if not t.alive or (t.x == x0 and t.z == z0):
+                continue
+            dx, dz = t.x - x0, t.z - z0
+            t.x, t.z = x0, z0
+            dx, dz = self._keep_on_ground(t, dx, dz)
+            t.x += dx
+            t.z += dz
+            self._tilt(t)
 
     def _keep_on_ground(self, t: Tank, dx: float, dz: float) -> tuple[float, float]:
         """The part of a move (dx, dz) that keeps the tank's centre on the walkable
@@ -590,6 +636,14 @@ class World:
         if lv >= 0:
             t.level = lv
             return dx, dz
+        if g.node_height(t.level, i0, j0) is None:
+            # off the surface already (placed there by hand, a spawn on its edge): any
+            # move onto a node near its height is a way back, others are refused
+            lv = g.locate(t.x + dx, t.z + dz, t.y)
+            hv = g.node_height(lv, i1, j1) if lv >= 0 else None
+            if hv is not None and abs(hv - t.y) <= g.climb:
+                t.level = lv
+                return dx, dz
         # refused: slide along whichever axis is still open
         for keep_x in (abs(dx) >= abs(dz), abs(dx) < abs(dz)):
             ii, jj = g.cell_of(t.x + (dx if keep_x else 0.0), t.z + (0.0 if keep_x else dz))

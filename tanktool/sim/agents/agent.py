@@ -69,7 +69,7 @@ from ...nav.navgrid import nearest_valid_node
 from ...nav.steering import heading_from_angle
 from ..commands import IDLE, Command
 from .fuzzy import PREDICT, AttackController, FIRE_THRESHOLD
-from .navigation import (Coverage, Memory, SearchPlan, Vantages, Wanderer, agent_grid, plan_path, vantages_for,
+from .navigation import (EYE, Coverage, Memory, SearchPlan, Vantages, Wanderer, agent_grid, plan_path, vantages_for,
                          views_for)
 from .perception import Senses, Sighting, wrap
 
@@ -258,7 +258,7 @@ class Agent:
             self._setup(world, tank)
         t = world.t
         self.memory.visit(tank.x, tank.z, t)  # type: ignore[union-attr]
-        self.coverage.look(tank.x, tank.z, tank.heading, t)  # type: ignore[union-attr]
+        self.coverage.look(tank.x, tank.z, tank.heading, t, tank.y)  # type: ignore[union-attr]
         previous = self.senses.last_seen.get(self.target) if self.target is not None else None
         seen = self.senses.look(world, tank)
         heard = self.senses.listen(world, tank)
@@ -278,7 +278,7 @@ class Agent:
             self.target = sight.index
 
         if self.state != "evade" and sight is None and len(self.hits) >= 2 and t >= self.evade_cooldown:
-            threat = (sight.x, sight.z) if sight else self._estimate(t)
+            threat = (sight.x, sight.z, sight.y) if sight else self._estimate(t)
             if threat is not None:
                 self._start_evade(world, tank, threat, t)
         if self.state == "evade":
@@ -286,7 +286,7 @@ class Agent:
             if cmd is not None:
                 return self._unstick(world, tank, cmd)
             self.evade_cooldown = t + 8.0
-            self._start_search(self.threat or (tank.x, tank.z), t)
+            self._start_search(self.threat or (tank.x, tank.z, tank.y), t)
         if sight is None and self.state != "attack":
             cmd = self._return_fire(world, tank)
             if cmd is not None:
@@ -301,15 +301,15 @@ class Agent:
                 self._enter("wander", t)
             else:
                 est = self._estimate(t)
-                self._start_search(est if est is not None else (tank.x, tank.z), t)
+                self._start_search(est if est is not None else (tank.x, tank.z, tank.y), t)
         elif sight is None and self.state in ("wander", "watch"):
             if heard is not None:
-                self._start_search((heard.x, heard.z), t)
+                self._start_search((heard.x, heard.z, heard.y), t)
             elif self.hits and self.hits[-1] == t:
                 # hit by something unseen: look behind
-                self._start_search((tank.x - 20.0 * tank.c, tank.z - 20.0 * tank.s), t)
+                self._start_search((tank.x - 20.0 * tank.c, tank.z - 20.0 * tank.s, tank.y), t)
         elif sight is None and self.state == "search" and heard is not None and t - self.state_since > 2.0:
-            self._start_search((heard.x, heard.z), t)
+            self._start_search((heard.x, heard.z, heard.y), t)
         if self.state == "search":
             cmd = self._search(world, tank)
             if cmd is not None:
@@ -345,15 +345,16 @@ class Agent:
                 return s
         return seen[0] if seen else None
 
-    def _estimate(self, t: float) -> tuple[float, float] | None:
-        """Where the enemy probably is: last seen moved on (up to 2 s), or last heard."""
+    def _estimate(self, t: float) -> tuple[float, float, float | None] | None:
+        """Where the enemy probably is, (x, z, height): last seen moved on (up to 2 s),
+        or last heard."""
         s = self.senses.last_seen.get(self.target) if self.target is not None else None
         h = self.senses.heard
         if s is not None and (h is None or s.t >= h.t):
             dt = min(t - s.t, 2.0)
-            return s.x + s.vx * dt, s.z + s.vz * dt
+            return s.x + s.vx * dt, s.z + s.vz * dt, s.y
         if h is not None:
-            return h.x, h.z
+            return h.x, h.z, h.y
         return None
 
     # ------------------------------------------------------------------ wander
@@ -374,11 +375,11 @@ class Agent:
             if not arrived:
                 return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
             self.path = []
-        best = cov.goal(x, z, t)
+        best = cov.goal(x, z, t, y=tank.y)
         if best is not None:
             cell, gain = best
             gx, gz = self.views.points[cell]
-            path = plan_path(self.grid, (x, z), (float(gx), float(gz)))
+            path = plan_path(self.grid, (x, z, tank.y), (float(gx), float(gz), float(self.views.heights[cell])))
             if path:
                 self.path, self.goal_cell, self.goal_gain, self.recheck = path, cell, gain, t + 1.0
                 return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
@@ -413,8 +414,9 @@ class Agent:
         return self._follow(world, tank, self.route, speed=0.85, lookahead=6.0)
 
     # ------------------------------------------------------------------ search
-    def _start_search(self, where: tuple[float, float], t: float) -> None:
-        self.plan = SearchPlan(self.grid, where[0], where[1])  # type: ignore[arg-type]
+    def _start_search(self, where: tuple[float, ...], t: float) -> None:
+        """Search from (x, z) or (x, z, height) (the height: which level first)."""
+        self.plan = SearchPlan(self.grid, where[0], where[1], y=where[2] if len(where) > 2 else None)  # type: ignore[arg-type]
         self.path, self.goal = [], None
         self.state = "wander"  # so _enter resets the route
         self._enter("search", t)
@@ -434,7 +436,7 @@ class Agent:
             self.goal = self.plan.next_goal(self.memory, t)
             if self.goal is None:
                 return None
-            self.path = plan_path(self.grid, (x, z), self.goal)  # type: ignore[arg-type]
+            self.path = plan_path(self.grid, (x, z, tank.y), self.goal)  # type: ignore[arg-type]
         trim(self.path, x, z)
         return self._follow(world, tank, self.path, speed=0.9, lookahead=4.0, corner=self._corner(tank))
 
@@ -500,17 +502,20 @@ class Agent:
             self.spot_replan = min(self.spot_replan, self.spot_chosen + 2.0)
         if self.spot is None or t >= self.spot_replan or lead != self.spot_ambush:
             self.spot_replan, self.spot_chosen, self.spot_ambush = t + 5.0, t, lead
-            here = self.views.cell_at(x, z)  # type: ignore[union-attr]
+            here = self.views.cell_at(x, z, tank.y)  # type: ignore[union-attr]
             if lead:
-                away = self.views.cell_at(noise.x, noise.z) if noise is not None else -1  # type: ignore[union-attr]
+                away = self.views.cell_at(noise.x, noise.z, noise.y) if noise is not None else -1  # type: ignore[union-attr]
                 cell, face = v.safest(here, AMBUSH_PER_M, away, AMBUSH_AWAY, AMBUSH_AWAY_CAP)
             else:
                 cell, face = v.best(here, WATCH_PER_M)
+            if cell < 0:            # off the map (no valid node near): nothing to watch from
+                self.spot = None
+                return None
             spot = tuple(float(c) for c in self.views.points[cell])  # type: ignore[union-attr]
             self.spot_face = face
             if spot != self.spot or not self.spot_path:
                 self.spot = spot  # type: ignore[assignment]
-                self.spot_path = plan_path(self.grid, (x, z), spot)  # type: ignore[arg-type]
+                self.spot_path = plan_path(self.grid, (x, z, tank.y), (*spot, float(self.views.heights[cell])))  # type: ignore[arg-type]
         gx, gz = self.spot  # type: ignore[misc]
         path = self.spot_path
         if math.hypot(gx - x, gz - z) > 2.5 and path:
@@ -521,7 +526,7 @@ class Agent:
         face = self.spot_face
         if lead and h is not None and t - h.t < 3.0:
             if self.faced is None or self.faced[0] is not h:
-                path = plan_path(self.grid, (x, z), (h.x, h.z))  # type: ignore[arg-type]
+                path = plan_path(self.grid, (x, z, tank.y), (h.x, h.z, h.y))  # type: ignore[arg-type]
                 q = next((q for q in path if math.hypot(q[0] - x, q[1] - z) >= 6.0), path[-1] if path else (h.x, h.z))
                 self.faced = (h, math.atan2(q[1] - z, q[0] - x))
             face = self.faced[1]
@@ -538,7 +543,7 @@ class Agent:
         t = world.t
         h = self.senses.heard            # the shot: fired up to half a second before the hit
         if self.hits and self.hits[-1] == t and h is not None and not h.engine and t - h.t < 0.5 \
-                and not world.walls.blocked(tank.x, tank.z, h.x, h.z):
+                and not world.line_blocked(tank.x, tank.z, h.x, h.z, world.eye(tank), _eye(h.y)):
             self.return_to = (math.atan2(h.z - tank.z, h.x - tank.x), t + RETURN_FIRE)
         face, until = self.return_to
         err = wrap(face - tank.heading)
@@ -548,7 +553,7 @@ class Agent:
         return self._drive(world, tank, 0.0, 0.0, self._turn(tank, err))
 
     # ------------------------------------------------------------------ evade
-    def _start_evade(self, world: "World", tank: "Tank", threat: tuple[float, float], t: float) -> None:
+    def _start_evade(self, world: "World", tank: "Tank", threat: tuple[float, ...], t: float) -> None:
         self.threat = threat
         self.state = "wander"
         self._enter("evade", t)
@@ -556,10 +561,11 @@ class Agent:
         self.path = []
         cover = self._cover(world, tank, threat)
         if cover is not None:
-            self.path = plan_path(self.grid, (tank.x, tank.z), cover)  # type: ignore[arg-type]
+            self.path = plan_path(self.grid, (tank.x, tank.z, tank.y), cover)  # type: ignore[arg-type]
 
-    def _cover(self, world: "World", tank: "Tank", threat: tuple[float, float]) -> tuple[float, float] | None:
-        """The nearest of a few sampled nodes 5-25 m away that the threat cannot see."""
+    def _cover(self, world: "World", tank: "Tank", threat: tuple[float, ...]) -> tuple[float, float] | None:
+        """The nearest of a few sampled nodes 5-25 m away that the threat (x, z and
+        maybe its height) cannot see."""
         grid = self.grid
         i, j = grid.node_of(tank.x, tank.z)  # type: ignore[union-attr]
         r = int(25.0 / grid.cell)  # type: ignore[union-attr]
@@ -573,7 +579,8 @@ class Agent:
             m = self.rng.randrange(len(a))
             cx, cz = grid.centre(int(a[m]) + i0, int(b[m]) + j0)  # type: ignore[union-attr]
             d = math.hypot(cx - tank.x, cz - tank.z)
-            if 5.0 <= d < best_d and world.walls.blocked(threat[0], threat[1], cx, cz):
+            if 5.0 <= d < best_d and world.line_blocked(threat[0], threat[1], cx, cz,
+                                                         _eye(threat[2] if len(threat) > 2 else None)):
                 best, best_d = (cx, cz), d
         return best
 
@@ -640,7 +647,7 @@ class Agent:
         best = length
         for o in offsets:
             ox, oz = tank.x - s * o, tank.z + c * o
-            hit = world.walls.first_hit(ox, oz, ox + c * length, oz + s * length)
+            hit = world.walls_of(tank).first_hit(ox, oz, ox + c * length, oz + s * length)
             if hit is not None:
                 best = min(best, hit[0] * length)
         return best
@@ -679,8 +686,9 @@ class Agent:
         # in place sweeps the whole footprint circle, and attack moves go anywhere
         push = spec.radius + 1.5
         px = pz = 0.0
-        for k in world.walls.near(tank.x, tank.z, push):
-            w = world.walls.walls[k]
+        walls = world.walls_of(tank)
+        for k in walls.near(tank.x, tank.z, push):
+            w = walls.walls[k]
             ax, az, ex, ez, l2, _ = w  # type: ignore[misc]
             u = min(max(((tank.x - ax) * ex + (tank.z - az) * ez) / l2, 0.0), 1.0)
             dx, dz = tank.x - (ax + u * ex), tank.z - (az + u * ez)
@@ -727,6 +735,11 @@ class Agent:
             self.route, self.walker, self.path, self.spot_path = [], None, [], []
             return self._drive(world, tank, -4.0, 0.0, self.reverse_turn)
         return cmd
+
+
+def _eye(y: float | None) -> float | None:
+    """The eye height over a tank standing at ``y`` (None: not known)."""
+    return None if y is None else y + EYE
 
 
 def trim(path: list[tuple[float, float]], x: float, z: float, reach: float = 3.0) -> None:

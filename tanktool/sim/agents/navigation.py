@@ -46,37 +46,72 @@ from typing import TYPE_CHECKING, Iterator
 
 import numpy as np
 
-from ...nav.navgrid import NavGrid, Node, STEPS, grid_from_mask, grid_shape, nearest_valid_node, reachable_from, too_close
+from ...nav.navgrid import (NavGrid, Node, STEPS, grid_from_mask, grid_shape, nearest_valid_node, nearest_valid_node3,
+                            reachable_from, too_close)
 from ...nav.path import find_path
 from ...nav.steering import children, decide, heading_of_move
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..world import World
 
+#: on a ground, the eye height of a block's point [m], the blocks at most (each line of
+#: the sight map is sampled through the model's solid), and how far they look [m]
+EYE = 1.2
+VIEW_BLOCKS = 450
+VIEW_RANGE = 150.0
+#: the link steps (di, dj): +x, +z, -x, -z
+STEP_LIST = ((0, 1), (1, 0), (0, -1), (-1, 0))
+
 _GRIDS: "weakref.WeakKeyDictionary[object, dict[tuple[float, float], NavGrid]]" = weakref.WeakKeyDictionary()
 
 
+#: an agent grid keeps the asked clearance, else the largest of these fractions of it
+#: that leaves valid nodes by a spawn (a corridor or deck barely wider than the tank)
+FALLBACK = (0.85, 0.7, 0.55, 0.4, 0.25, 0.0)
+
+
 def agent_grid(world: "World", cell: float, clearance: float) -> NavGrid:
-    """The navigation grid agents of this clearance use in ``world`` (cached per wall set)."""
-    per = _GRIDS.setdefault(world.walls, {})
+    """The navigation grid agents of this clearance use in ``world`` (cached per wall
+    set, or per ground on an arena with relief or levels: then a projection carrying
+    the layered grid as ``.layers``, see ``agents.layers``).
+
+    Where the clearance leaves no valid node by any spawn (an arena barely wider than
+    the tank), the grid is made again with less (``FALLBACK``), down to every node off
+    the walls: its ``clearance`` says which it kept.  Agents then plan as close to the
+    walls as they must; the physics keeps them out."""
+    per = _GRIDS.setdefault(world.ground if world.ground is not None else world.walls, {})
     key = (float(cell), float(clearance))
     if key not in per:
-        bounds = np.asarray(world.bounds, dtype=np.float64)
-        shape = grid_shape(bounds, cell)
-        origin = bounds[0].copy()
-        free = ~too_close(world.walls.segments, origin, cell, shape, clearance)
-        g0 = grid_from_mask(free, origin, cell)
-        seeds = []
-        for x, z, _ in world.spawns:
-            n = nearest_valid_node(free, g0.node_of(x, z), int(math.ceil(clearance / cell)) + 2)
-            if n is not None:
-                seeds.append(n)
-        valid = reachable_from(free, seeds) if seeds else free
-        grid = grid_from_mask(valid, origin, cell)
-        grid.clearance = float(clearance)
-        grid.spawn_nodes = seeds
+        grid = None
+        for c in (clearance, *(clearance * f for f in FALLBACK)):
+            grid = _make_grid(world, cell, c)
+            if grid.spawn_nodes and grid.valid.any():
+                break
         per[key] = grid
     return per[key]
+
+
+def _make_grid(world: "World", cell: float, clearance: float) -> NavGrid:
+    if world.ground is not None:
+        from .layers import ground_agent_grid
+
+        spawns = [(x, z, y) for (x, z, _), y in zip(world.spawns, world.spawn_y)]
+        return ground_agent_grid(world.ground, cell, clearance, spawns)
+    bounds = np.asarray(world.bounds, dtype=np.float64)
+    shape = grid_shape(bounds, cell)
+    origin = bounds[0].copy()
+    free = ~too_close(world.walls.segments, origin, cell, shape, clearance)
+    g0 = grid_from_mask(free, origin, cell)
+    seeds = []
+    for x, z, _ in world.spawns:
+        n = nearest_valid_node(free, g0.node_of(x, z), int(math.ceil(clearance / cell)) + 2)
+        if n is not None:
+            seeds.append(n)
+    valid = reachable_from(free, seeds) if seeds else free
+    grid = grid_from_mask(valid, origin, cell)
+    grid.clearance = float(clearance)
+    grid.spawn_nodes = seeds
+    return grid
 
 
 class Memory:
@@ -237,21 +272,54 @@ def leaf_goal(grid: NavGrid, r: Rect) -> tuple[float, float] | None:
     return gx, gz
 
 
-class SearchPlan:
-    """The quadrant search from an estimate (x, z): goals in the paper's order."""
+def leaf_goals_layered(grid: NavGrid, r: Rect, y: float | None) -> list[tuple[float, float, float]]:
+    """Per level of a layered grid, the valid node inside the quadrant nearest its
+    centre, as (x, z, height); the level nearest height ``y`` first (else the lowest)."""
+    x0, z0, x1, z1 = r
+    cx, cz = 0.5 * (x0 + x1), 0.5 * (z0 + z1)
+    steps = int(math.ceil(max(x1 - x0, z1 - z0) / (2 * grid.cell)))
+    valid, height = grid.layered("valid"), grid.layered("height")
+    out = []
+    for lv in range(valid.shape[0]):
+        n = nearest_valid_node(valid[lv], grid.node_of(cx, cz), steps)
+        if n is None:
+            continue
+        gx, gz = grid.centre(*n)
+        if x0 <= gx <= x1 and z0 <= gz <= z1:
+            out.append((gx, gz, float(height[lv][n])))
+    out.sort(key=lambda g: abs(g[2] - y) if y is not None else g[2])
+    return out
 
-    def __init__(self, grid: NavGrid, x: float, z: float, leaf: float = 30.0) -> None:
+
+class SearchPlan:
+    """The quadrant search from an estimate (x, z): goals in the paper's order.  On a
+    layered grid (``grid.layers``) each quadrant is searched on every level it holds,
+    the estimate's level (height ``y``) first; goals are then (x, z, height)."""
+
+    def __init__(self, grid: NavGrid, x: float, z: float, leaf: float = 30.0, y: float | None = None) -> None:
         self.grid = grid
         (bx0, bz0), (bx1, bz1) = grid.bounds.tolist()
-        first = nearest_valid_node(grid.valid, grid.node_of(x, z), int(math.ceil(6.0 / grid.cell)))
-        self.goals: list[tuple[float, float]] = [grid.centre(*first)] if first is not None else []
+        layers = grid.layers
+        self.goals: list[tuple[float, ...]] = []
+        if layers is not None:
+            first3 = nearest_valid_node3(layers.layered("valid"), layers.layered("height"), layers.node_of(x, z), y,
+                                         int(math.ceil(6.0 / grid.cell)))
+            if first3 is not None:
+                lv, i, j = first3
+                self.goals = [(*layers.centre(i, j), float(layers.layered("height")[first3]))]
+        else:
+            first = nearest_valid_node(grid.valid, grid.node_of(x, z), int(math.ceil(6.0 / grid.cell)))
+            self.goals = [grid.centre(*first)] if first is not None else []
         for r in search_order((bx0, bz0, bx1, bz1), x, z, leaf):
+            if layers is not None:
+                self.goals.extend(leaf_goals_layered(layers, r, y))
+                continue
             g = leaf_goal(grid, r)
             if g is not None:
                 self.goals.append(g)
         self.k = 0
 
-    def next_goal(self, memory: Memory | None, t: float, fresh: float = 25.0) -> tuple[float, float] | None:
+    def next_goal(self, memory: Memory | None, t: float, fresh: float = 25.0) -> tuple[float, ...] | None:
         """The next goal not visited within ``fresh`` seconds; None when all are done."""
         while self.k < len(self.goals):
             g = self.goals[self.k]
@@ -261,10 +329,63 @@ class SearchPlan:
         return None
 
 
-def plan_path(grid: NavGrid, start: tuple[float, float], goal: tuple[float, float]) -> list[tuple[float, float]]:
-    """A* waypoints from start to goal (the first, our position, dropped); [] when none."""
-    pts = find_path(grid, start, goal, snap=int(math.ceil(4.0 / grid.cell)))
+def plan_path(grid: NavGrid, start: tuple[float, ...], goal: tuple[float, ...]) -> list[tuple[float, float]]:
+    """A* waypoints from start to goal (the first, our position, dropped); [] when none.
+
+    Points are (x, z) or (x, z, y): on a layered grid (``grid.layers``) the height
+    picks the level at each end (the lowest when left out) and the path may change
+    levels along the grid's links."""
+    snap = int(math.ceil(4.0 / grid.cell))
+    if grid.layers is not None:
+        return _plan_layered(grid.layers, start, goal, snap)
+    pts = find_path(grid, start[:2], goal[:2], snap=snap)
     return [(float(x), float(z)) for x, z in pts[1:]]
+
+
+def _plan_layered(grid: NavGrid, start: tuple[float, ...], goal: tuple[float, ...], snap: int) -> list[tuple[float, float]]:
+    """plan_path on a layered grid: A* across levels, then within each stretch on one
+    level the corners the grid's line of sight lets it cut."""
+    from ...nav.path import astar_layered, grid_line_of_sight
+
+    valid, height = grid.layered("valid"), grid.layered("height")
+    ends = []
+    for p in (start, goal):
+        y = float(p[2]) if len(p) > 2 and p[2] is not None and math.isfinite(p[2]) else None
+        n = nearest_valid_node3(valid, height, grid.node_of(p[0], p[1]), y, snap)
+        if n is None:
+            return []
+        ends.append(n)
+    nodes = astar_layered(grid, ends[0], ends[1])
+    if not nodes:
+        return []
+    kept = [nodes[0]]
+    for k in range(1, len(nodes) - 1):
+        a, b = kept[-1], nodes[k + 1]
+        if a[0] == b[0] == nodes[k][0] and grid_line_of_sight(grid, a[1:], b[1:], valid[a[0]]):
+            continue
+        kept.append(nodes[k])
+    kept.append(nodes[-1])
+    out = [grid.centre(i, j) for _, i, j in kept[1:-1]]
+    return [(float(x), float(z)) for x, z in out] + [(float(goal[0]), float(goal[1]))]
+
+
+def _wall_visibility(p: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """(n, n) line of sight between points: no wall crosses the segment (the test of
+    ``perception.can_see``, for all pairs at once)."""
+    n = len(p)
+    seg = np.asarray(segments, dtype=np.float64).reshape(-1, 2, 2)
+    w0, e = seg[:, 0], seg[:, 1] - seg[:, 0]
+    vis = np.zeros((n, n), dtype=bool)
+    for a in range(n):
+        r = p - p[a]                                      # (n, 2)
+        q = w0 - p[a]                                     # (m, 2)
+        den = r[:, None, 0] * e[None, :, 1] - r[:, None, 1] * e[None, :, 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = (q[None, :, 0] * e[None, :, 1] - q[None, :, 1] * e[None, :, 0]) / den
+            u = (q[None, :, 0] * r[:, None, 1] - q[None, :, 1] * r[:, None, 0]) / den
+        cross = (den != 0.0) & (s >= 0.0) & (s <= 1.0) & (u >= 0.0) & (u <= 1.0)
+        vis[a] = ~cross.any(axis=1)
+    return vis
 
 
 # ------------------------------------------------------------------ what was seen
@@ -276,84 +397,110 @@ class Views:
     the same test as ``perception.can_see``, for all pairs at once), their distances,
     and which blocks touch (a valid node of one 4-adjacent to a valid node of the other).
     Built once per (walls, grid) and cached: it is the map, not anything seen.
+
+    On a layered grid (``grid.layers``) a block is a square *on one level* (the deck
+    and the passage under it are two), its point stands at eye height over its node,
+    lines of sight run in 3D through the model's solid (``solids``: a
+    ``sim.ground.SolidField``) and blocks touch along the grid's links.
     """
 
-    def __init__(self, grid: NavGrid, segments: np.ndarray, block: float = 4.0, max_blocks: int = 700) -> None:
-        valid = np.asarray(grid.valid, dtype=bool)
+    def __init__(self, grid: NavGrid, segments: np.ndarray, block: float = 4.0, max_blocks: int = 700,
+                 solids=None) -> None:
+        layers = grid.layers
+        base = layers if layers is not None else grid
+        valid = np.asarray(base.layered("valid"), dtype=bool)   # (L, nz, nx): L = 1 on a flat grid
+        L, nz, nx = valid.shape
         k = max(int(round(block / grid.cell)), 1)
         while True:
-            bz, bx = -(-valid.shape[0] // k), -(-valid.shape[1] // k)
-            pad = np.zeros((bz * k, bx * k), dtype=bool)
-            pad[:valid.shape[0], :valid.shape[1]] = valid
-            has = pad.reshape(bz, k, bx, k).any(axis=(1, 3))
+            bz, bx = -(-nz // k), -(-nx // k)
+            pad = np.zeros((L, bz * k, bx * k), dtype=bool)
+            pad[:, :nz, :nx] = valid
+            has = pad.reshape(L, bz, k, bx, k).any(axis=(2, 4))
             if has.sum() <= max_blocks:
                 break
             k += 1
         self.k = k
         self.grid = grid
+        self.layers = layers
         self.shape = (bz, bx)
-        self.index = np.full((bz, bx), -1, dtype=np.int64)     # block -> cell number
-        pts, nodes = [], []
-        for bi, bj in zip(*np.nonzero(has)):
-            sub = valid[bi * k:(bi + 1) * k, bj * k:(bj + 1) * k]
+        height = base.layered("height") if layers is not None else None
+        pts, nodes, ys = [], [], []
+        index = np.full((L, bz, bx), -1, dtype=np.int64)     # block -> cell number
+        for lv, bi, bj in zip(*np.nonzero(has)):
+            sub = valid[lv, bi * k:(bi + 1) * k, bj * k:(bj + 1) * k]
             ii, jj = np.nonzero(sub)
             c = 0.5 * (k - 1)
             m = int(np.argmin((ii - c) ** 2 + (jj - c) ** 2))
             n = (int(bi * k + ii[m]), int(bj * k + jj[m]))
-            self.index[bi, bj] = len(pts)
-            nodes.append(n)
+            index[lv, bi, bj] = len(pts)
+            nodes.append(n if layers is None else (int(lv), *n))
             pts.append(grid.centre(*n))
+            ys.append(float(height[lv][n]) if height is not None else 0.0)
+        self.index = index if layers is not None else index[0]
         self.nodes = nodes
         self.points = np.asarray(pts, dtype=np.float64).reshape(-1, 2)
+        self.heights = np.asarray(ys, dtype=np.float64)       # surface height of each point (0 when flat)
         n = len(pts)
         p = self.points
         self.distance = np.hypot(p[:, None, 0] - p[None, :, 0], p[:, None, 1] - p[None, :, 1])
-        # line of sight, all pairs: segment p_a -> p_b against every wall
-        seg = np.asarray(segments, dtype=np.float64).reshape(-1, 2, 2)
-        w0, e = seg[:, 0], seg[:, 1] - seg[:, 0]
-        vis = np.zeros((n, n), dtype=bool)
-        for a in range(n):
-            r = p - p[a]                                      # (n, 2)
-            q = w0 - p[a]                                     # (m, 2)
-            den = r[:, None, 0] * e[None, :, 1] - r[:, None, 1] * e[None, :, 0]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                s = (q[None, :, 0] * e[None, :, 1] - q[None, :, 1] * e[None, :, 0]) / den
-                u = (q[None, :, 0] * r[:, None, 1] - q[None, :, 1] * r[:, None, 0]) / den
-            cross = (den != 0.0) & (s >= 0.0) & (s <= 1.0) & (u >= 0.0) & (u <= 1.0)
-            vis[a] = ~cross.any(axis=1)
-        self.visible = vis
+        if solids is not None:
+            # in 3D, eye to eye against the model's solid (hills and decks hide)
+            self.visible = solids.visible(np.column_stack([p[:, 0], self.heights + EYE, p[:, 1]]), VIEW_RANGE)
+        else:
+            self.visible = _wall_visibility(p, segments)
         # neighbouring blocks (path distances between blocks go through these)
         cell_of = np.full(valid.shape, -1, dtype=np.int64)
-        ii, jj = np.nonzero(valid)
-        cell_of[ii, jj] = self.index[ii // k, jj // k]
-        self.cell_of = cell_of
+        li, ii, jj = np.nonzero(valid)
+        cell_of[li, ii, jj] = index[li, ii // k, jj // k]
         pairs = set()
-        for a, b in ((cell_of[:, :-1], cell_of[:, 1:]), (cell_of[:-1, :], cell_of[1:, :])):
-            m = (a >= 0) & (b >= 0) & (a != b)
-            pairs.update(zip(a[m].tolist(), b[m].tolist()))
+        if layers is None:
+            c2 = cell_of[0]
+            for a, b in ((c2[:, :-1], c2[:, 1:]), (c2[:-1, :], c2[1:, :])):
+                m = (a >= 0) & (b >= 0) & (a != b)
+                pairs.update(zip(a[m].tolist(), b[m].tolist()))
+        else:
+            link = base.links()
+            a = cell_of[li, ii, jj]
+            for d, (di, dj) in enumerate(STEP_LIST):
+                tl = link[li, ii, jj, d].astype(np.int64)
+                ti, tj = ii + di, jj + dj
+                ok = (tl >= 0) & (ti >= 0) & (ti < nz) & (tj >= 0) & (tj < nx)
+                b = np.full(len(a), -1, dtype=np.int64)
+                b[ok] = cell_of[tl[ok], ti[ok], tj[ok]]
+                m = (b >= 0) & (a != b)
+                pairs.update(zip(a[m].tolist(), b[m].tolist()))
+        self.cell_of = cell_of if layers is not None else cell_of[0]
         self.neighbours: list[list[tuple[int, float]]] = [[] for _ in range(n)]
         for a, b in pairs:
-            d = float(self.distance[a, b])
-            self.neighbours[a].append((b, d))
-            self.neighbours[b].append((a, d))
+            if a < b or (b, a) not in pairs:
+                d = float(self.distance[a, b])
+                self.neighbours[a].append((b, d))
+                self.neighbours[b].append((a, d))
 
     def __len__(self) -> int:
         return len(self.points)
 
-    def cell_at(self, x: float, z: float) -> int:
-        """The block cell holding (x, z), or the one of the nearest valid node; -1 if none."""
-        n = self.grid.node_of(x, z)
-        c = int(self.cell_of[n])
-        if c >= 0:
-            return c
-        m = nearest_valid_node(self.grid.valid, n, 6)
-        return int(self.cell_of[m]) if m is not None else -1
+    def cell_at(self, x: float, z: float, y: float | None = None) -> int:
+        """The block cell holding (x, z) (on a layered grid: the level nearest height
+        ``y``, the lowest when None), or the one of the nearest valid node; -1 if none."""
+        if self.layers is None:
+            n = self.grid.node_of(x, z)
+            c = int(self.cell_of[n])
+            if c >= 0:
+                return c
+            m = nearest_valid_node(self.grid.valid, n, 6)
+            return int(self.cell_of[m]) if m is not None else -1
+        lay = self.layers
+        m3 = nearest_valid_node3(lay.layered("valid"), lay.layered("height"), lay.node_of(x, z), y, 6)
+        return int(self.cell_of[m3]) if m3 is not None else -1
 
     def path_distances(self, start: int) -> np.ndarray:
         """Dijkstra over touching blocks: metres from ``start`` to every block (inf: unreachable)."""
         import heapq
 
         dist = [math.inf] * len(self.points)
+        if not 0 <= start < len(dist):
+            return np.asarray(dist)  # not on the map (no valid node near): nothing reachable
         dist[start] = 0.0
         heap = [(0.0, start)]
         nb = self.neighbours
@@ -375,13 +522,15 @@ _VIEWS: dict[tuple, Views] = {}
 def views_for(world: "World", grid: NavGrid) -> Views:
     """The :class:`Views` of this arena and grid (cached by the walls' content)."""
     seg = np.asarray(world.walls.segments, dtype=np.float64)
-    key = (hash(seg.tobytes()), hash(np.asarray(grid.valid).tobytes()), float(grid.cell),
-           tuple(np.asarray(grid.origin, dtype=np.float64).tolist()))
+    valid = grid.layers.valid if grid.layers is not None else grid.valid
+    key = (hash(seg.tobytes()), hash(np.asarray(valid).tobytes()), float(grid.cell),
+           tuple(np.asarray(grid.origin, dtype=np.float64).tolist()), id(world.ground))
     v = _VIEWS.get(key)
     if v is None:
         if len(_VIEWS) >= 8:
             _VIEWS.pop(next(iter(_VIEWS)))
-        v = _VIEWS[key] = Views(grid, seg)
+        solids = world.ground.solids if grid.layers is not None and world.ground is not None else None
+        v = _VIEWS[key] = Views(grid, seg, max_blocks=VIEW_BLOCKS if solids is not None else 700, solids=solids)
     return v
 
 
@@ -408,9 +557,9 @@ class Coverage:
         self.seen = np.full(len(views), -math.inf)
         self.sees = (views.visible & (views.distance <= vision_range)).astype(np.float64)
 
-    def look(self, x: float, z: float, heading: float, t: float) -> None:
+    def look(self, x: float, z: float, heading: float, t: float, y: float | None = None) -> None:
         v = self.views
-        c = v.cell_at(x, z)
+        c = v.cell_at(x, z, y)
         if c < 0:
             return
         self.seen[c] = t
@@ -431,9 +580,9 @@ class Coverage:
         """The fraction of the blocks not seen for ``fresh`` seconds (or never)."""
         return float(np.mean(t - self.seen >= self.fresh))
 
-    def since(self, x: float, z: float, t: float) -> float:
+    def since(self, x: float, z: float, t: float, y: float | None = None) -> float:
         """Seconds since the block of (x, z) was seen (inf: never)."""
-        c = self.views.cell_at(x, z)
+        c = self.views.cell_at(x, z, y)
         return t - self.seen[c] if c >= 0 else math.inf
 
     def gain(self, cell: int, t: float) -> float:
@@ -441,7 +590,7 @@ class Coverage:
         return float(self.sees[cell] @ self.staleness(t))
 
     def goal(self, x: float, z: float, t: float, weight: np.ndarray | None = None,
-             least: float = 1.0, d0: float = 60.0) -> tuple[int, float] | None:
+             least: float = 1.0, d0: float = 60.0, y: float | None = None) -> tuple[int, float] | None:
         """(block, its gain) of the best block to go and look from; None when nothing in
         sight of any reachable block has at least ``least`` staleness.  The score is the
         gain over (path metres + ``d0``): a large ``d0`` favours the blocks that see much
@@ -449,7 +598,7 @@ class Coverage:
         of duels without a meeting where 10 m left 36 %).  ``weight`` multiplies each
         block's staleness (a prior of where enemies are likely)."""
         v = self.views
-        c = v.cell_at(x, z)
+        c = v.cell_at(x, z, y)
         if c < 0:
             return None
         s = self.staleness(t)
@@ -503,7 +652,10 @@ class Vantages:
 
     def best(self, here: int, per_m: float) -> tuple[int, float]:
         """(block, heading) of the best vantage from block ``here``: the most cover less
-        ``per_m`` per metre of path to it; unreachable blocks never."""
+        ``per_m`` per metre of path to it; unreachable blocks never (-1: ``here`` is
+        no block)."""
+        if here < 0 or len(self.views) == 0:
+            return -1, 0.0                    # not on the map: nowhere to go
         score = self.block_cover - per_m * self.views.path_distances(here)    # unreachable: -inf
         b = int(np.argmax(score))
         return b, float(self.block_face[b])
@@ -513,6 +665,8 @@ class Vantages:
         """(block, heading) of the best hiding place from block ``here``: the most safety
         less ``per_m`` per metre of path to it, plus ``per_m_away`` per metre of path
         (up to ``cap``) from block ``away`` (where an enemy was heard; -1: none)."""
+        if here < 0 or len(self.views) == 0:
+            return -1, 0.0
         score = self.safety - per_m * self.views.path_distances(here)
         if away >= 0:
             d = self.views.path_distances(away)

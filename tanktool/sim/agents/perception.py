@@ -4,8 +4,11 @@
   half-angle of the heading (the hull carries the gun and the crew's view), and the
   segment between the two centres crosses no wall.  That last test is the paper's
   "línea imaginaria R" against every wall, asked of the world's wall quadtree (only
-  the walls in the leaves the segment passes are intersected).  Range and angle are
-  checked first because they cost nothing.
+  the walls in the leaves the segment passes are intersected).  On an arena with
+  relief or levels the segment runs between the two guns in 3D and the model's solid
+  stops it (``World.sees``): a hill or a deck between two tanks hides them, a low
+  wall does not hide a tank on a hill behind it.  Range and angle are checked first
+  because they cost nothing.
 * **Hearing**: a gunshot within the hearing radius reveals roughly where it came from:
   the shooter's position plus Gaussian noise growing with distance.  A shot is the
   shooter's shot counter going up (the same thing the world's ``shot`` event reports).
@@ -47,8 +50,8 @@ def wrap(a: float) -> float:
 
 @dataclass(frozen=True)
 class Sighting:
-    """One enemy seen at time ``t``: its index, centre and velocity then, distance, and
-    which way its hull (and gun) points."""
+    """One enemy seen at time ``t``: its index, centre and velocity then, distance,
+    which way its hull (and gun) points, and the height it stands at."""
 
     index: int
     x: float
@@ -58,17 +61,19 @@ class Sighting:
     t: float
     distance: float
     heading: float = 0.0
+    y: float = 0.0
 
 
 @dataclass(frozen=True)
 class Heard:
     """A shot (or, ``engine`` True, a moving tank) heard at time ``t`` from around
-    (x, z) (noisy)."""
+    (x, z) (noisy), at about height ``y`` (which floor it came from)."""
 
     x: float
     z: float
     t: float
     engine: bool = False
+    y: float | None = None
 
 
 def in_cone(ox: float, oz: float, heading: float, tx: float, tz: float, half_angle: float, vision_range: float) -> bool:
@@ -124,8 +129,9 @@ class Senses:
         for o in world.tanks:
             if o is me or not o.alive:
                 continue
-            if can_see(world.walls, me.x, me.z, me.heading, o.x, o.z, self.half_angle, self.vision_range):
-                s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z), o.heading)
+            if in_cone(me.x, me.z, me.heading, o.x, o.z, self.half_angle, self.vision_range) and world.sees(me, o):
+                s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z), o.heading,
+                             o.y)
                 self.last_seen[o.index] = s
                 out.append(s)
         out.sort(key=lambda s: (s.distance, s.index))
@@ -145,7 +151,7 @@ class Senses:
             if d <= self.hearing_radius and d < best_d:
                 best_d = d
                 sd = self.hearing_noise * d
-                best = Heard(o.x + self.rng.gauss(0.0, sd), o.z + self.rng.gauss(0.0, sd), world.t)
+                best = Heard(o.x + self.rng.gauss(0.0, sd), o.z + self.rng.gauss(0.0, sd), world.t, y=o.y)
         if best is not None:
             self.heard = best
         return best
@@ -170,7 +176,7 @@ class Senses:
         if best is None:
             return None
         sd = self.hearing_noise * best_d
-        heard = Heard(best.x + self.rng.gauss(0.0, sd), best.z + self.rng.gauss(0.0, sd), world.t, True)
+        heard = Heard(best.x + self.rng.gauss(0.0, sd), best.z + self.rng.gauss(0.0, sd), world.t, True, best.y)
         self.heard = heard
         return heard
 

@@ -1,0 +1,121 @@
+"""The agents' grid on an arena with relief or levels, from the simulation's ground.
+
+On a flat arena an agent's grid comes from the walls (``navigation.agent_grid``).  On
+a ground (``sim.ground.Ground``: the walkable surface at 0.5 m with each node's
+height and links) the walls alone say nothing of a deck's edge or a slope too steep,
+so the agent grid is made from the surface itself:
+
+* **clearance**: for every node of the surface, the chamfer distance along its links
+  to the nearest edge of walkable space (a side without a link: a wall's foot, a
+  drop-off, a slope too steep), so a node under a bridge is measured on its own floor;
+  a node is *valid* for an agent when that distance is at least its clearance;
+* **coarse nodes** every ``k`` surface cells (the agent's cell, 1 m by default),
+  each at the centre of a surface node, on that node's level and height;
+* **links** between coarse neighbours: the ``k`` surface steps between their centres
+  followed link by link, every one on a valid node (so a coarse link never cuts a
+  corner of a wall nor jumps a drop); the level it arrives on is the link's level;
+* **reachable**: the valid nodes joined by links to a spawn.
+
+The result is a layered ``NavGrid`` (``(L, nz, nx)`` arrays, ``height``, ``link``):
+``nav.path.astar_layered`` plans on it across ramps, steps and decks.  The agents'
+2-D views of the map (where it has been, the quadrants it searches, the Wander
+heuristic) read its projection: a column is valid when any of its levels is.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ...nav.navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3, runs
+from ...nav.walkable import chamfer_clearance
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..ground import Ground
+
+#: steps (di, dj) of the links +x, +z, -x, -z
+_STEPS = ((0, 1), (1, 0), (0, -1), (-1, 0))
+
+
+def surface_clearance(ground: "Ground", limit: float) -> np.ndarray:
+    """(L, nz, nx) metres from each surface node's centre to the nearest edge of the
+    walkable surface along its links (capped a little above ``limit``; NaN off the
+    surface)."""
+    exists = ground.exists
+    L, nz, nx = exists.shape
+    per = nz * nx
+    node = np.flatnonzero(exists)
+    compact = np.full(L * per + 1, -1, dtype=np.int64)   # flat node -> surface index; last: none
+    compact[node] = np.arange(len(node))
+    lv, rest = np.divmod(node, per)
+    i, j = np.divmod(rest, nx)
+    link = ground.link.reshape(L * per, 4)[node].astype(np.int64)
+    nb = np.full((len(node), 4), -1, dtype=np.int64)
+    for d, (di, dj) in enumerate(_STEPS):
+        a, b = i + di, j + dj
+        ok = (link[:, d] >= 0) & (a >= 0) & (a < nz) & (b >= 0) & (b < nx)
+        target = np.where(ok, link[:, d] * per + np.clip(a, 0, nz - 1) * nx + np.clip(b, 0, nx - 1), L * per)
+        nb[:, d] = compact[target]
+    half = 0.5 * ground.cell
+    steps = int(math.ceil(limit / half)) + 2
+    out = np.full(L * per, np.nan)
+    out[node] = chamfer_clearance(nb, steps) * half
+    return out.reshape(L, nz, nx)
+
+
+def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: list) -> NavGrid:
+    """The projection grid (2-D, see the module docstring) of the layered agent grid,
+    which it carries as ``.layers``; ``spawns`` are (x, z, y or None)."""
+    fine = ground.cell
+    k = max(int(round(cell / fine)), 1)
+    clear = surface_clearance(ground, clearance)
+    ok_fine = np.nan_to_num(clear, nan=-1.0) >= clearance
+    L, nz, nx = ok_fine.shape
+    off = k // 2
+    NZ, NX = max((nz - off - 1) // k + 1, 1), max((nx - off - 1) // k + 1, 1)
+    ii = off + k * np.arange(NZ)
+    jj = off + k * np.arange(NX)
+    valid = ok_fine[:, ii][:, :, jj]
+    heights = ground.h[:, ii][:, :, jj]
+    link = np.full((L, NZ, NX, 4), -1, dtype=np.int8)
+    lvl = np.broadcast_to(np.arange(L)[:, None, None], valid.shape)
+    I = np.broadcast_to(ii[None, :, None], valid.shape)
+    J = np.broadcast_to(jj[None, None, :], valid.shape)
+    fl = ground.link
+    for d, (di, dj) in enumerate(_STEPS):
+        cur, ci, cj = lvl.copy(), I.copy(), J.copy()
+        alive = valid.copy()
+        for _ in range(k):
+            ni, nj = ci + di, cj + dj
+            inside = (ni >= 0) & (ni < nz) & (nj >= 0) & (nj < nx)
+            alive &= inside
+            nxt = np.where(alive, fl[np.where(alive, cur, 0), np.clip(ci, 0, nz - 1), np.clip(cj, 0, nx - 1), d], -1)
+            alive &= nxt >= 0
+            ci, cj = np.clip(ni, 0, nz - 1), np.clip(nj, 0, nx - 1)
+            cur = np.where(alive, nxt, 0)
+            alive &= ok_fine[cur, ci, cj]
+        link[..., d] = np.where(alive, cur, -1)
+    # coarse node (I, J) sits at the centre of surface node (off + k I, off + k J)
+    step = k * fine
+    origin = np.array([ground.ox + (off + 0.5) * fine - 0.5 * step, ground.oz + (off + 0.5) * fine - 0.5 * step])
+    seeds = []
+    for x, z, y in spawns:
+        node = (int(np.clip((z - origin[1]) // step, 0, NZ - 1)), int(np.clip((x - origin[0]) // step, 0, NX - 1)))
+        n = nearest_valid_node3(valid, heights, node, y, int(math.ceil(clearance / step)) + 2)
+        if n is not None:
+            seeds.append(n)
+    reach = layered_reachable(valid, link, seeds) if seeds else valid.copy()
+    valid = valid & reach
+    link = np.where(valid[..., None], link, -1).astype(np.int8)
+    ri, rt, ci_, ct = layered_runs(valid, link)
+    layered = NavGrid(origin, step, (NZ, NX), valid, ri, rt, ci_, ct, valid.copy(), float(clearance),
+                      height=np.where(valid, heights, np.nan), link=link)
+    layered.spawn_nodes = seeds
+    proj = valid.any(axis=0)
+    a, b, c, e = runs(proj)
+    grid = NavGrid(origin, step, (NZ, NX), proj, a, b, c, e, proj.copy(), float(clearance))
+    grid.spawn_nodes = [n[1:] for n in seeds]
+    grid.layers = layered
+    return grid
