@@ -23,6 +23,7 @@ refused with its line: DXF group codes and numbers, SVG's XML and the numbers of
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import re
@@ -32,6 +33,10 @@ import numpy as np
 
 from ..errors import FormatError
 from .bundle import read_input
+from .limits import MAX_MODEL_BYTES, MAX_OBJECTS
+
+#: points of all the drawing's lines and sampled curves together
+MAX_PLAN_POINTS = 2_000_000
 
 #: extensions handled here
 PLAN_EXTENSIONS = {".dxf", ".svg"}
@@ -122,7 +127,7 @@ def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
 
     path = Path(path)
     fmt = path.suffix.lower()[1:]
-    data = read_input(path, "a floor plan")
+    data = read_input(path, "a floor plan", limit=MAX_MODEL_BYTES)
     if fmt == "dxf":
         check_dxf(path, data)
     elif fmt == "svg":
@@ -130,7 +135,7 @@ def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
     else:
         raise FormatError(f"{path}: not a floor plan (expected .dxf or .svg)")
     try:
-        drawing = trimesh.load(str(path), file_type=fmt)
+        drawing = trimesh.load(io.BytesIO(data), file_type=fmt)
     except FormatError:
         raise
     except ImportError as e:
@@ -139,13 +144,30 @@ def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
     except Exception as e:  # trimesh raises many kinds for bad drawings
         raise FormatError(f"{path}: cannot read as .{fmt}: {e}") from None
     lines: list[np.ndarray] = []
-    for entity in getattr(drawing, "entities", ()):
+    entities = getattr(drawing, "entities", ())
+    if len(entities) > MAX_OBJECTS:
+        raise FormatError(f"{path}: {len(entities):,} lines and shapes, more than the {MAX_OBJECTS:,} this tool reads")
+    vertices = np.asarray(getattr(drawing, "vertices", np.zeros((0, 2))), dtype=np.float64)
+    if len(vertices) and not np.isfinite(vertices).all():
+        raise FormatError(f"{path}: the drawing has non-finite coordinates")
+    # trimesh samples curves finely enough for a sagitta of 5 % of ``scale`` units; with
+    # its default of 1 unit a circle of radius 1e7 would become 1.2e9 points.  Tie it
+    # to the drawing's size instead (unchanged for drawings up to 1000 units across)
+    extent = float(np.ptp(vertices, axis=0).max()) if len(vertices) else 0.0
+    scale = max(1.0, extent / 1000.0)
+    total = 0
+    for entity in entities:
         if type(entity).__name__ == "Text":
             continue
         try:
-            pts = np.asarray(entity.discrete(drawing.vertices), dtype=np.float64)
+            pts = np.asarray(entity.discrete(vertices, scale=scale), dtype=np.float64)
+        except (MemoryError, RecursionError):
+            raise FormatError(f"{path}: a {type(entity).__name__.lower()} cannot be sampled (too large)") from None
         except Exception:  # an entity trimesh cannot sample (degenerate arc, ...)
             continue
+        total += len(pts)
+        if total > MAX_PLAN_POINTS:
+            raise FormatError(f"{path}: the drawing's lines and curves make more than {MAX_PLAN_POINTS:,} points")
         if pts.ndim != 2 or pts.shape[0] < 2 or pts.shape[1] < 2:
             continue
         pts = pts[:, :2]
