@@ -236,7 +236,7 @@ def import_arena(
         raise ArenaError(f"--wall-height ({wall_height:g}) must be above the cut --height ({height:g}), "
                          f"or the walls would not be cut")
     scene = load_scene(model, up=up, scale=scale, warn=remark, wall_height=wall_height,
-                       wall_thickness=wall_thickness)
+                       wall_thickness=wall_thickness, progress=progress)
     if progress:
         progress("read")
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]

@@ -102,8 +102,10 @@ def default_up(fmt: str) -> str:
 
 def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.0,
                warn: Callable[[str], None] | None = None, wall_height: float | None = None,
-               wall_thickness: float | None = None):
+               wall_thickness: float | None = None, progress: Callable[[str], None] | None = None):
     """Load ``path`` as a ``trimesh.Scene`` in the world frame (Y up, metres).
+
+    ``progress`` receives the stages of a floor plan (formats/floorplan.py PLAN_STAGES).
 
     ``warn`` receives the non-fatal remarks of built formats (a .bzw file's
     unknown objects); ``wall_height`` / ``wall_thickness`` shape the walls of a
@@ -143,7 +145,7 @@ def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.
             scene = floorplan.load_scene(
                 path,
                 floorplan.DEFAULT_WALL_HEIGHT if wall_height is None else wall_height,
-                floorplan.DEFAULT_WALL_THICKNESS if wall_thickness is None else wall_thickness)
+                floorplan.DEFAULT_WALL_THICKNESS if wall_thickness is None else wall_thickness, progress=progress)
         elif fmt in ("glb", "gltf"):
             scene = _load_gltf(path)
         else:

@@ -136,6 +136,38 @@ def _table(manifest: Path, doc: dict[str, Any], key: str) -> dict[str, Any]:
     return t
 
 
+#: optional keys the simulation takes from anywhere in vehicle.toml (sim/body.py
+#: TankSpec.from_vehicle), and the range each must have
+SIM_KEYS: dict[str, tuple[float, float]] = {
+    "turn_rate": (1e-6, 100.0),    # rad/s, top turning speed
+    "grip": (0.0, 1e4),            # 1/s, lateral grip
+    "shell_damage": (0.0, 1e6),    # hit points a shell takes
+}
+
+
+def _find(doc: dict[str, Any], key: str) -> Any:
+    """The first ``key`` anywhere in nested tables, as the simulation finds it."""
+    stack = [doc]
+    while stack:
+        d = stack.pop(0)
+        if key in d:
+            return d[key]
+        stack[:0] = [v for v in d.values() if isinstance(v, dict)]
+    return None
+
+
+def _check_sim_keys(manifest: Path, doc: dict[str, Any]) -> None:
+    for key, (lo, hi) in SIM_KEYS.items():
+        v = _find(doc, key)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))
+                              or not math.isfinite(v) or not lo <= v <= hi):
+            raise VehicleError(f"{manifest}: {key} must be a number from {lo:g} to {hi:g}, got {v!r:.60}")
+    m = _find(doc, "muzzle")
+    if m is not None and (not isinstance(m, list) or len(m) != 3 or not all(
+            isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in m)):
+        raise VehicleError(f"{manifest}: muzzle must be a list of 3 finite numbers (vehicle frame), got {m!r:.60}")
+
+
 def load_vehicle(path: str | os.PathLike) -> VehicleBundle:
     """Load ``vehicles/<name>/`` (or its ``vehicle.toml``) and check it is usable."""
     path = Path(path)
@@ -182,6 +214,7 @@ def load_vehicle(path: str | os.PathLike) -> VehicleBundle:
     if len(spheres) > MAX_SPHERES:
         raise FormatError(f"{spheres_f}: {len(spheres):,} spheres, more than the {MAX_SPHERES:,} a vehicle may have")
 
+    _check_sim_keys(manifest, doc)
     radius = float(np.max(np.hypot(hull[:, 0], hull[:, 2])))
     return VehicleBundle(
         name=name, path=path, toml=doc, hull=hull, spheres=spheres, mass=mass, inertia=inertia,
