@@ -36,7 +36,8 @@ class UserError(click.ClickException):
         self.exit_code = exit_code
 
     def show(self, file=None) -> None:
-        click.echo(f"error: {self.format_message()}", err=True)
+        # one line, whatever the message: a library's text may hold line breaks
+        click.echo(f"error: {' '.join(self.format_message().split())}", err=True)
 
 
 class LazyGroup(click.Group):

@@ -223,7 +223,11 @@ def os_error_text(e: OSError) -> str:
 
 
 def output_error(target: str | os.PathLike, e: OSError, what: str = "cannot write") -> OutputError:
-    return OutputError(f"{target}: {what}: {os_error_text(e)}")
+    """One line: the file (a staging name shown as the file it becomes), what failed, why."""
+    shown = _TEMP_IN_PATH.sub(r"\1", os.fspath(target))
+    if e.filename and _TEMP_IN_PATH.sub(r"\1", os.fsdecode(e.filename)) == shown:
+        e.filename = None  # said once is enough
+    return OutputError(f"{shown}: {what}: {os_error_text(e)}")
 
 
 # ---------------------------------------------------------------------------

@@ -38,6 +38,8 @@ from .limits import MAX_MODEL_BYTES, MAX_OBJECTS
 
 #: points of all the drawing's lines and sampled curves together
 MAX_PLAN_POINTS = 2_000_000
+#: how many wall thicknesses a drawing may be across
+MAX_THICKNESSES = 1e6
 
 #: extensions handled here
 PLAN_EXTENSIONS = {".dxf", ".svg"}
@@ -97,7 +99,8 @@ def check_svg(path: Path, data: bytes) -> None:
         root = etree.fromstring(data, parser=etree.XMLParser(resolve_entities=False, no_network=True))
     except etree.XMLSyntaxError as e:
         line = e.position[0] if e.position else getattr(e, "lineno", 0)
-        raise FormatError(f"{path}:{line}: not well-formed SVG/XML: {e.msg}") from None
+        msg = " ".join(str(e.msg).split())  # lxml's messages run over several lines
+        raise FormatError(f"{path}:{line}: not well-formed SVG/XML: {msg}") from None
     if not isinstance(root.tag, str) or etree.QName(root).localname != "svg":
         raise FormatError(f"{path}:{root.sourceline}: expected an <svg> document")
     for el in root.iter():
@@ -143,7 +146,7 @@ def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
         raise FormatError(f"{path}: reading .{fmt} needs a missing package ({e.name}); "
                           f"reinstall tanktool with its dependencies") from None
     except Exception as e:  # trimesh raises many kinds for bad drawings
-        raise FormatError(f"{path}: cannot read as .{fmt}: {e}") from None
+        raise FormatError(f"{path}: cannot read as .{fmt}: {' '.join(str(e).split())[:300]}") from None
     lines: list[np.ndarray] = []
     entities = getattr(drawing, "entities", ())
     if len(entities) > MAX_OBJECTS:
@@ -153,9 +156,10 @@ def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
         raise FormatError(f"{path}: the drawing has non-finite coordinates")
     # trimesh samples curves finely enough for a sagitta of 5 % of ``scale`` units; with
     # its default of 1 unit a circle of radius 1e7 would become 1.2e9 points.  Tie it
-    # to the drawing's size instead (unchanged for drawings up to 1000 units across)
+    # to the drawing's size instead (unchanged for drawings up to 100 units across; at
+    # most about 12,600 points per curve)
     extent = float(np.ptp(vertices, axis=0).max()) if len(vertices) else 0.0
-    scale = max(1.0, extent / 1000.0)
+    scale = max(1.0, extent / 100.0)
     total = 0
     for entity in entities:
         if type(entity).__name__ == "Text":
@@ -190,6 +194,13 @@ def plan_walls(lines: list[np.ndarray], thickness: float):
 
     if not (math.isfinite(thickness) and thickness > 0):
         raise FormatError(f"--wall-thickness must be a positive number, got {thickness}")
+    pts = np.concatenate(lines)
+    extent = float(np.ptp(pts, axis=0).max())
+    if extent > MAX_THICKNESSES * thickness:
+        # GEOS loses itself (it hangs) on walls this thin for their length, and no
+        # arena is a million walls wide: a unit mistake
+        raise FormatError(f"the drawing is {extent:.4g} units across, more than {MAX_THICKNESSES:,.0f} wall "
+                          f"thicknesses ({thickness:g}): wrong units? (--wall-thickness is in drawing units)")
     geoms = [shapely.LineString(ln) for ln in lines]
     # noding splits lines where they cross; merging joins pieces that meet end to end,
     # so separate LINE entities around a corner are mitred like one polyline

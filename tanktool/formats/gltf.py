@@ -243,7 +243,7 @@ def _accessors(d: _Doc, doc: dict, views: list[dict], lengths: list[int], budget
         if "sparse" in a:
             raise d.fail(f"{where}.sparse", "sparse accessors are not supported")
         ctype = a.get("componentType")
-        if isinstance(ctype, bool) or ctype not in COMPONENTS:
+        if isinstance(ctype, bool) or not isinstance(ctype, int) or ctype not in COMPONENTS:
             raise d.fail(f"{where}.componentType", f"{ctype!r:.40} is not a glTF component type")
         kind = a.get("type")
         if not isinstance(kind, str) or kind not in WIDTHS:

@@ -7,10 +7,13 @@ and are converted with (x, y, z) -> (x, z, -y); everything else is taken as Y-up
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import math
 import os
+import warnings
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 
@@ -100,16 +103,34 @@ def default_up(fmt: str) -> str:
     return "z" if fmt in ("3ds", "bzw", *PLAN_FORMATS) else "y"
 
 
+@contextlib.contextmanager
+def quiet() -> Iterator[None]:
+    """Silence trimesh's log (it logs tracebacks for files it fails to read) and
+    numpy's warnings while a model is read: the reader's own FormatError says what is
+    wrong, in one line.  ``-vv`` (DEBUG) keeps them."""
+    log = logging.getLogger("trimesh")
+    if logging.getLogger().isEnabledFor(logging.DEBUG):
+        yield
+        return
+    level = log.level
+    log.setLevel(logging.CRITICAL)
+    try:
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            yield
+    finally:
+        log.setLevel(level)
+
+
 def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.0,
                warn: Callable[[str], None] | None = None, wall_height: float | None = None,
                wall_thickness: float | None = None, progress: Callable[[str], None] | None = None):
     """Load ``path`` as a ``trimesh.Scene`` in the world frame (Y up, metres).
 
-    ``progress`` receives the stages of a floor plan (formats/floorplan.py PLAN_STAGES).
-
     ``warn`` receives the non-fatal remarks of built formats (a .bzw file's
     unknown objects); ``wall_height`` / ``wall_thickness`` shape the walls of a
-    .dxf/.svg floor plan (defaults in formats/floorplan.py).  Raises FormatError for
+    .dxf/.svg floor plan (defaults in formats/floorplan.py) and ``progress`` receives
+    its stages (floorplan.PLAN_STAGES; big plans take a while).  Raises FormatError for
     unreadable files, models without triangles, non-finite vertices, models beyond the
     limits of formats/limits.py (objects, triangles) and extents that are a unit
     mistake (over 100 km or under 1 mm after ``scale``).
@@ -132,6 +153,14 @@ def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.
         raise FormatError(f"--up must be 'y' or 'z', got {up!r}")
     if isinstance(scale, bool) or not (isinstance(scale, (int, float)) and math.isfinite(scale) and scale > 0):
         raise FormatError(f"--scale must be a positive number, got {scale!r}")
+    with quiet():
+        scene = _read_scene(path, fmt, warn, wall_height, wall_thickness, progress)
+        return _to_world(scene, path, up, scale)
+
+
+def _read_scene(path: Path, fmt: str, warn, wall_height, wall_thickness, progress):
+    from . import threeds
+
     try:
         if fmt == "3ds":
             scene = threeds.load_scene(path)
@@ -158,7 +187,17 @@ def load_scene(path: str | os.PathLike, up: str | None = None, scale: float = 1.
     except RecursionError:
         raise FormatError(f"{path}: cannot read as .{fmt}: structures nested too deeply") from None
     except Exception as e:  # trimesh raises many kinds for bad files
-        raise FormatError(f"{path}: cannot read as .{fmt}: {e}") from None
+        raise FormatError(f"{path}: cannot read as .{fmt}: {_one_line(e)}") from None
+    return scene
+
+
+def _one_line(e: Exception) -> str:
+    return " ".join(str(e).split())[:300] or type(e).__name__
+
+
+def _to_world(scene, path: Path, up: str, scale: float):
+    """Check the scene's triangles and vertices, turn it into the world frame (Y up,
+    metres) and check its extent."""
     import trimesh
 
     geoms = [g for g in scene.geometry.values() if isinstance(g, trimesh.Trimesh) and len(g.faces)]
