@@ -203,8 +203,11 @@ def _play_load(kind: str, bundle: Path) -> None:
         model = model if model.name else bundle / "model.glb"
         if model.suffix.lower() == ".glb" and model.is_file():  # what the 3D view draws
             read_gltf(read_input(model, "a .glb model"), str(model))
+        from ..formats.npz import read_npz
+
         for name, reader in (("quadtree.npz", WallQuadtree.load), ("navgrid.npz", NavGrid.load)):
             if (bundle / name).is_file():  # what the top view's overlays read
+                read_npz(bundle / name, f"a {name} file")  # a damaged archive: one clear line
                 reader(bundle / name)
         World(info.walls, [TankSpec.box("check")], info.spawns, bounds=info.bounds)  # a match needs a spawn
     else:

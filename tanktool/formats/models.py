@@ -204,8 +204,17 @@ def _to_world(scene, path: Path, up: str, scale: float):
     if not geoms:
         raise FormatError(f"{path}: the model has no triangles")
     for name, g in scene.geometry.items():
-        if isinstance(g, trimesh.Trimesh) and not np.isfinite(g.vertices).all():
-            bad = int(np.flatnonzero(~np.isfinite(g.vertices).all(axis=1))[0])
+        if not isinstance(g, trimesh.Trimesh):
+            continue
+        v, f = np.asarray(g.vertices), np.asarray(g.faces)
+        if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or (len(f) and f.shape[1] != 3):
+            raise FormatError(f"{path}: object {name!r} is not a triangle mesh (faces of shape {f.shape})")
+        if len(f) and (f.min() < 0 or f.max() >= len(v)):
+            k = int(np.flatnonzero((f < 0).any(axis=1) | (f >= len(v)).any(axis=1))[0])
+            raise FormatError(f"{path}: object {name!r} face {k} uses vertex {int(f[k].max())}, "
+                              f"the object has {len(v)} vertices")
+        if not np.isfinite(v).all():
+            bad = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
             raise FormatError(f"{path}: object {name!r} vertex {bad} is not finite (NaN or inf)")
     transform = np.eye(4)
     if up == "z":
