@@ -28,7 +28,7 @@ MAX_FACES = 8_000_000
 MAX_OBJECTS = 100_000
 #: more objects than this are merged into one mesh (keeps the scene graph small, so
 #: the cost of a model stays linear in its number of objects)
-MERGE_OBJECTS = 256
+MERGE_OBJECTS = 64
 #: a model's extent after --scale, metres: beyond these it is a unit mistake
 MAX_EXTENT = 1.0e5
 MIN_EXTENT = 1.0e-3
