@@ -271,6 +271,32 @@ NUMBERS = ["0", "-0", "1e300", "-1e300", "1e-300", "nan", "inf", "-inf", "1e15",
            "1" * 50, "0x10", "", "--", "1e99999", "3.4e38", "-3.4e38", "999999999", "1e7", "1e9"]
 
 
+LINE_OPS = ("delete", "duplicate", "swap", "field", "cut_line", "cut_file")
+
+
+def line_op(lines: list[str], i: int, op: str, rng: random.Random, numbers: list[str]) -> list[str]:
+    """One of the mutations every line-based format gets (``LINE_OPS``) at line ``i``:
+    delete it, duplicate it elsewhere, swap it with another, replace one of its fields
+    by one of ``numbers``, cut it short, cut the file short.  Returns the lines."""
+    if op == "delete":
+        del lines[i]
+    elif op == "duplicate":
+        lines.insert(rng.randrange(len(lines) + 1), lines[i])
+    elif op == "swap":
+        j = rng.randrange(len(lines))
+        lines[i], lines[j] = lines[j], lines[i]
+    elif op == "field":
+        fields = lines[i].split()
+        if fields:
+            fields[rng.randrange(len(fields))] = rng.choice(numbers)
+            lines[i] = " ".join(fields)
+    elif op == "cut_line":
+        lines[i] = lines[i][: rng.randrange(len(lines[i]) + 1)]
+    elif op == "cut_file":
+        lines = lines[: rng.randrange(len(lines) + 1)]
+    return lines
+
+
 def mutate_text(data: bytes, rng: random.Random, pool: list[bytes] | None = None) -> bytes:
     text = data.decode("utf-8", "replace")
     lines = text.splitlines()
@@ -279,21 +305,8 @@ def mutate_text(data: bytes, rng: random.Random, pool: list[bytes] | None = None
             lines = ["0"]
         i = rng.randrange(len(lines))
         op = rng.randrange(8)
-        fields = lines[i].split()
-        if op == 0:
-            del lines[i]
-        elif op == 1:
-            lines.insert(rng.randrange(len(lines) + 1), lines[i])
-        elif op == 2:
-            j = rng.randrange(len(lines))
-            lines[i], lines[j] = lines[j], lines[i]
-        elif op == 3 and fields:
-            fields[rng.randrange(len(fields))] = rng.choice(NUMBERS)
-            lines[i] = " ".join(fields)
-        elif op == 4:
-            lines[i] = lines[i][: rng.randrange(len(lines[i]) + 1)]
-        elif op == 5:
-            lines = lines[: rng.randrange(len(lines) + 1)]
+        if op < len(LINE_OPS):
+            lines = line_op(lines, i, LINE_OPS[op], rng, NUMBERS)
         elif op == 6:
             lines[i:i] = [lines[i]] * rng.choice([10, 100, 1000])
         else:
@@ -634,6 +647,12 @@ def _import_arena(path: Path) -> None:
     import_arena(path, path.parent / "bundle")
 
 
+def _import_vehicle(path: Path) -> None:
+    from tanktool.cli.import_vehicle import build_vehicle_bundle
+
+    build_vehicle_bundle(path, path.parent / "bundle", "v")
+
+
 def _any_model(tmp: Path) -> list[bytes]:
     return _3ds_seeds(tmp)[:8]
 
@@ -647,6 +666,7 @@ EXTRA_KINDS: dict[str, Kind] = {k.name: k for k in [
     Kind("import-bzw", ".bzw", _files("tests/data/bzw/*.bzw"), mutate_text, _import_arena),
     Kind("import-svg", ".svg", _files("tests/data/plans/*.svg"), mutate_text, _import_arena),
     Kind("import-stl", ".stl", _trimesh_seeds("stl"), mutate_bytes, _import_arena),
+    Kind("import-vehicle", ".3ds", _files("vehicles/*/*.3ds"), mutate_bytes, _import_vehicle),
 ]}
 
 

@@ -506,15 +506,25 @@ def staged_dir(target: str | os.PathLike, force: bool = False, manifest: str | N
     except OSError as e:
         e.filename = None
         raise output_error(shown, e, f"cannot make a folder in {target.parent}") from None
-    try:
+    # nothing may have appeared at the target meanwhile
+    with _installing(tmp, target, shown, lambda: check_replaceable(target, force, manifest)):
         yield tmp
-        check_replaceable(target, force, manifest)  # nothing appeared there meanwhile
-        _install(tmp, target)
+
+
+@contextlib.contextmanager
+def _installing(stage: Path, target: Path, shown: Any, before: Any = None) -> Iterator[None]:
+    """Run the body, then put ``stage`` at ``target``; on any failure remove ``stage``
+    (an OSError becomes an OutputError naming ``shown``)."""
+    try:
+        yield
+        if before is not None:
+            before()
+        _install(stage, target)
     except OSError as e:
-        shutil.rmtree(tmp, ignore_errors=True)
+        shutil.rmtree(stage, ignore_errors=True)
         raise output_error(shown, e) from None
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        shutil.rmtree(stage, ignore_errors=True)
         raise
 
 
@@ -560,12 +570,5 @@ def bundle_update(bundle: str | os.PathLike) -> Iterator[Path]:
     except OSError as e:
         shutil.rmtree(stage, ignore_errors=True)
         raise output_error(shown, e) from None
-    try:
+    with _installing(stage, bundle, shown):
         yield stage
-        _install(stage, bundle)
-    except OSError as e:
-        shutil.rmtree(stage, ignore_errors=True)
-        raise output_error(shown, e) from None
-    except BaseException:
-        shutil.rmtree(stage, ignore_errors=True)
-        raise
