@@ -201,6 +201,16 @@ def plan_walls(lines: list[np.ndarray], thickness: float):
         # arena is a million walls wide: a unit mistake
         raise FormatError(f"the drawing is {extent:.4g} units across, more than {MAX_THICKNESSES:,.0f} wall "
                           f"thicknesses ({thickness:g}): wrong units? (--wall-thickness is in drawing units)")
+    # the same line drawn twice is one wall: GEOS nodes 1,000 copies of a square in
+    # 900 MB, so copies (either direction) go before the union
+    seen: set[bytes] = set()
+    unique = []
+    for ln in lines:
+        key = min(ln.tobytes(), ln[::-1].tobytes())
+        if key not in seen:
+            seen.add(key)
+            unique.append(ln)
+    lines = unique
     geoms = [shapely.LineString(ln) for ln in lines]
     # noding splits lines where they cross; merging joins pieces that meet end to end,
     # so separate LINE entities around a corner are mitred like one polyline
