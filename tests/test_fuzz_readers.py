@@ -270,7 +270,7 @@ def test_replay_zlib_bomb_is_refused_without_inflating(tmp_path, tape):
     from tanktool.sim.replay import read_replay
 
     p = tmp_path / "bomb.ttr"
-    p.write_bytes(F.zlib_bomb_replay(tape, 512 << 20))     # ~0.5 MB inflating to 512 MB
+    p.write_bytes(F.zlib_bomb_replay(tape, 128 << 20))     # ~130 KB inflating to 128 MB
     tracemalloc.start()
     with pytest.raises(FormatError, match="zlib bomb"):
         read_replay(p)
