@@ -49,57 +49,88 @@ class ArenaBundle:
     toml: dict[str, Any] = field(default_factory=dict)
 
     def file(self, key: str) -> Path:
-        """Path of a file the manifest names in table ``key`` (e.g. "walls", "model")."""
-        return self.path / str(self.toml.get(key, {}).get("file", ""))
+        """Path of a file the manifest names in table ``key`` (e.g. "walls", "model"),
+        inside the bundle (``load_arena`` refused names that lead out of it); the
+        bundle folder itself when the table names none."""
+        from .formats.bundle import bundle_file
+
+        t = self.toml.get(key)
+        name = t.get("file") if isinstance(t, dict) else None
+        if name is None:
+            return self.path / ""
+        return bundle_file(self.path, name, f"{self.path / MANIFEST}: [{key}] file")
+
+
+#: spawn points an arena may list (a match uses at most 64 tanks)
+MAX_SPAWNS = 4096
+
+
+def _finite(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _table(doc: dict[str, Any], key: str, manifest: Path) -> dict[str, Any]:
+    t = doc.get(key, {})
+    if not isinstance(t, dict):
+        raise ArenaError(f"{manifest}: [{key}] must be a table, got {key} = {t!r:.60}")
+    return t
 
 
 def load_arena(path: str | os.PathLike) -> ArenaBundle:
-    """Read an arena bundle folder (or its ``arena.toml``).
+    """Read an arena bundle folder (or its ``arena.toml``) the way ``play`` uses it.
 
-    Raises ArenaError / FormatError naming the file and what is wrong.
+    Every value play needs is checked for its type and range, and every file the
+    manifest names must lie inside the bundle.  Raises ArenaError / FormatError
+    naming the file and the key.
     """
-    from .formats.bundle import read_toml
+    from .errors import FormatError
+    from .formats.bundle import bundle_file, clean_stale, read_toml
     from .formats.walls_txt import read_walls
 
     path = Path(path)
-    if path.is_file() and path.name == MANIFEST:
+    if path.name == MANIFEST and path.is_file():
         path = path.parent
+    if not path.is_dir():
+        clean_stale(path.parent, path.name)  # a replacement killed half-way: put the bundle back
     if not path.is_dir():
         raise ArenaError(f"{path}: no such arena folder")
     manifest = path / MANIFEST
     if not manifest.is_file():
         raise ArenaError(f"{path}: not an arena bundle (no {MANIFEST})")
     doc = read_toml(manifest)
-    walls_name = doc.get("walls", {}).get("file", "walls.txt")
-    if not isinstance(walls_name, str) or "/" in walls_name or "\\" in walls_name:
-        raise ArenaError(f"{manifest}: [walls] file must be a file name in the bundle, got {walls_name!r}")
-    walls = read_walls(path / walls_name)
+    name = doc.get("name", path.name)
+    if not isinstance(name, str) or not name:
+        raise ArenaError(f"{manifest}: 'name' must be a non-empty string, got {name!r:.60}")
+    walls_t = _table(doc, "walls", manifest)
+    model_t = _table(doc, "model", manifest)
     try:
-        raw = doc.get("spawns", [])
-        width = len(raw[0]) if isinstance(raw, list) and raw and isinstance(raw[0], list) else 3
-        if width not in (3, 4) or any(not isinstance(r, list) or len(r) != width for r in raw):
-            raise ValueError
-        spawns = np.asarray(raw, dtype=np.float64).reshape(-1, width)
-    except (TypeError, ValueError):
-        raise ArenaError(f"{manifest}: 'spawns' must be a list of [x, z, heading] or [x, z, heading, y] "
-                         "lists, all of one length") from None
-    if not np.isfinite(spawns).all():
-        raise ArenaError(f"{manifest}: 'spawns' must be finite numbers")
+        walls_path = bundle_file(path, walls_t.get("file", "walls.txt"), f"{manifest}: [walls] file")
+        if "file" in model_t:
+            bundle_file(path, model_t["file"], f"{manifest}: [model] file")
+    except FormatError as e:  # a name that leads out of the bundle: the manifest is wrong
+        raise ArenaError(str(e)) from None
+    walls = read_walls(walls_path)
+    raw = doc.get("spawns", [])
+    width = len(raw[0]) if isinstance(raw, list) and raw and isinstance(raw[0], list) else 3
+    if (not isinstance(raw, list) or len(raw) > MAX_SPAWNS or width not in (3, 4)
+            or not all(isinstance(s, list) and len(s) == width and all(_finite(v) for v in s) for s in raw)):
+        raise ArenaError(f"{manifest}: 'spawns' must be a list of at most {MAX_SPAWNS} [x, z, heading] or "
+                         f"[x, z, heading, y] lists of finite numbers, all of one length")
+    spawns = np.array(raw, dtype=np.float64).reshape(-1, width)
     raw_bounds = doc.get("bounds")
     if raw_bounds is None:
         bounds = walls.bounds
     else:
-        try:
-            bounds = np.asarray(raw_bounds, dtype=np.float64).reshape(2, 2)
-        except (TypeError, ValueError):
-            raise ArenaError(f"{manifest}: 'bounds' must be [[xmin, zmin], [xmax, zmax]]") from None
-        if not (np.isfinite(bounds).all() and (bounds[1] > bounds[0]).all()):
-            raise ArenaError(f"{manifest}: 'bounds' must be finite with xmin < xmax and zmin < zmax")
-    try:
-        floor_y = float(doc.get("floor_y", 0.0))
-    except (TypeError, ValueError):
-        raise ArenaError(f"{manifest}: 'floor_y' must be a number") from None
-    return ArenaBundle(str(doc.get("name", path.name)), path, walls, bounds, spawns, floor_y, doc)
+        if (not isinstance(raw_bounds, list) or len(raw_bounds) != 2
+                or not all(isinstance(c, list) and len(c) == 2 and all(_finite(v) for v in c) for c in raw_bounds)):
+            raise ArenaError(f"{manifest}: 'bounds' must be [[xmin, zmin], [xmax, zmax]] of finite numbers")
+        bounds = np.array(raw_bounds, dtype=np.float64)
+        if not (bounds[1] > bounds[0]).all():
+            raise ArenaError(f"{manifest}: 'bounds' must have xmin < xmax and zmin < zmax")
+    floor_y = doc.get("floor_y", 0.0)
+    if not _finite(floor_y):
+        raise ArenaError(f"{manifest}: 'floor_y' must be a finite number, got {floor_y!r:.60}")
+    return ArenaBundle(name, path, walls, bounds, spawns, float(floor_y), doc)
 
 
 # ---------------------------------------------------------------------------
@@ -128,20 +159,27 @@ _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
 
 
 def _companion_files(model: Path) -> list[Path]:
-    """Files a model needs beside it: an .obj's material libraries."""
+    """Files a model needs beside it: an .obj's material libraries (regular files in
+    the model's own folder only)."""
+    from .errors import FormatError
+    from .formats.bundle import bundle_file, read_input
+
     if model.suffix.lower() != ".obj":
         return []
-    out = []
+    out: list[Path] = []
     try:
-        with open(model, "rb") as f:
-            for raw in f:
-                if raw.startswith(b"mtllib"):
-                    for name in raw.split()[1:]:
-                        p = model.parent / name.decode("utf-8", "replace")
-                        if p.is_file() and p.parent == model.parent:
-                            out.append(p)
-    except OSError:
+        data = read_input(model, "an .obj model")
+    except FormatError:
         return []
+    for raw in data.splitlines():
+        if raw.startswith(b"mtllib"):
+            for name in raw.split()[1:]:
+                try:
+                    p = bundle_file(model.parent, name.decode("utf-8", "replace"), "mtllib")
+                except FormatError:
+                    continue
+                if p.is_file() and not p.is_symlink() and p.parent == model.parent and p not in out:
+                    out.append(p)
     return out
 
 
@@ -213,7 +251,7 @@ def import_arena(
     import trimesh
 
     from .fleet import bundled_fleet
-    from .formats.bundle import sha256_file, staged_dir, write_toml
+    from .formats.bundle import check_replaceable, sha256_file, staged_dir, write_toml
     from .formats.models import default_up, detect_format, load_scene
     from .formats.walls_txt import write_walls
     from .nav.arena_levels import analyse_arena, spawn_y_needed
@@ -227,10 +265,7 @@ def import_arena(
     if not _NAME_RE.match(name):
         raise ArenaError(f"arena name {name!r}: use letters, digits, '.', '_' or '-'")
     target = Path(out) if out is not None else Path.cwd() / name
-    if target.exists() and not force:
-        raise ArenaError(f"{target}: already exists (use --force to overwrite)")
-    if target.exists() and not target.is_dir():
-        raise ArenaError(f"{target}: exists and is not a folder")
+    check_replaceable(target, force, MANIFEST)  # before any work: only a bundle tanktool wrote is replaced
     if not (math.isfinite(height) and height > 0):
         raise ArenaError(f"--height must be a positive number of metres, got {height}")
     if not (math.isfinite(tolerance) and 0 < tolerance < height):
@@ -255,7 +290,9 @@ def import_arena(
         raise ArenaError(f"--wall-height ({wall_height:g}) must be above the cut --height ({height:g}), "
                          f"or the walls would not be cut")
     scene = load_scene(model, up=up, scale=scale, warn=remark, wall_height=wall_height,
-                       wall_thickness=wall_thickness)
+                       wall_thickness=wall_thickness, progress=progress)
+    if progress:
+        progress("read")
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
     if not meshes:
         raise ArenaError(f"{model}: the model has no triangles")
@@ -280,8 +317,9 @@ def import_arena(
     nav["cell"] = float(params.cell)
     bounds = walls.bounds
     with_y = spawn_y_needed(result)
-    with staged_dir(target, force=force) as tmp:
-        copied = [model, *_companion_files(model)]
+    companions = _companion_files(model)
+    with staged_dir(target, force=force, manifest=MANIFEST) as tmp:
+        copied = [model, *companions]
         for f in copied:
             shutil.copyfile(f, tmp / f.name)
         glb = scene.export(file_type="glb")
@@ -303,8 +341,9 @@ def import_arena(
             "floor_y": _r(result.floor_y),
             "spawns": [[_r(x), _r(z), _r(h, 6), _r(y)] if with_y else [_r(x), _r(z), _r(h, 6)]
                        for x, z, h, y in spawns],
-            "source": {"file": model.name, "sha256": sha256_file(model), "up": src_up, "scale": float(scale),
-                       **_plan_source(fmt, wall_height, wall_thickness)},
+            "source": {"file": model.name, "sha256": sha256_file(tmp / model.name), "up": src_up,
+                       "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness),
+                       **({"companions": [f.name for f in companions]} if companions else {})},
             "model": {"file": "model.glb"},
             "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
                       "count": len(walls)},

@@ -12,6 +12,11 @@ class FormatError(TanktoolError):
     """A file could not be parsed: the message names the file and the place."""
 
 
+class OutputError(TanktoolError):
+    """A file or folder could not be written (permissions, a full disk, a file size
+    limit, a folder that is not a bundle and must not be replaced, ...)."""
+
+
 class ArenaError(TanktoolError):
     """An arena cannot be built or used (no floor, no free space, ...)."""
 

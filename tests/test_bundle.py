@@ -1,6 +1,6 @@
 import pytest
 
-from tanktool.errors import FormatError
+from tanktool.errors import FormatError, OutputError
 from tanktool.formats.bundle import atomic_write_text, read_toml, sha256_file, staged_dir, write_toml
 
 
@@ -30,12 +30,14 @@ def test_staged_dir_leaves_nothing_on_failure(tmp_path):
 
 def test_staged_dir_refuses_then_forces(tmp_path):
     target = tmp_path / "bundle"
-    with staged_dir(target) as d:
-        (d / "a").write_text("1")
-    with pytest.raises(FormatError, match="--force"):
-        with staged_dir(target):
+    with staged_dir(target, manifest="arena.toml") as d:
+        (d / "arena.toml").write_text('tool_version = "test"\n')
+        (d / "walls.txt").write_text("1")
+    with pytest.raises(OutputError, match="--force"):
+        with staged_dir(target, manifest="arena.toml"):
             pass
-    with staged_dir(target, force=True) as d:
+    with staged_dir(target, force=True, manifest="arena.toml") as d:
+        (d / "arena.toml").write_text('tool_version = "test"\n')
         (d / "b").write_text("2")
-    assert sorted(p.name for p in target.iterdir()) == ["b"]
+    assert sorted(p.name for p in target.iterdir()) == ["arena.toml", "b"]
     assert [p.name for p in tmp_path.iterdir()] == ["bundle"]

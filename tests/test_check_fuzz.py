@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from fuzz_inputs import line_op
 from tanktool.check import RULES, run_check
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -37,6 +38,10 @@ def sources() -> list[tuple[str, Path | None]]:
     return out
 
 
+#: the mutations shared with every line-based format (tests/fuzz_inputs.py line_op)
+COMMON = {0: "delete", 1: "duplicate", 2: "swap", 3: "field", 9: "cut_line", 10: "cut_file"}
+
+
 def mutate(text: str, rng: random.Random) -> bytes:
     lines = text.splitlines()
     for _ in range(rng.randint(1, 4)):
@@ -45,16 +50,8 @@ def mutate(text: str, rng: random.Random) -> bytes:
         i = rng.randrange(len(lines))
         op = rng.randrange(12)
         fields = lines[i].split()
-        if op == 0:
-            del lines[i]
-        elif op == 1:
-            lines.insert(rng.randrange(len(lines) + 1), lines[i])
-        elif op == 2:
-            j = rng.randrange(len(lines))
-            lines[i], lines[j] = lines[j], lines[i]
-        elif op == 3 and fields:
-            fields[rng.randrange(len(fields))] = rng.choice(NUMBERS)
-            lines[i] = " ".join(fields)
+        if op in COMMON:
+            lines = line_op(lines, i, COMMON[op], rng, NUMBERS)
         elif op == 4 and len(fields) == 5:
             fields[4] = str(-int(float(fields[4]))) if fields[4] in ("1", "-1") else "1"
             lines[i] = " ".join(fields)
@@ -76,10 +73,6 @@ def mutate(text: str, rng: random.Random) -> bytes:
             lines = [ln for ln in lines if not ln.startswith("# auxiliary")]
         elif op == 8:
             lines.insert(rng.randrange(len(lines) + 1), "# auxiliary")
-        elif op == 9:
-            lines[i] = lines[i][: rng.randrange(len(lines[i]) + 1)]
-        elif op == 10:
-            lines = lines[: rng.randrange(len(lines) + 1)]
         elif op == 11 and len(fields) == 5:
             fields[2:4] = fields[0:2]  # zero length
             lines[i] = " ".join(fields)

@@ -183,8 +183,11 @@ def spawn_line(path: Path, i: int) -> int:
     or one number a line as tomli_w alone writes them)."""
     lines = path.read_text().splitlines()
     start = next(no for no, ln in enumerate(lines, 1) if ln.startswith("spawns = "))
-    end = next(no for no, ln in enumerate(lines, 1) if no > start and ln == "]")
-    items = [no for no, ln in enumerate(lines, 1) if start < no < end and ln.startswith("    [")]
+    items = []
+    for no, ln in enumerate(lines[start:], start + 1):  # "    [" (one number a line) or "    [x, z, h],"
+        if not ln.startswith("    ["):
+            break
+        items.append(no)
     return items[i]
 
 
@@ -330,6 +333,11 @@ def make_cases() -> None:
     with open(c / "arenas/a/arena.obj", "a") as f:
         f.write("# edited\n")
     expect(c, "B204", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", "sha256")])
+
+    # --- what play cannot load although no other rule objects: [walls] is not a table
+    c = BROKEN / "B301_walls_not_a_table"
+    write_arena(c / "arenas" / "a", toml_edit=lambda d: d.update(walls=1))
+    expect(c, "B301", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", "walls = 1")])
 
     # --- vehicles
     def vcase(code, name, **kw):

@@ -218,14 +218,24 @@ def analyse(walls: WallList) -> FreeSpace:
 
 
 def _dangling_ends(snapped: np.ndarray, live: np.ndarray, lines, g: float) -> tuple[np.ndarray, np.ndarray]:
-    """Wall ends touching no other wall (neither its ends nor its length)."""
+    """Wall ends touching no other wall (neither its ends nor its length).
+
+    Walls with the same two ends are looked up once: both ends of a repeated wall touch
+    its copy, and a wall pasted 2,000 times would otherwise make 8 million end-wall
+    pairs (seconds of work for a 60 KB file)."""
     ends = np.concatenate([snapped[live, 0], snapped[live, 1]])
     owner = np.concatenate([live, live])
-    tree = STRtree(lines[live])
+    a, b = snapped[live, 0], snapped[live, 1]
+    swap = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
+    key = np.where(swap[:, None], np.hstack([b, a]), np.hstack([a, b]))
+    _, first, group, count = np.unique(key, axis=0, return_index=True, return_inverse=True, return_counts=True)
+    group = group.reshape(-1)
+    tree = STRtree(lines[live[first]])
     pi, ti = tree.query(shapely.points(ends), predicate="dwithin", distance=2.0 * g)
-    other = live[ti] != owner[pi]
+    other = ti != np.concatenate([group, group])[pi]
     joined = np.zeros(len(ends), dtype=bool)
     joined[pi[other]] = True
+    joined |= np.concatenate([count[group] > 1, count[group] > 1])   # touches its own copy
     return ends[~joined], owner[~joined]
 
 

@@ -20,6 +20,7 @@ else:  # pragma: no cover
     import tomli as tomllib
 
 from ..formats.bundle import sha256_file
+from ..formats.limits import MAX_DEPTH, nesting_depth
 from .diagnostics import Diagnostic, diag
 
 _HEADER = re.compile(r"^\s*\[\s*([A-Za-z0-9_.\-\" ]+?)\s*\]\s*(#.*)?$")
@@ -78,6 +79,21 @@ class TomlLines:
         return out[:count]
 
 
+def _manifest_bytes(path: Path) -> bytes:
+    """A manifest's bytes: a regular file of at most MAX_MANIFEST_BYTES, else OSError
+    (the runner reports the path as unreadable)."""
+    import errno
+
+    from ..errors import FormatError
+    from ..formats.bundle import read_input
+    from ..formats.limits import MAX_MANIFEST_BYTES
+
+    try:
+        return read_input(path, "a TOML manifest", limit=MAX_MANIFEST_BYTES)
+    except FormatError as e:
+        raise OSError(errno.EINVAL, str(e).split(": ", 1)[-1], str(path)) from None
+
+
 class Manifest:
     """A bundle's manifest: the parsed document (or None), its text lines, its path."""
 
@@ -86,7 +102,7 @@ class Manifest:
         self.doc: dict[str, Any] | None = None
         self.lines = TomlLines("")
         self.diagnostics: list[Diagnostic] = []
-        data = path.read_bytes()  # OSError goes to the runner: the path cannot be read
+        data = _manifest_bytes(path)  # OSError goes to the runner: the path cannot be read
         try:
             text = data.decode("utf-8")
         except UnicodeDecodeError as e:
@@ -99,6 +115,11 @@ class Manifest:
         except tomllib.TOMLDecodeError as e:
             m = re.search(r"line (\d+)", str(e))
             self.diagnostics.append(diag("B101", str(path), int(m.group(1)) if m else 0, f"invalid TOML: {e}"))
+        except RecursionError:
+            self.diagnostics.append(diag("B101", str(path), 0, "invalid TOML: values nested too deeply"))
+        if self.doc is not None and nesting_depth(self.doc) > MAX_DEPTH:
+            self.doc = None
+            self.diagnostics.append(diag("B101", str(path), 0, f"values nested deeper than {MAX_DEPTH} levels"))
 
     def missing(self, table: str, key: str, what: str) -> Diagnostic:
         name = f"[{table}] {key}" if table else key
@@ -135,11 +156,16 @@ class Manifest:
 
 
 def safe_file(bundle: Path, name: str) -> Path | None:
-    """``bundle/name`` if ``name`` is a plain relative path inside the bundle."""
-    p = Path(name)
-    if p.is_absolute() or ".." in p.parts:
+    """``bundle/name`` if ``name`` is a relative path that stays inside the bundle
+    (symbolic links followed), else None: ``/etc/passwd`` or a link to ``/dev/zero``
+    is never opened."""
+    from ..errors import FormatError
+    from ..formats.bundle import bundle_file
+
+    try:
+        return bundle_file(bundle, name, "")
+    except FormatError:
         return None
-    return bundle / p
 
 
 def file_rules(man: Manifest, bundle: Path, required_derived: tuple[str, ...]) -> list[Diagnostic]:

@@ -17,6 +17,8 @@ import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from .arena_rules import ArenaInfo, VehicleSize, check_arena, check_walls_file
 from .diagnostics import ERROR, WARNING, Diagnostic, diag
 from .vehicle_rules import check_vehicle, vehicle_fit
@@ -199,6 +201,89 @@ def _fallback_note(what: list[Path], kind: str, used: list[Path]) -> str:
             f"(name {other} bundles to check against others)")
 
 
+def _key_line(man_path: Path, message: str) -> int:
+    """The manifest line of the key a loader's message names (``[hull] file``,
+    ``'spawns'``, ``[walls]``), or 0."""
+    import re
+
+    from .manifest import Manifest
+
+    try:
+        lines = Manifest(man_path).lines
+    except OSError:
+        return 0
+    for m in re.finditer(r"\[(\w+)\](?: (\w+))?", message):
+        line = (m.group(2) and lines.key(m.group(1), m.group(2))) or lines.table(m.group(1)) \
+            or lines.key("", m.group(1))
+        if line:
+            return line
+    for m in re.finditer(r"'(\w+)'|\b(\w+) must\b", message):
+        line = lines.key("", m.group(1) or m.group(2))
+        if line:
+            return line
+    return 0
+
+
+def play_rules(kind: str, bundle: Path) -> list[Diagnostic]:
+    """B301: load the bundle the way ``play`` does (sim/match.py's loaders, the world,
+    the files the game window reads: model.glb, quadtree.npz, navgrid.npz), so that
+    anything that would stop ``play`` is an error here too."""
+    from ..errors import TanktoolError
+
+    manifest = bundle / (ARENA_MANIFEST if kind == "arenas" else VEHICLE_MANIFEST)
+    try:
+        _play_load(kind, bundle)
+    except TanktoolError as e:
+        msg = str(e)
+        return [diag("B301", str(manifest), _key_line(manifest, msg), f"play cannot load this bundle: {msg}")]
+    except (ValueError, TypeError, KeyError, IndexError, ArithmeticError) as e:
+        return [diag("B301", str(manifest), 0, f"play would stop with an internal error: {type(e).__name__}: {e}")]
+    return []
+
+
+def _play_load(kind: str, bundle: Path) -> None:
+    from ..formats.bundle import read_input
+    from ..formats.gltf import read_gltf
+    from ..sim.body import TankSpec
+    from ..sim.match import load_match_arena, load_tank_spec
+    from ..sim.world import World
+
+    if kind == "arenas":
+        from ..arena import load_arena
+        from ..nav.navgrid import NavGrid
+        from ..nav.quadtree import WallQuadtree
+
+        info = load_match_arena(bundle)
+        model = load_arena(bundle).file("model")
+        model = model if model.name else bundle / "model.glb"
+        if model.suffix.lower() == ".glb" and model.is_file():  # what the 3D view draws
+            read_gltf(read_input(model, "a .glb model"), str(model))
+        from ..formats.npz import read_npz
+
+        for name, reader in (("quadtree.npz", WallQuadtree.load), ("navgrid.npz", NavGrid.load)):
+            if (bundle / name).is_file():  # what the top view's overlays read
+                read_npz(bundle / name, f"a {name} file")  # a damaged archive: one clear line
+                reader(bundle / name)
+        World(info.walls, [TankSpec.box("check")], info.spawns, bounds=info.bounds)  # a match needs a spawn
+    else:
+        spec = load_tank_spec(bundle)
+        model = bundle / "model.glb"
+        if model.is_file():
+            read_gltf(read_input(model, "a .glb model"), str(model))
+        World(np.array([[[0.0, 0.0], [100.0, 0.0]]]), [spec], [[50.0, 50.0, 0.0]],
+              bounds=np.array([[0.0, 0.0], [100.0, 100.0]]))
+
+
+def _with_play_rules(report: Report, kind: str, bundle: Path) -> None:
+    """Add B301 for ``bundle`` unless its rules already found an error (which stops
+    play as well and says more precisely what to fix)."""
+    root = bundle.resolve()
+    for d in report.diagnostics:
+        if d.severity == ERROR and (Path(d.path).resolve() == root or root in Path(d.path).resolve().parents):
+            return
+    report.diagnostics += _guard(report, bundle, play_rules, kind, bundle) or []
+
+
 def run_check(paths: list[str | os.PathLike]) -> Report:
     targets = discover([Path(p) for p in paths])
     report = Report(unreadable=list(targets.unreadable))
@@ -214,6 +299,7 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
             report.diagnostics += res[0]
             if res[1]:
                 sizes[v.resolve()] = res[1]
+        _with_play_rules(report, "vehicles", v)
     checked_vehicles = set(sizes)
     infos: dict[Path, ArenaInfo] = {}
     for a in targets.arenas:
@@ -225,6 +311,7 @@ def run_check(paths: list[str | os.PathLike]) -> Report:
         if res:
             report.diagnostics += res[0]
             infos[a.resolve()] = res[1]
+        _with_play_rules(report, "arenas", a)
     for w in targets.walls:
         report.files.append(str(w))
         res = _guard(report, w, check_walls_file, w)

@@ -35,12 +35,25 @@ def pair_rules(walls: WallList, grid: float) -> list[Diagnostic]:
     live = np.flatnonzero(length > 0)
     if len(live) < 2:
         return []
+    # exact repeats (same ends in either order, same free side) are A202 against their
+    # first copy and take no further part: a wall pasted 10,000 times would otherwise
+    # make 10^8 candidate pairs
+    flip = (seg[live, 0, 0] > seg[live, 1, 0]) | ((seg[live, 0, 0] == seg[live, 1, 0]) & (seg[live, 0, 1] > seg[live, 1, 1]))
+    ends = np.where(flip[:, None, None], seg[live, ::-1], seg[live]).reshape(-1, 4)
+    keys = np.column_stack([ends, np.where(flip, -walls.direction[live], walls.direction[live])])
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    origin = live[first[inverse.reshape(-1)]]
+    repeats = [diag("A202", path, _line(walls, k), f"this wall repeats the wall on line {_line(walls, o)}")
+               for k, o in zip(live, origin) if k != o]
+    live = np.unique(origin)
+    if len(live) < 2:
+        return repeats
     lines = shapely.linestrings(seg[live])
     i, j = STRtree(lines).query(lines, predicate="intersects")
     keep = i < j
     a, b = live[i[keep]], live[j[keep]]
     if not len(a):
-        return []
+        return repeats
     tol = 4.0 * grid
     P, Q = seg[a, 0], seg[a, 1]
     R, S = seg[b, 0], seg[b, 1]
@@ -67,7 +80,7 @@ def pair_rules(walls: WallList, grid: float) -> list[Diagnostic]:
         cross = ((ca1 > tol) & (ca2 < -tol) | (ca1 < -tol) & (ca2 > tol)) & \
                 ((cb1 > tol) & (cb2 < -tol) | (cb1 < -tol) & (cb2 > tol))
 
-    out: list[Diagnostic] = []
+    out: list[Diagnostic] = repeats
     # two coincident walls with opposite normals are the shared face of two touching
     # solids (both normals point into solid, they cancel): legal, so only same-side pairs count
     dup = collinear & same_ends & same_side

@@ -286,24 +286,37 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
     tree_path = target.output("quadtree.npz")
     grid_path = target.output("navgrid.npz")
 
-    atomic_write_bytes(grid_path, grid.to_bytes())
-    tree.save(tree_path)
-    atomic_write_bytes(plot_path, picture)
     if table is not None:
         atomic_write_text(table_path, table)
-    if target.manifest is not None:
-        doc = dict(target.toml)
-        doc["navgrid"] = {**doc.get("navgrid", {}), "cell": float(cell), "clearance": float(clearance),
-                          "quadtree_depth": int(quadtree_depth)}
-        if params is not None:  # the surface this grid was built from
-            doc["walkable"] = params.as_toml()
-        derived = dict(doc.get("derived", {}))
-        derived["navgrid.npz"] = sha256_file(grid_path)
-        derived["quadtree.npz"] = sha256_file(tree_path)
-        if plot_path.resolve() == (target.out_dir / "navgrid.png").resolve():
-            derived["navgrid.png"] = sha256_file(plot_path)
-        doc["derived"] = derived
-        atomic_write_text(target.manifest, dumps_toml(doc))
+    if target.manifest is None:
+        atomic_write_bytes(grid_path, grid.to_bytes())
+        tree.save(tree_path)
+        atomic_write_bytes(plot_path, picture)
+    else:
+        # the grid files and the manifest that hashes them change together, in one
+        # atomic swap of the bundle folder (formats/bundle.py bundle_update)
+        from ..formats.bundle import bundle_update
+
+        in_bundle = plot_path.resolve().parent == target.out_dir.resolve()
+        if not in_bundle:
+            atomic_write_bytes(plot_path, picture)
+        with bundle_update(target.out_dir) as stage:
+            atomic_write_bytes(stage / grid_path.name, grid.to_bytes())
+            tree.save(stage / tree_path.name)
+            if in_bundle:
+                atomic_write_bytes(stage / plot_path.name, picture)
+            doc = dict(target.toml)
+            doc["navgrid"] = {**doc.get("navgrid", {}), "cell": float(cell), "clearance": float(clearance),
+                              "quadtree_depth": int(quadtree_depth)}
+            if params is not None:  # the surface this grid was built from
+                doc["walkable"] = params.as_toml()
+            derived = dict(doc.get("derived", {}))
+            derived["navgrid.npz"] = sha256_file(stage / grid_path.name)
+            derived["quadtree.npz"] = sha256_file(stage / tree_path.name)
+            if in_bundle and plot_path.name == "navgrid.png":
+                derived["navgrid.png"] = sha256_file(stage / plot_path.name)
+            doc["derived"] = derived
+            atomic_write_text(stage / target.manifest.name, dumps_toml(doc))
 
     n_valid = int(grid.valid.sum())
     n_reach = int((grid.valid & grid.reachable).sum())

@@ -10,8 +10,11 @@ from .options import force_option, name_option, out_option, progress, scale_opti
 
 #: models with more faces than this get a progress bar
 PROGRESS_FACES = 100_000
-#: the stages import_arena reports (nav.arena_levels.STAGES, then the files)
-STAGES = ("surface", "walls", "grid", "spawns", "report", "files")
+#: floor plans bigger than this get one (a 37 KB plan of 800 pillars takes seconds)
+PROGRESS_PLAN_BYTES = 16_000
+#: the stages import_arena reports (floor plans report PLAN_STAGES while being read),
+#: then nav.arena_levels.STAGES, then the files
+STAGES = ("read", "surface", "walls", "grid", "spawns", "report", "files")
 
 
 def _face_count_guess(model: Path) -> int:
@@ -22,6 +25,16 @@ def _face_count_guess(model: Path) -> int:
         return 0
     # ~40 bytes a face in .obj text, ~14 in .3ds; either way a big file is a big model
     return size // 20
+
+
+def _stages(model: Path) -> tuple[str, ...] | None:
+    """The progress bar's stages for ``model``, or None when it imports in a moment."""
+    from ..formats.floorplan import PLAN_EXTENSIONS, PLAN_STAGES
+
+    if model.suffix.lower() in PLAN_EXTENSIONS:
+        big = _face_count_guess(model) * 20 > PROGRESS_PLAN_BYTES
+        return PLAN_STAGES + STAGES if big else None
+    return STAGES if _face_count_guess(model) > PROGRESS_FACES else None
 
 
 @click.command("import-arena")
@@ -77,8 +90,9 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
 
     kw = dict(warn=warn, wall_height=wall_height, wall_thickness=wall_thickness, max_slope=max_slope,
               climb=climb, headroom=headroom, cell=cell)
-    if _face_count_guess(model) > PROGRESS_FACES:
-        with progress(length=len(STAGES), label=f"importing {model.name}") as bar:
+    stages = _stages(model)
+    if stages:
+        with progress(length=len(stages), label=f"importing {model.name}") as bar:
             result = run(model, out, name, up, scale, height, tolerance, force, progress=lambda _s: bar.update(1),
                          **kw)
     else:

@@ -175,7 +175,8 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
     """
     import trimesh
 
-    from ..formats.bundle import dumps_toml, sha256_file, staged_dir, atomic_write_text, atomic_write_bytes
+    from ..formats.bundle import (atomic_write_bytes, atomic_write_text, check_replaceable, dumps_toml,
+                                  sha256_file, staged_dir)
     from ..formats.models import default_up, detect_format, load_scene
     from ..formats.vehicle_bundle import write_hull
     from ..geometry.mass import drive_defaults, sig, to_scale
@@ -186,8 +187,7 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
     model = Path(model)
     check_options(hull_points_n, levels, branching, mass, name)
     out = Path(out)
-    if out.exists() and not force:
-        raise VehicleError(f"{out}: already exists (use --force to overwrite)")
+    check_replaceable(out, force, "vehicle.toml")  # only a vehicle bundle tanktool wrote is replaced
     if out.resolve() == model.resolve().parent:
         raise VehicleError(f"{out}: the output folder must not be the folder of the model being imported")
     fmt = detect_format(model)
@@ -218,7 +218,7 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
         params.update({k: drive[k] for k in params if k in drive})
     header = f"{name}: made by tanktool {__version__} import-vehicle from {model.name}"
 
-    with staged_dir(out, force=force) as tmp:
+    with staged_dir(out, force=force, manifest="vehicle.toml") as tmp:
         source_name = model.name
         shutil.copyfile(model, tmp / source_name)
         atomic_write_bytes(tmp / "model.glb", scene.export(file_type="glb"))

@@ -39,7 +39,8 @@ class UserError(click.ClickException):
         self.exit_code = exit_code
 
     def show(self, file=None) -> None:
-        click.echo(f"error: {self.format_message()}", err=True)
+        # one line, whatever the message: a library's text may hold line breaks
+        click.echo(f"error: {' '.join(self.format_message().split())}", err=True)
 
 
 def _set_output(ctx: click.Context, verbose: int, quiet: bool) -> None:
@@ -88,6 +89,13 @@ class LazyGroup(click.Group):
             if ctx.obj and ctx.obj.get("verbose"):
                 traceback.print_exc()
             raise UserError(str(e), e.exit_code) from e
+        except OSError as e:  # the system refused: a full disk, a file size limit, a read-only folder
+            if ctx.obj and ctx.obj.get("verbose"):
+                traceback.print_exc()
+            from ..formats.bundle import os_error_text
+
+            where, e.filename = e.filename, None
+            raise UserError(f"{where or 'the system'}: {os_error_text(e)}") from e
 
     def list_commands(self, ctx: click.Context) -> list[str]:
         return [name for name in COMMANDS if self._available(name)]

@@ -1,19 +1,40 @@
-"""Bundles on disk: TOML manifests, hashes, and atomic writes.
+"""Bundles on disk: TOML manifests, hashes, files confined to their bundle, and writes
+that survive being killed at any moment.
 
-Nothing the tools write is ever half-written: single files go to a temporary file
-in the same folder and are renamed over the target; whole bundles are assembled in a
-temporary sibling folder (:func:`staged_dir`) and renamed into place at the end.
+Reading.  :func:`read_input` is the one way the tools read an input file: only a
+regular file (never a device, a FIFO or a folder), at most a given number of bytes,
+every failure a :class:`~tanktool.errors.FormatError` naming the file.
+:func:`bundle_file` resolves a file name written in a manifest inside its bundle, or
+refuses it (``/etc/passwd``, ``../x``, a symbolic link that leads out).
+
+Writing.  Single files go to a temporary file in the same folder and are renamed over
+the target (:func:`atomic_write_bytes`).  Whole bundles are assembled in a staging
+folder beside the target (:func:`staged_dir`) and swapped into place with one atomic
+``renameat2(RENAME_EXCHANGE)``, so at every moment the target is either the complete
+old bundle or the complete new one; :func:`bundle_update` changes some files of an
+existing bundle and its manifest together the same way.  Only a bundle tanktool wrote
+is ever replaced (:func:`check_replaceable`).
+
+Every temporary name carries ``tanktool-<pid>-<random>``: when a run is killed
+(SIGKILL, power loss of the process) what it left behind is recognised by the next
+run (the pid is gone) and removed -- or, for the rare file systems without
+RENAME_EXCHANGE, the previous bundle is put back (:func:`clean_stale`).
+An OSError while writing (read-only folder, full disk, file size limit) becomes one
+:class:`~tanktool.errors.OutputError` line.
 """
 
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import errno
 import hashlib
 import os
 import re
+import secrets
 import shutil
+import stat
 import sys
-import tempfile
 from pathlib import Path
 from typing import Any, Iterator
 
@@ -22,7 +43,11 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover
     import tomli as tomllib
 
-from ..errors import FormatError
+from ..errors import FormatError, OutputError
+from .limits import MAX_DEPTH, MAX_MANIFEST_BYTES, MAX_MODEL_BYTES, nesting_depth
+
+# ---------------------------------------------------------------------------
+# reading
 
 
 def _umask() -> int:
@@ -31,53 +56,64 @@ def _umask() -> int:
     return mask
 
 
-def sha256_file(path: str | os.PathLike) -> str:
-    """Hex sha256 of a file's bytes."""
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
-def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file and a rename."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+def _open_regular(path: str | os.PathLike, label: str, expected: str) -> int:
+    """An fd of a regular file, opened without blocking (a FIFO would hang ``open``)."""
     try:
-        # mkstemp makes 0600 files; give the result the mode a plain open() would
-        os.chmod(tmp, 0o666 & ~_umask())
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
-        raise
-
-
-def atomic_write_text(path: str | os.PathLike, text: str) -> None:
-    atomic_write_bytes(path, text.encode("utf-8"))
-
-
-def read_input(path: str | os.PathLike, expected: str = "a file", label: str | None = None) -> bytes:
-    """The bytes of an input file.  A missing file, a folder or an unreadable file is a
-    FormatError naming ``label`` (default: the path) and saying what was ``expected``."""
-    label = label or str(path)
-    try:
-        return Path(path).read_bytes()
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     except FileNotFoundError:
         raise FormatError(f"{label}: no such file") from None
     except IsADirectoryError:
         raise FormatError(f"{label}: is a folder, expected {expected}") from None
+    except (OSError, ValueError) as e:  # ValueError: a NUL byte in the name
+        raise FormatError(f"{label}: cannot read: {getattr(e, 'strerror', None) or e}") from None
+    try:
+        st = os.fstat(fd)
+    except OSError as e:
+        os.close(fd)
+        raise FormatError(f"{label}: cannot read: {e.strerror}") from None
+    if stat.S_ISDIR(st.st_mode):
+        os.close(fd)
+        raise FormatError(f"{label}: is a folder, expected {expected}")
+    if not stat.S_ISREG(st.st_mode):
+        os.close(fd)
+        raise FormatError(f"{label}: is not a regular file (a device, pipe or socket), expected {expected}")
+    return fd
+
+
+def read_input(path: str | os.PathLike, expected: str = "a file", label: str | None = None,
+               limit: int = MAX_MODEL_BYTES) -> bytes:
+    """The bytes of an input file, at most ``limit`` of them.
+
+    A missing file, a folder, a device or FIFO, an unreadable or too large file is a
+    FormatError naming ``label`` (default: the path) and saying what was ``expected``.
+    """
+    label = label or str(path)
+    fd = _open_regular(path, label, expected)
+    try:
+        size = os.fstat(fd).st_size
+        if size > limit:
+            raise FormatError(f"{label}: {size:,} bytes, more than the {limit:,} bytes {expected} may have")
+        chunks, total = [], 0
+        with os.fdopen(fd, "rb", closefd=False) as f:
+            while True:
+                block = f.read(min(1 << 24, limit + 1 - total))
+                if not block:
+                    break
+                chunks.append(block)
+                total += len(block)
+                if total > limit:  # it grew while we read it
+                    raise FormatError(f"{label}: more than the {limit:,} bytes {expected} may have")
+        return b"".join(chunks)
     except OSError as e:
         raise FormatError(f"{label}: cannot read: {e.strerror}") from None
+    finally:
+        os.close(fd)
 
 
-def read_input_text(path: str | os.PathLike, expected: str = "a text file") -> str:
+def read_input_text(path: str | os.PathLike, expected: str = "a text file", limit: int = MAX_MODEL_BYTES) -> str:
     """An input file as UTF-8 text; bytes that are not UTF-8 are a FormatError naming the
     line and the byte offset."""
-    data = read_input(path, expected)
+    data = read_input(path, expected, limit=limit)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as e:
@@ -85,18 +121,65 @@ def read_input_text(path: str | os.PathLike, expected: str = "a text file") -> s
         raise FormatError(f"{path}:{line}: not UTF-8 text (byte offset {e.start})") from None
 
 
-def read_toml(path: str | os.PathLike) -> dict[str, Any]:
-    """Read a TOML file; a syntax error becomes a FormatError naming the file."""
-    path = Path(path)
+def parse_toml(data: bytes, label: str) -> dict[str, Any]:
+    """TOML bytes as a dict; syntax errors, non-UTF-8 bytes and nesting deeper than
+    ``MAX_DEPTH`` are FormatErrors naming ``label``."""
     try:
-        with open(path, "rb") as f:
-            return tomllib.load(f)
-    except FileNotFoundError:
-        raise FormatError(f"{path}: no such file") from None
-    except tomllib.TOMLDecodeError as e:
-        raise FormatError(f"{path}: invalid TOML: {e}") from None
+        text = data.decode("utf-8")
     except UnicodeDecodeError as e:
-        raise FormatError(f"{path}: not UTF-8 text at byte {e.start}") from None
+        line = data[: e.start].count(b"\n") + 1
+        raise FormatError(f"{label}:{line}: not UTF-8 text (byte offset {e.start})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise FormatError(f"{label}: invalid TOML: {e}") from None
+    except RecursionError:
+        raise FormatError(f"{label}: invalid TOML: values nested deeper than {MAX_DEPTH} levels") from None
+    if nesting_depth(doc) > MAX_DEPTH:
+        raise FormatError(f"{label}: values nested deeper than {MAX_DEPTH} levels")
+    return doc
+
+
+def read_toml(path: str | os.PathLike, limit: int = MAX_MANIFEST_BYTES) -> dict[str, Any]:
+    """Read a TOML file (a manifest, the bindings); every defect is a FormatError naming it."""
+    return parse_toml(read_input(path, "a TOML file", limit=limit), str(path))
+
+
+def sha256_file(path: str | os.PathLike) -> str:
+    """Hex sha256 of a regular file's bytes (a device or FIFO is a FormatError)."""
+    label = str(path)
+    fd = _open_regular(path, label, "a file")
+    h = hashlib.sha256()
+    try:
+        with os.fdopen(fd, "rb", closefd=False) as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+    finally:
+        os.close(fd)
+    return h.hexdigest()
+
+
+def bundle_file(bundle: str | os.PathLike, name: Any, where: str) -> Path:
+    """``bundle/name`` for a file name written in a bundle's manifest, or a FormatError.
+
+    The name must be a relative path that stays inside the bundle once symbolic links
+    are followed: ``/etc/passwd``, ``../../x``, a link to ``/dev/zero`` are refused
+    (``where`` says which key named it, e.g. ``vehicles/x/vehicle.toml: [hull] file``).
+    """
+    if not isinstance(name, str) or not name or "\0" in name:
+        raise FormatError(f"{where} must be a file name in the bundle, got {name!r}")
+    p = Path(name)
+    if p.is_absolute() or ".." in p.parts or "\\" in name:
+        raise FormatError(f"{where} must be a file name inside the bundle, got {name!r}")
+    root = Path(bundle)
+    try:
+        real_root = root.resolve()
+        real = (root / p).resolve()
+    except (OSError, RuntimeError):  # a loop of symbolic links
+        raise FormatError(f"{where}: {name!r} cannot be resolved (a loop of symbolic links?)") from None
+    if real != real_root and real_root not in real.parents:
+        raise FormatError(f"{where}: {name!r} leads outside the bundle (to {real})")
+    return root / p
 
 
 #: an array of scalars that tomli_w spread over one line per item
@@ -113,33 +196,379 @@ def dumps_toml(data: dict[str, Any]) -> str:
     return _SCALAR_ARRAY.sub(one_line, tomli_w.dumps(data))
 
 
+# ---------------------------------------------------------------------------
+# OS errors as one line
+
+
+_OS_HINTS = {
+    errno.ENOSPC: "no space left on the disk",
+    errno.EFBIG: "file size limit reached (ulimit -f)",
+    errno.EROFS: "read-only file system",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "operation not permitted",
+    errno.EDQUOT: "disk quota exceeded",
+}
+
+
+#: a temporary name inside a path, as the user should see it: the final name
+_TEMP_IN_PATH = re.compile(r"\.([^/]+?)\.tanktool-\d+-[0-9a-f]+(?:\.tmp|\.old)?(?=/|$)")
+
+
+def os_error_text(e: OSError) -> str:
+    """What went wrong, in words: 'no space left on the disk', 'permission denied', ...
+    and the file it happened to (temporary names shown as the file they become)."""
+    text = _OS_HINTS.get(e.errno or 0) or e.strerror or str(e)
+    where = _TEMP_IN_PATH.sub(r"\1", os.fsdecode(e.filename)) if e.filename else ""
+    return f"{text} ({where})" if where else text
+
+
+def output_error(target: str | os.PathLike, e: OSError, what: str = "cannot write") -> OutputError:
+    """One line: the file (a staging name shown as the file it becomes), what failed, why."""
+    shown = _TEMP_IN_PATH.sub(r"\1", os.fspath(target))
+    if e.filename and _TEMP_IN_PATH.sub(r"\1", os.fsdecode(e.filename)) == shown:
+        e.filename = None  # said once is enough
+    return OutputError(f"{shown}: {what}: {os_error_text(e)}")
+
+
+# ---------------------------------------------------------------------------
+# temporary names and what killed runs leave behind
+
+#: ``.<name>.tanktool-<pid>-<hex>`` (a staging folder), ``...tmp`` (a file being
+#: written), ``...old`` (a bundle moved aside during a swap without RENAME_EXCHANGE)
+_TEMP = re.compile(r"^\.(?P<name>.+)\.tanktool-(?P<pid>\d+)-[0-9a-f]+(?P<kind>\.tmp|\.old)?$")
+
+
+def _temp_name(name: str, suffix: str = "") -> str:
+    return f".{name}.tanktool-{os.getpid()}-{secrets.token_hex(4)}{suffix}"
+
+
+def is_temp_name(name: str) -> bool:
+    """True for the names of tanktool's own temporary files and folders."""
+    return _TEMP.match(name) is not None
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return pid > 0  # someone else's process
+    return True
+
+
+def _remove(p: Path) -> None:
+    if p.is_dir() and not p.is_symlink():
+        shutil.rmtree(p, ignore_errors=True)
+    else:
+        with contextlib.suppress(OSError):
+            p.unlink()
+
+
+def clean_stale(folder: str | os.PathLike, name: str | None = None) -> list[str]:
+    """Remove what killed tanktool runs left in ``folder`` (only for ``name`` if
+    given): staging folders and temporary files of processes that no longer exist.
+    A bundle moved aside by an interrupted swap is put back when its place is empty.
+    Returns the names handled; failures (a read-only folder) are ignored."""
+    folder = Path(folder)
+    try:
+        entries = os.listdir(folder)
+    except OSError:
+        return []
+    done = []
+    # put moved-aside bundles back first, then drop staging folders and temporary files
+    found = [(m, e) for e in entries if (m := _TEMP.match(e)) and (name is None or m["name"] == name)]
+    found.sort(key=lambda me: me[0]["kind"] != ".old")
+    for m, entry in found:
+        if _alive(int(m["pid"])):
+            continue
+        p = folder / entry
+        home = folder / m["name"]
+        if m["kind"] == ".old" and not os.path.lexists(home):
+            with contextlib.suppress(OSError):
+                os.replace(p, home)
+                done.append(entry)
+                continue
+        _remove(p)
+        done.append(entry)
+    return done
+
+
+# ---------------------------------------------------------------------------
+# single files
+
+
+def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file and a rename.
+
+    The file gets the mode a plain ``open()`` would give it.  On any failure the
+    temporary file is removed and ``path`` is left as it was; an OSError becomes an
+    OutputError naming ``path``.
+    """
+    path = Path(path)
+    if not path.name:
+        raise OutputError(f"{path}: not a file name")
+    clean_stale(path.parent, path.name)
+    tmp = path.parent / _temp_name(path.name, ".tmp")
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_CLOEXEC", 0), 0o666)
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view):]
+        finally:
+            os.close(fd)
+        os.replace(tmp, path)
+    except BaseException as e:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(e, OSError):
+            raise output_error(path, e) from None
+        raise
+
+
+def atomic_write_text(path: str | os.PathLike, text: str) -> None:
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
 def write_toml(path: str | os.PathLike, data: dict[str, Any]) -> None:
     atomic_write_text(path, dumps_toml(data))
 
 
-@contextlib.contextmanager
-def staged_dir(target: str | os.PathLike, force: bool = False) -> Iterator[Path]:
-    """Yield a temporary folder beside ``target``; on success it replaces ``target``.
+# ---------------------------------------------------------------------------
+# which folders may be replaced
 
-    On any exception the temporary folder is removed and ``target`` is left as it
-    was.  Without ``force`` an existing ``target`` is refused before any work.
+MANIFESTS = ("arena.toml", "vehicle.toml")
+#: files each kind of bundle holds besides those its manifest names
+_STANDARD = {
+    "arena.toml": ("model.glb", "walls.txt", "preview.png", "navgrid.npz", "quadtree.npz", "navgrid.png"),
+    "vehicle.toml": ("model.glb", "hull.txt", "spheres.txt", "preview.png"),
+}
+
+
+def _obj_materials(model: Path) -> set[str]:
+    """Plain file names of an .obj's ``mtllib`` lines (copied into bundles beside it)."""
+    out: set[str] = set()
+    try:
+        data = read_input(model, "an .obj file")
+    except FormatError:
+        return out
+    for raw in data.splitlines():
+        if raw.startswith(b"mtllib"):
+            out.update(n.decode("utf-8", "replace") for n in raw.split()[1:])
+    return out
+
+
+def bundle_files(folder: Path, doc: dict[str, Any], manifest: str) -> set[str]:
+    """Names of the files a bundle written by tanktool holds (its own, not a user's)."""
+    names = {manifest, *_STANDARD.get(manifest, ())}
+    for table in doc.values():
+        if isinstance(table, dict) and isinstance(table.get("file"), str):
+            names.add(table["file"])
+    derived = doc.get("derived")
+    if isinstance(derived, dict):
+        names.update(str(k) for k in derived)
+    src = doc.get("source")
+    if isinstance(src, dict):
+        comp = src.get("companions")
+        if isinstance(comp, list):
+            names.update(c for c in comp if isinstance(c, str))
+        f = src.get("file")
+        if isinstance(f, str) and f.lower().endswith(".obj") and "/" not in f:
+            names |= _obj_materials(folder / f)
+    return names
+
+
+def check_replaceable(target: str | os.PathLike, force: bool, manifest: str | None = None) -> None:
+    """Raise OutputError unless ``target`` is free or may be replaced.
+
+    A path that exists is replaced only with ``force`` and only when it is a bundle
+    tanktool wrote: a real folder (not a link) holding ``manifest`` (any kind when
+    None) with a ``tool_version``, and no file the bundle does not account for.  A
+    user's folder, a file, another kind of bundle are refused with the reason.
     """
     target = Path(target)
-    if target.exists() and not force:
-        raise FormatError(f"{target}: already exists (use --force to overwrite)")
-    target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
-    os.chmod(tmp, 0o777 & ~_umask())  # mkdtemp makes 0700 folders; bundles are shared
+    if not os.path.lexists(target):
+        return
+    if not force:
+        raise OutputError(f"{target}: already exists (use --force to overwrite)")
+    kinds = (manifest,) if manifest else MANIFESTS
+    if os.path.islink(target):
+        raise OutputError(f"{target}: is a symbolic link; refusing to replace it (give the folder it points to)")
+    if not target.is_dir():
+        raise OutputError(f"{target}: exists and is not a folder; refusing to replace it with a bundle")
+    found = next((k for k in kinds if (target / k).is_file()), None)
+    if found is None:
+        other = next((k for k in MANIFESTS if k not in kinds and (target / k).is_file()), None)
+        if other:
+            raise OutputError(f"{target}: is {'an arena' if other == 'arena.toml' else 'a vehicle'} bundle "
+                              f"(it has {other}); refusing to replace it")
+        raise OutputError(f"{target}: is not a tanktool bundle (no {kinds[0]}); refusing to replace a folder "
+                          f"tanktool did not write (choose another -o)")
     try:
-        yield tmp
+        doc = read_toml(target / found)
+    except FormatError as e:
+        raise OutputError(f"{target}: its {found} cannot be read, so it is not a bundle tanktool wrote ({e}); "
+                          f"refusing to replace it") from None
+    if not isinstance(doc.get("tool_version"), str):
+        raise OutputError(f"{target}: its {found} has no tool_version, so tanktool did not write it; "
+                          f"refusing to replace it")
+    known = bundle_files(target, doc, found)
+    try:
+        foreign = sorted(n for n in os.listdir(target) if n not in known and not is_temp_name(n))
+    except OSError as e:
+        raise output_error(target, e, "cannot list the folder") from None
+    if foreign:
+        shown = ", ".join(foreign[:3]) + (", ..." if len(foreign) > 3 else "")
+        raise OutputError(f"{target}: holds {len(foreign)} file(s) that are not part of the bundle ({shown}); "
+                          f"refusing to replace it (move them away, or choose another -o)")
+
+
+# ---------------------------------------------------------------------------
+# whole bundles
+
+_AT_FDCWD = -100
+_RENAME_EXCHANGE = 2
+_renameat2: Any = None
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap two paths in one atomic step (Linux ``renameat2(RENAME_EXCHANGE)``).
+    False when the system or the file system cannot; other failures raise OSError."""
+    global _renameat2
+    if _renameat2 is None:
+        try:
+            _renameat2 = getattr(ctypes.CDLL(None, use_errno=True), "renameat2", False)
+        except OSError:  # pragma: no cover - no C library to ask
+            _renameat2 = False
+    if not _renameat2:
+        return False
+    if _renameat2(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.EINVAL, errno.ENOSYS, errno.ENOTSUP, errno.EOPNOTSUPP):
+        return False
+    raise OSError(err, os.strerror(err), str(b))
+
+
+def _install(stage: Path, target: Path) -> None:
+    """Put the complete ``stage`` folder at ``target``, replacing what is there.
+
+    With RENAME_EXCHANGE the target is never missing; without, the old bundle is
+    renamed aside first (a killed run leaves it there, and :func:`clean_stale` puts
+    it back)."""
+    if not os.path.lexists(target):
+        os.rename(stage, target)
+        return
+    if _exchange(stage, target):
+        shutil.rmtree(stage, ignore_errors=True)  # now holds the old bundle
+        return
+    old = stage.with_name(stage.name + ".old")
+    os.rename(target, old)
+    try:
+        os.rename(stage, target)
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        os.rename(old, target)
         raise
-    old = None
-    if target.exists():
-        old = target.with_name(f".{target.name}.old")
-        shutil.rmtree(old, ignore_errors=True)
-        os.replace(target, old)
-    os.replace(tmp, target)
-    if old is not None:
-        shutil.rmtree(old, ignore_errors=True)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def _absolute(target: str | os.PathLike) -> Path:
+    """``target`` as an absolute path with a real last component (``.`` -> the folder's name)."""
+    t = Path(os.path.abspath(os.fspath(target)))
+    if not t.name or t == t.parent:
+        raise OutputError(f"{target}: cannot write a bundle there (the root of the file system)")
+    return t
+
+
+@contextlib.contextmanager
+def staged_dir(target: str | os.PathLike, force: bool = False, manifest: str | None = None) -> Iterator[Path]:
+    """Yield an empty staging folder beside ``target``; on success it replaces ``target``.
+
+    On any exception the staging folder is removed and ``target`` is left as it was.
+    An existing ``target`` is refused before any work unless ``force`` is given and it
+    is a bundle tanktool wrote (:func:`check_replaceable`; ``manifest`` names the
+    kind).  OSErrors (a folder that cannot be made, a full disk) become OutputError.
+    """
+    shown = target
+    target = _absolute(target)
+    check_replaceable(target, force, manifest)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise output_error(shown, e, "cannot make the folder") from None
+    clean_stale(target.parent, target.name)
+    tmp = target.parent / _temp_name(target.name)
+    try:
+        os.mkdir(tmp, 0o777)  # the umask applies, as for any folder the user makes
+    except OSError as e:
+        e.filename = None
+        raise output_error(shown, e, f"cannot make a folder in {target.parent}") from None
+    # nothing may have appeared at the target meanwhile
+    with _installing(tmp, target, shown, lambda: check_replaceable(target, force, manifest)):
+        yield tmp
+
+
+@contextlib.contextmanager
+def _installing(stage: Path, target: Path, shown: Any, before: Any = None) -> Iterator[None]:
+    """Run the body, then put ``stage`` at ``target``; on any failure remove ``stage``
+    (an OSError becomes an OutputError naming ``shown``)."""
+    try:
+        yield
+        if before is not None:
+            before()
+        _install(stage, target)
+    except OSError as e:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise output_error(shown, e) from None
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+
+
+def _link_or_copy(src: str, dst: str) -> None:
+    try:
+        os.link(src, dst, follow_symlinks=False)
+    except OSError:
+        shutil.copy2(src, dst, follow_symlinks=False)
+
+
+@contextlib.contextmanager
+def bundle_update(bundle: str | os.PathLike) -> Iterator[Path]:
+    """Change files of an existing bundle and its manifest together, atomically.
+
+    Yields a staged copy of ``bundle`` (hard links to its files, so it costs almost
+    nothing); write the new files into it, each with :func:`atomic_write_bytes` (a
+    rename, never writing into a linked file), manifest included.  On success the
+    copy replaces the bundle in one atomic exchange: readers see the old bundle or the
+    new one, never new derived files with an old manifest.  On failure (or when the
+    process is killed) the bundle is untouched and the copy is removed (at the next
+    run).  OSErrors become OutputError.
+    """
+    shown = bundle
+    bundle = _absolute(bundle)
+    if not bundle.is_dir() or bundle.is_symlink():
+        raise OutputError(f"{shown}: not a bundle folder")
+    clean_stale(bundle.parent, bundle.name)
+    clean_stale(bundle)
+    stage = bundle.parent / _temp_name(bundle.name)
+    try:
+        os.mkdir(stage, 0o700)
+        os.chmod(stage, stat.S_IMODE(os.stat(bundle).st_mode))
+        for entry in os.scandir(bundle):
+            if is_temp_name(entry.name):
+                continue
+            dst = stage / entry.name
+            if entry.is_symlink():
+                os.symlink(os.readlink(entry.path), dst)
+            elif entry.is_dir():
+                shutil.copytree(entry.path, dst, symlinks=True, copy_function=_link_or_copy)
+            else:
+                _link_or_copy(entry.path, str(dst))
+    except OSError as e:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise output_error(shown, e) from None
+    with _installing(stage, bundle, shown):
+        yield stage

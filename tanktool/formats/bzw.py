@@ -52,6 +52,10 @@ import numpy as np
 
 from ..errors import FormatError
 from .bundle import read_input
+from .limits import MAX_MODEL_BYTES, MAX_OBJECTS
+
+#: warnings passed on per file (a file of a million unknown lines says so once)
+MAX_WARNINGS = 50
 
 #: BZFlag's default world half-width (``world size``; bzfs doubles it)
 WORLD_SIZE = 400.0
@@ -163,7 +167,7 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
     """
     path = Path(path)
     if text is None:
-        data = read_input(path, "a .bzw file")
+        data = read_input(path, "a .bzw file", limit=MAX_MODEL_BYTES)
         try:
             text = data.decode("utf-8")
         except UnicodeDecodeError:
@@ -213,6 +217,9 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
             elif key == "options":
                 options, options_line = [(lineno, w) for w in args], lineno
             elif key in SOLIDS:
+                if len(world.objects) >= MAX_OBJECTS:
+                    raise FormatError(f"{path}:{lineno}: more than {MAX_OBJECTS:,} objects (a world this tool reads "
+                                      f"has fewer)")
                 current = BzwObject(key, lineno, size=DEFAULT_SIZE[key])
             elif key == "define":
                 in_define = lineno
@@ -464,8 +471,10 @@ def load_scene(path: str | os.PathLike, warn: Callable[[str], None] | None = Non
 
     world = parse_bzw(path)
     if warn is not None:
-        for w in world.warnings:
+        for w in world.warnings[:MAX_WARNINGS]:
             warn(w)
+        if len(world.warnings) > MAX_WARNINGS:
+            warn(f"{path}: {len(world.warnings) - MAX_WARNINGS:,} more warnings like these not shown")
     scene = trimesh.Scene()
     for name, (v, f, rgba) in world_meshes(world).items():
         mesh = trimesh.Trimesh(vertices=v, faces=f, process=False)

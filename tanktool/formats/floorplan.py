@@ -23,15 +23,23 @@ refused with its line: DXF group codes and numbers, SVG's XML and the numbers of
 
 from __future__ import annotations
 
+import io
 import math
 import os
 import re
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
 from ..errors import FormatError
 from .bundle import read_input
+from .limits import MAX_MODEL_BYTES, MAX_OBJECTS
+
+#: points of all the drawing's lines and sampled curves together
+MAX_PLAN_POINTS = 2_000_000
+#: how many wall thicknesses a drawing may be across
+MAX_THICKNESSES = 1e6
 
 #: extensions handled here
 PLAN_EXTENSIONS = {".dxf", ".svg"}
@@ -91,7 +99,8 @@ def check_svg(path: Path, data: bytes) -> None:
         root = etree.fromstring(data, parser=etree.XMLParser(resolve_entities=False, no_network=True))
     except etree.XMLSyntaxError as e:
         line = e.position[0] if e.position else getattr(e, "lineno", 0)
-        raise FormatError(f"{path}:{line}: not well-formed SVG/XML: {e.msg}") from None
+        msg = " ".join(str(e.msg).split())  # lxml's messages run over several lines
+        raise FormatError(f"{path}:{line}: not well-formed SVG/XML: {msg}") from None
     if not isinstance(root.tag, str) or etree.QName(root).localname != "svg":
         raise FormatError(f"{path}:{root.sourceline}: expected an <svg> document")
     for el in root.iter():
@@ -122,7 +131,7 @@ def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
 
     path = Path(path)
     fmt = path.suffix.lower()[1:]
-    data = read_input(path, "a floor plan")
+    data = read_input(path, "a floor plan", limit=MAX_MODEL_BYTES)
     if fmt == "dxf":
         check_dxf(path, data)
     elif fmt == "svg":
@@ -130,22 +139,40 @@ def read_plan(path: str | os.PathLike) -> list[np.ndarray]:
     else:
         raise FormatError(f"{path}: not a floor plan (expected .dxf or .svg)")
     try:
-        drawing = trimesh.load(str(path), file_type=fmt)
+        drawing = trimesh.load(io.BytesIO(data), file_type=fmt)
     except FormatError:
         raise
     except ImportError as e:
         raise FormatError(f"{path}: reading .{fmt} needs a missing package ({e.name}); "
                           f"reinstall tanktool with its dependencies") from None
     except Exception as e:  # trimesh raises many kinds for bad drawings
-        raise FormatError(f"{path}: cannot read as .{fmt}: {e}") from None
+        raise FormatError(f"{path}: cannot read as .{fmt}: {' '.join(str(e).split())[:300]}") from None
     lines: list[np.ndarray] = []
-    for entity in getattr(drawing, "entities", ()):
+    entities = getattr(drawing, "entities", ())
+    if len(entities) > MAX_OBJECTS:
+        raise FormatError(f"{path}: {len(entities):,} lines and shapes, more than the {MAX_OBJECTS:,} this tool reads")
+    vertices = np.asarray(getattr(drawing, "vertices", np.zeros((0, 2))), dtype=np.float64)
+    if len(vertices) and not np.isfinite(vertices).all():
+        raise FormatError(f"{path}: the drawing has non-finite coordinates")
+    # trimesh samples curves finely enough for a sagitta of 5 % of ``scale`` units; with
+    # its default of 1 unit a circle of radius 1e7 would become 1.2e9 points.  Tie it
+    # to the drawing's size instead (unchanged for drawings up to 100 units across; at
+    # most about 12,600 points per curve)
+    extent = float(np.ptp(vertices, axis=0).max()) if len(vertices) else 0.0
+    scale = max(1.0, extent / 100.0)
+    total = 0
+    for entity in entities:
         if type(entity).__name__ == "Text":
             continue
         try:
-            pts = np.asarray(entity.discrete(drawing.vertices), dtype=np.float64)
+            pts = np.asarray(entity.discrete(vertices, scale=scale), dtype=np.float64)
+        except (MemoryError, RecursionError):
+            raise FormatError(f"{path}: a {type(entity).__name__.lower()} cannot be sampled (too large)") from None
         except Exception:  # an entity trimesh cannot sample (degenerate arc, ...)
             continue
+        total += len(pts)
+        if total > MAX_PLAN_POINTS:
+            raise FormatError(f"{path}: the drawing's lines and curves make more than {MAX_PLAN_POINTS:,} points")
         if pts.ndim != 2 or pts.shape[0] < 2 or pts.shape[1] < 2:
             continue
         pts = pts[:, :2]
@@ -167,17 +194,34 @@ def plan_walls(lines: list[np.ndarray], thickness: float):
 
     if not (math.isfinite(thickness) and thickness > 0):
         raise FormatError(f"--wall-thickness must be a positive number, got {thickness}")
+    pts = np.concatenate(lines)
+    extent = float(np.ptp(pts, axis=0).max())
+    if extent > MAX_THICKNESSES * thickness:
+        # GEOS loses itself (it hangs) on walls this thin for their length, and no
+        # arena is a million walls wide: a unit mistake
+        raise FormatError(f"the drawing is {extent:.4g} units across, more than {MAX_THICKNESSES:,.0f} wall "
+                          f"thicknesses ({thickness:g}): wrong units? (--wall-thickness is in drawing units)")
+    # the same line drawn twice is one wall: GEOS nodes 1,000 copies of a square in
+    # 900 MB, so copies (either direction) go before the union
+    seen: set[bytes] = set()
+    unique = []
+    for ln in lines:
+        key = min(ln.tobytes(), ln[::-1].tobytes())
+        if key not in seen:
+            seen.add(key)
+            unique.append(ln)
+    lines = unique
     geoms = [shapely.LineString(ln) for ln in lines]
     # noding splits lines where they cross; merging joins pieces that meet end to end,
     # so separate LINE entities around a corner are mitred like one polyline
-    merged = shapely.line_merge(shapely.union_all(geoms))
+    merged = shapely.get_parts(shapely.line_merge(shapely.union_all(geoms)))
     # trimesh samples a circle into ~250 points; a sagitta of 1/20 of the thickness is
-    # invisible in the wall and keeps the wall list short
+    # invisible in the wall and keeps the wall list short.  Piece by piece, then one
+    # union: GEOS buffers a network of thousands of lines as a whole 5x slower
     merged = shapely.simplify(merged, thickness / 20.0, preserve_topology=True)
-    walls = shapely.buffer(merged, thickness / 2.0, cap_style="flat", join_style="mitre", mitre_limit=MITRE_LIMIT)
+    pieces = shapely.buffer(merged, thickness / 2.0, cap_style="flat", join_style="mitre", mitre_limit=MITRE_LIMIT)
     fills = solid_shapes(lines, geoms, thickness)
-    if fills:
-        walls = shapely.union_all([walls, *fills])
+    walls = shapely.union_all([*pieces, *fills])
     walls = shapely.make_valid(walls)
     polys = [p for p in shapely.get_parts(walls) if p.geom_type == "Polygon" and p.area > 0]
     if not polys:
@@ -188,23 +232,26 @@ def plan_walls(lines: list[np.ndarray], thickness: float):
 def solid_shapes(lines: list[np.ndarray], geoms: list, thickness: float) -> list:
     """Closed shapes to fill: those with no other line inside them (a pillar, a block),
     except the largest closed shape (the arena's outer wall stays a ring).  A closed
-    line has no door, so what it encloses could never be reached anyway."""
+    line has no door, so what it encloses could never be reached anyway.
+
+    One spatial index query for all of them (a plan with 800 pillars and 600 lines
+    asked 480,000 intersection questions one by one)."""
     import shapely
 
     closed = [i for i, ln in enumerate(lines) if len(ln) >= 4 and np.allclose(ln[0], ln[-1])]
     if len(closed) < 2:
         return []            # a lone closed shape is the largest: it stays a ring
-    polys = {i: shapely.make_valid(shapely.Polygon(lines[i])) for i in closed}
-    largest = max(closed, key=lambda i: polys[i].area)
-    out = []
-    for i in closed:
-        if i == largest or polys[i].area <= 0:
-            continue
-        inner = shapely.buffer(polys[i], -thickness / 2.0)
-        if any(j != i and shapely.intersects(inner, geoms[j]) for j in range(len(geoms))):
-            continue             # it encloses other walls: a walled yard, keep it a ring
-        out.append(polys[i])
-    return out
+    polys = shapely.make_valid(np.array([shapely.Polygon(lines[i]) for i in closed], dtype=object))
+    areas = shapely.area(polys)
+    largest = int(np.argmax(areas))
+    inner = shapely.buffer(polys, -thickness / 2.0)
+    hit_shape, hit_line = shapely.STRtree(geoms).query(inner, predicate="intersects")
+    encloses = np.zeros(len(closed), dtype=bool)
+    own = np.asarray(closed)[hit_shape]
+    encloses[hit_shape[hit_line != own]] = True   # another wall inside: a walled yard, keep it a ring
+    keep = (areas > 0) & ~encloses
+    keep[largest] = False
+    return list(polys[keep])
 
 
 def extrude(footprint, height: float) -> tuple[np.ndarray, np.ndarray]:
@@ -219,16 +266,22 @@ def extrude(footprint, height: float) -> tuple[np.ndarray, np.ndarray]:
     for poly in shapely.get_parts(footprint):
         poly = shapely.orient_polygons(poly) if hasattr(shapely, "orient_polygons") else \
             shapely.geometry.polygon.orient(poly, 1.0)
-        tris = [t for t in shapely.get_parts(shapely.constrained_delaunay_triangles(poly)) if t.area > 0]
-        for tri in tris:
-            c = np.asarray(tri.exterior.coords)[:3]
-            if (c[1, 0] - c[0, 0]) * (c[2, 1] - c[0, 1]) - (c[1, 1] - c[0, 1]) * (c[2, 0] - c[0, 0]) < 0:
-                c = c[::-1]                       # counter-clockwise from above: the top faces up
-            top = np.column_stack([c, np.full(3, height)])
-            bottom = np.column_stack([c[::-1], np.zeros(3)])
+        tris = shapely.get_parts(shapely.constrained_delaunay_triangles(poly))
+        tris = tris[shapely.area(tris) > 0]
+        if len(tris):
+            # every triangle at once: its first 3 ring points, made counter-clockwise
+            # from above so that the top faces up
+            c = shapely.get_coordinates(tris).reshape(len(tris), 4, 2)[:, :3]
+            cw = ((c[:, 1, 0] - c[:, 0, 0]) * (c[:, 2, 1] - c[:, 0, 1])
+                  - (c[:, 1, 1] - c[:, 0, 1]) * (c[:, 2, 0] - c[:, 0, 0])) < 0
+            c[cw] = c[cw, ::-1]
+            k = len(c)
+            top = np.concatenate([c, np.full((k, 3, 1), height)], axis=2).reshape(-1, 3)
+            bottom = np.concatenate([c[:, ::-1], np.zeros((k, 3, 1))], axis=2).reshape(-1, 3)
             verts += [top, bottom]
-            faces += [np.array([[n, n + 1, n + 2]]), np.array([[n + 3, n + 4, n + 5]])]
-            n += 6
+            idx = n + 3 * np.arange(k)[:, None] + np.arange(3)[None, :]
+            faces += [idx, idx + 3 * k]
+            n += 6 * k
         # exterior counter-clockwise, holes clockwise: the solid is on the left of each
         # ring, so (p0, q0, q1) with the ring's direction faces outwards
         for ring in (poly.exterior, *poly.interiors):
@@ -248,22 +301,33 @@ def extrude(footprint, height: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(verts), np.concatenate(faces).astype(np.int64)
 
 
+#: what load_scene reports to its ``progress`` callback, in order
+PLAN_STAGES = ("plan lines", "plan walls", "plan solid")
+
+
 def load_scene(path: str | os.PathLike, wall_height: float = DEFAULT_WALL_HEIGHT,
-               wall_thickness: float = DEFAULT_WALL_THICKNESS):
+               wall_thickness: float = DEFAULT_WALL_THICKNESS, progress: Callable[[str], None] | None = None):
     """Read a .dxf/.svg floor plan as a Z-up ``trimesh.Scene``: ``walls`` (the
-    extruded lines) and ``floor`` (their bounding rectangle at z = 0)."""
+    extruded lines) and ``floor`` (their bounding rectangle at z = 0).  ``progress``
+    is called with each of ``PLAN_STAGES`` as it is done (big plans take a while)."""
     import trimesh
 
     path = Path(path)
     if not (math.isfinite(wall_height) and wall_height > 0):
         raise FormatError(f"--wall-height must be a positive number of metres, got {wall_height}")
     lines = read_plan(path)
+    if progress:
+        progress(PLAN_STAGES[0])
     try:
         footprint = plan_walls(lines, wall_thickness)
     except FormatError as e:
         raise FormatError(f"{path}: {e}") from None
+    if progress:
+        progress(PLAN_STAGES[1])
     # plan (x, y) must end up as world (x, z); the Z-up conversion maps y to -z
     v, f = extrude(footprint, wall_height)
+    if progress:
+        progress(PLAN_STAGES[2])
     v[:, 1] *= -1.0
     f = f[:, ::-1].copy()                 # the mirror flips the winding back outwards
     x0, y0, x1, y1 = footprint.bounds

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..errors import FormatError
 from .bundle import read_input
+from .limits import MAX_FACES, MAX_OBJECTS
 
 if TYPE_CHECKING:
     import trimesh
@@ -256,6 +257,7 @@ class _Reader:
         # material name, face indices), resolved once the whole file is read because
         # materials may follow the objects that use them
         self.pending_groups: list[tuple[np.ndarray, str, np.ndarray]] = []
+        self.faces = 0
 
     # -- helpers -------------------------------------------------------------
 
@@ -384,7 +386,13 @@ class _Reader:
         for cid, coff, body, cend in self.children(pos, end, NAMED_OBJECT):
             # lights (0x4600) and cameras (0x4700) are skipped by their length
             if cid == N_TRI_OBJECT:
-                model.objects.append(self.trimesh(name, off, body, cend))
+                if len(model.objects) >= MAX_OBJECTS:
+                    raise self.error(coff, f"more than {MAX_OBJECTS:,} mesh objects (a model this tool reads has fewer)")
+                obj = self.trimesh(name, off, body, cend)
+                self.faces += len(obj.faces)
+                if self.faces > MAX_FACES:
+                    raise self.error(coff, f"more than {MAX_FACES:,} triangles in all (a model this tool reads has fewer)")
+                model.objects.append(obj)
 
     def trimesh(self, name: str, off: int, start: int, end: int) -> MeshObject:
         obj = MeshObject(
@@ -576,22 +584,49 @@ def _unique_names(names: Sequence[str]) -> list[str]:
     return out
 
 
-def _face_colors(model: Model3DS, obj: MeshObject) -> np.ndarray:
+def _palette(model: Model3DS) -> np.ndarray:
+    """(k + 1, 4) uint8 RGBA of each material, then the default colour (index -1)."""
+    return np.array([m.rgba() for m in model.materials] + [DEFAULT_COLOR], dtype=np.uint8)
+
+
+def _face_colors(model: Model3DS, obj: MeshObject, palette: np.ndarray | None = None) -> np.ndarray:
     """(m, 4) uint8 RGBA per face from its material (grey when it has none)."""
-    palette = np.array([m.rgba() for m in model.materials] + [DEFAULT_COLOR], dtype=np.uint8)
+    if palette is None:
+        palette = _palette(model)
     # -1 (no material) picks the last row, the default colour
     return palette[obj.face_material]
 
 
 def _geometry_kwargs(model: Model3DS) -> dict[str, dict[str, Any]]:
-    """Trimesh keyword arguments for each mesh object with faces, master scale applied."""
+    """Trimesh keyword arguments for each mesh object with faces, master scale applied.
+
+    More than ``MERGE_OBJECTS`` objects become one geometry ``merged`` (per-face
+    colours kept, object names in its metadata): a scene of 20,000 small objects
+    costs trimesh time that grows with the square of their number, one mesh does not.
+    """
+    from .limits import MERGE_OBJECTS
+
     objs = [o for o in model.objects if len(o.faces)]
+    palette = _palette(model)
+    names = _unique_names([o.name for o in objs])
+    if len(objs) > MERGE_OBJECTS:
+        sizes = np.array([len(o.vertices) for o in objs], dtype=np.int64)
+        base = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+        used = np.unique(np.concatenate([o.face_material for o in objs]))
+        return {"merged": {
+            "vertices": np.concatenate([o.vertices for o in objs]) * model.master_scale,
+            "faces": np.concatenate([o.faces.astype(np.int64) + b for o, b in zip(objs, base)]),
+            "face_colors": palette[np.concatenate([o.face_material for o in objs])],
+            "process": False,
+            "metadata": {"name": "merged", "3ds_objects": names,
+                         "materials": sorted({model.materials[i].name for i in used if i >= 0})},
+        }}
     out = {}
-    for name, obj in zip(_unique_names([o.name for o in objs]), objs):
+    for name, obj in zip(names, objs):
         out[name] = {
             "vertices": obj.vertices * model.master_scale,
             "faces": obj.faces.astype(np.int64),
-            "face_colors": _face_colors(model, obj),
+            "face_colors": _face_colors(model, obj, palette),
             "process": False,
             "metadata": {
                 "name": name,
@@ -614,9 +649,10 @@ def _scene_metadata(model: Model3DS) -> dict[str, Any]:
 def load_scene(path: str | os.PathLike) -> "trimesh.Scene":
     """Read ``path`` as a ``trimesh.Scene`` in the file's own axes (Z up).
 
-    One geometry per mesh object with faces, named after the object; per-face
-    colours from the material diffuse colour (alpha from its transparency; faces
-    without a material are neutral grey); master scale applied.
+    One geometry per mesh object with faces, named after the object (beyond
+    ``MERGE_OBJECTS`` objects, one geometry ``merged``); per-face colours from the
+    material diffuse colour (alpha from its transparency; faces without a material are
+    neutral grey); master scale applied.
     """
     import trimesh
 

@@ -22,9 +22,12 @@ import numpy as np
 
 from ..errors import FormatError, VehicleError
 from ..geometry.spheres import SphereTree, read_spheres
-from .bundle import atomic_write_text, read_input_text, read_toml
+from .bundle import atomic_write_text, bundle_file, clean_stale, read_input, read_input_text, read_toml
+from .limits import MAX_SMALL_TEXT_BYTES
 
 HULL_MIN, HULL_MAX = 8, 16
+#: spheres a vehicle's sphere tree may have (import-vehicle makes a few dozen)
+MAX_SPHERES = 4096
 
 #: [drive] keys, their meaning and the range ``load_vehicle`` accepts
 DRIVE_KEYS: dict[str, tuple[float, float]] = {
@@ -62,7 +65,7 @@ def write_hull(path: str | os.PathLike, points: np.ndarray, header: str = "") ->
 def read_hull(path: str | os.PathLike) -> np.ndarray:
     """Read ``hull.txt`` as (k, 3), 8 <= k <= 16; defects raise FormatError with the line."""
     path = Path(path)
-    text = read_input_text(path, "a hull.txt file")
+    text = read_input_text(path, "a hull.txt file", limit=MAX_SMALL_TEXT_BYTES)
     rows: list[tuple[float, float, float]] = []
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = raw.split("#", 1)[0].strip()
@@ -109,8 +112,10 @@ class VehicleBundle:
 
     @property
     def model_path(self) -> Path | None:
-        m = self.toml.get("model", {}).get("file")
-        return self.path / m if m else None
+        """The model file inside the bundle (``load_vehicle`` refused one that leads out)."""
+        t = self.toml.get("model")
+        m = t.get("file") if isinstance(t, dict) else None
+        return bundle_file(self.path, m, f"{self.path / 'vehicle.toml'}: [model] file") if m else None
 
 
 def _number(manifest: Path, table: dict[str, Any], key: str, where: str, lo: float, hi: float) -> float:
@@ -131,12 +136,46 @@ def _table(manifest: Path, doc: dict[str, Any], key: str) -> dict[str, Any]:
     return t
 
 
+#: optional keys the simulation takes from anywhere in vehicle.toml (sim/body.py
+#: TankSpec.from_vehicle), and the range each must have
+SIM_KEYS: dict[str, tuple[float, float]] = {
+    "turn_rate": (1e-6, 100.0),    # rad/s, top turning speed
+    "grip": (0.0, 1e4),            # 1/s, lateral grip
+    "shell_damage": (0.0, 1e6),    # hit points a shell takes
+}
+
+
+def _find(doc: dict[str, Any], key: str) -> Any:
+    """The first ``key`` anywhere in nested tables, as the simulation finds it."""
+    stack = [doc]
+    while stack:
+        d = stack.pop(0)
+        if key in d:
+            return d[key]
+        stack[:0] = [v for v in d.values() if isinstance(v, dict)]
+    return None
+
+
+def _check_sim_keys(manifest: Path, doc: dict[str, Any]) -> None:
+    for key, (lo, hi) in SIM_KEYS.items():
+        v = _find(doc, key)
+        if v is not None and (isinstance(v, bool) or not isinstance(v, (int, float))
+                              or not math.isfinite(v) or not lo <= v <= hi):
+            raise VehicleError(f"{manifest}: {key} must be a number from {lo:g} to {hi:g}, got {v!r:.60}")
+    m = _find(doc, "muzzle")
+    if m is not None and (not isinstance(m, list) or len(m) != 3 or not all(
+            isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in m)):
+        raise VehicleError(f"{manifest}: muzzle must be a list of 3 finite numbers (vehicle frame), got {m!r:.60}")
+
+
 def load_vehicle(path: str | os.PathLike) -> VehicleBundle:
     """Load ``vehicles/<name>/`` (or its ``vehicle.toml``) and check it is usable."""
     path = Path(path)
     if path.is_file() and path.name == "vehicle.toml":
         path = path.parent
     manifest = path / "vehicle.toml"
+    if not path.is_dir():
+        clean_stale(path.parent, path.name)  # a replacement killed half-way: put the bundle back
     if not path.is_dir():
         raise VehicleError(f"{path}: no such vehicle bundle folder")
     if not manifest.exists():
@@ -152,16 +191,30 @@ def load_vehicle(path: str | os.PathLike) -> VehicleBundle:
     com = mass_t.get("centre_of_mass")
     if (not isinstance(com, list) or len(com) != 3
             or not all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in com)):
-        raise VehicleError(f"{manifest}: [mass] centre_of_mass must be a list of 3 finite numbers, got {com!r}")
+        raise VehicleError(f"{manifest}: [mass] centre_of_mass must be a list of 3 finite numbers, got {com!r:.60}")
 
     drive_t = _table(manifest, doc, "drive")
     drive = {k: _number(manifest, drive_t, k, "[drive] ", lo, hi) for k, (lo, hi) in DRIVE_KEYS.items()}
 
     hull_t = _table(manifest, doc, "hull")
-    hull = read_hull(path / str(hull_t.get("file", "hull.txt")))
     spheres_t = _table(manifest, doc, "spheres")
-    spheres = read_spheres(path / str(spheres_t.get("file", "spheres.txt")))
+    model_t = doc.get("model", {})
+    if not isinstance(model_t, dict):
+        raise VehicleError(f"{manifest}: [model] must be a table, got model = {model_t!r:.60}")
+    try:  # a name that leads out of the bundle: the manifest is wrong
+        hull_f = bundle_file(path, hull_t.get("file", "hull.txt"), f"{manifest}: [hull] file")
+        spheres_f = bundle_file(path, spheres_t.get("file", "spheres.txt"), f"{manifest}: [spheres] file")
+        if "file" in model_t:
+            bundle_file(path, model_t["file"], f"{manifest}: [model] file")
+    except FormatError as e:
+        raise VehicleError(str(e)) from None
+    hull = read_hull(hull_f)
+    read_input(spheres_f, "a spheres.txt file", limit=MAX_SMALL_TEXT_BYTES)  # a device, a FIFO, a huge file
+    spheres = read_spheres(spheres_f)
+    if len(spheres) > MAX_SPHERES:
+        raise FormatError(f"{spheres_f}: {len(spheres):,} spheres, more than the {MAX_SPHERES:,} a vehicle may have")
 
+    _check_sim_keys(manifest, doc)
     radius = float(np.max(np.hypot(hull[:, 0], hull[:, 2])))
     return VehicleBundle(
         name=name, path=path, toml=doc, hull=hull, spheres=spheres, mass=mass, inertia=inertia,

@@ -51,7 +51,9 @@ DEFAULTS: dict[str, list[str]] = {
     "overlay_agents": ["key:f3"],
     "quit": ["key:f10"],
 }
-INPUT_NAME = re.compile(r"^(key:.+|mouse:\d+|mouse:[xy][+-]|joybutton:\d+|joyaxis:\d+[+-])$")
+INPUT_NAME = re.compile(r"^(key:.+|mouse:\d{1,4}|mouse:[xy][+-]|joybutton:\d{1,4}|joyaxis:\d{1,4}[+-])$")
+#: inputs one action may be bound to
+MAX_INPUTS = 16
 #: mouse travel in one frame [px] that counts as a full-strength action
 MOUSE_FULL = 24.0
 #: a mouse move this long in one event is a deliberate choice on the remap screen
@@ -107,17 +109,18 @@ def load_bindings(path: str | os.PathLike | None = None) -> Bindings:
     b = Bindings()
     dz = doc.get("deadzone", DEADZONE)
     if not isinstance(dz, (int, float)) or isinstance(dz, bool) or not 0.0 <= dz < 1.0:
-        raise FormatError(f"{path}: deadzone must be a number in [0, 1), got {dz!r}")
+        raise FormatError(f"{path}: deadzone must be a number in [0, 1), got {dz!r:.60}")
     b.deadzone = float(dz)
     table = doc.get("actions", {})
     if not isinstance(table, dict):
         raise FormatError(f"{path}: [actions] must be a table of action = [input names]")
     for action, names in table.items():
         if action not in ACTIONS:
-            raise FormatError(f"{path}: [actions] {action}: unknown action (one of {', '.join(ACTIONS)})")
-        if not isinstance(names, list) or not all(isinstance(n, str) and INPUT_NAME.match(n) for n in names):
-            raise FormatError(f"{path}: [actions] {action}: expected a list of input names like "
-                              f"\"key:w\", \"mouse:1\", \"joybutton:0\", \"joyaxis:1-\", got {names!r}")
+            raise FormatError(f"{path}: [actions] {str(action)[:60]}: unknown action (one of {', '.join(ACTIONS)})")
+        if (not isinstance(names, list) or len(names) > MAX_INPUTS
+                or not all(isinstance(n, str) and len(n) <= 64 and INPUT_NAME.match(n) for n in names)):
+            raise FormatError(f"{path}: [actions] {action}: expected a list of at most {MAX_INPUTS} input names "
+                              f"like \"key:w\", \"mouse:1\", \"joybutton:0\", \"joyaxis:1-\", got {names!r:.120}")
         b.actions[action] = list(names)
     return b
 

@@ -175,7 +175,14 @@ def load_glb(path: str) -> np.ndarray:
     if not p.is_file():
         raise TanktoolError(f"{p}: no such model (rebuild the bundle: tanktool import-arena / import-vehicle)")
     try:
-        scene = trimesh.load(p, force="scene", process=False)
+        import io
+
+        from ..formats.bundle import read_input
+        from ..formats.gltf import read_gltf, sanitized_glb
+
+        # validated first (formats/gltf.py): a hostile model.glb cannot crash the game
+        glb = sanitized_glb(read_gltf(read_input(p, "a .glb model"), str(p)))
+        scene = trimesh.load(io.BytesIO(glb), file_type="glb", force="scene", process=False)
     except Exception as e:
         raise TanktoolError(f"{p}: cannot read the model ({e})") from None
     meshes = []

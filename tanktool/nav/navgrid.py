@@ -200,26 +200,28 @@ class NavGrid:
         import zipfile
         import zlib
 
+        from ..formats.npz import read_npz
+
         try:
-            with np.load(path, allow_pickle=False) as z:
-                missing = [k for k in ("origin", "cell", "shape", *_FIELDS[:-1]) if k not in z.files]
-                if missing:
-                    raise FormatError(f"{path}: not a navgrid file (missing {', '.join(missing)})")
-                raw_shape = z["shape"]
-                if raw_shape.shape != (2,) or raw_shape.dtype.kind not in "iu":
-                    raise FormatError(f"{path}: 'shape' must be two integers (nz, nx)")
-                shape = (int(raw_shape[0]), int(raw_shape[1]))
-                if min(shape) < 1 or shape[0] * shape[1] > MAX_NODES:
-                    raise FormatError(f"{path}: shape {shape} is not a grid of 1 to {MAX_NODES:,} nodes")
-                arrays = {}
-                for k in (*_FIELDS, "height", "link"):
-                    if k in z.files:
-                        a = z[k]
-                        if a.size > 16 * MAX_NODES * 4:
-                            raise FormatError(f"{path}: {k} is too large ({a.size:,} values)")
-                        arrays[k] = a
-                origin = z["origin"].astype(np.float64)
-                cell = float(z["cell"])
+            z = read_npz(path, "a navgrid file")  # bounded, no pickles, a damaged zip one clear error
+            missing = [k for k in ("origin", "cell", "shape", *_FIELDS[:-1]) if k not in z]
+            if missing:
+                raise FormatError(f"{path}: not a navgrid file (missing {', '.join(missing)})")
+            raw_shape = z["shape"]
+            if raw_shape.shape != (2,) or raw_shape.dtype.kind not in "iu":
+                raise FormatError(f"{path}: 'shape' must be two integers (nz, nx)")
+            shape = (int(raw_shape[0]), int(raw_shape[1]))
+            if min(shape) < 1 or shape[0] * shape[1] > MAX_NODES:
+                raise FormatError(f"{path}: shape {shape} is not a grid of 1 to {MAX_NODES:,} nodes")
+            arrays = {}
+            for k in (*_FIELDS, "height", "link"):
+                if k in z:
+                    a = z[k]
+                    if a.size > 16 * MAX_NODES * 4:
+                        raise FormatError(f"{path}: {k} is too large ({a.size:,} values)")
+                    arrays[k] = a
+            origin = z["origin"].astype(np.float64)
+            cell = float(z["cell"])
         except FileNotFoundError:
             raise FormatError(f"{path}: no such file") from None
         except FormatError:

@@ -18,6 +18,7 @@ ones a brute-force search uses, so results equal brute force exactly.
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from typing import Callable
@@ -308,26 +309,42 @@ class WallQuadtree:
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> "WallQuadtree":
-        """Read what :meth:`save` wrote; a damaged file raises FormatError naming it."""
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                if "format" not in z.files or str(z["format"]) != _FORMAT:
-                    raise FormatError(f"{path}: not a tanktool quadtree file (expected '{_FORMAT}')")
-                tree = cls(
-                    z["segments"].astype(np.float64), z["box"].astype(np.float64), z["child"].astype(np.int64),
-                    z["depth"].astype(np.int64), z["offsets"].astype(np.int64), z["walls"].astype(np.int64),
-                    float(z["eps"]),
-                )
-        except FileNotFoundError:
-            raise FormatError(f"{path}: no such file") from None
-        except (OSError, ValueError, KeyError) as e:
-            raise FormatError(f"{path}: cannot read quadtree: {e}") from None
+        """Read what :meth:`save` wrote; a damaged file raises FormatError naming it
+        (read by formats/npz.py: bounded, no pickles, every array's type and shape
+        checked, node links checked before any query follows them)."""
+        from ..formats.npz import read_npz
+
+        z = read_npz(path, "a quadtree file")
+        fmt = z.get("format")
+        if fmt is None or fmt.dtype.kind != "U" or fmt.size != 1 or str(fmt.reshape(())) != _FORMAT:
+            raise FormatError(f"{path}: not a tanktool quadtree file (expected '{_FORMAT}')")
+        kinds = {"segments": "f", "box": "f", "child": "iu", "depth": "iu", "offsets": "iu", "walls": "iu",
+                 "eps": "f"}
+        for key, kind in kinds.items():
+            if key not in z:
+                raise FormatError(f"{path}: not a tanktool quadtree file (no '{key}' array)")
+            if z[key].dtype.kind not in kind:
+                raise FormatError(f"{path}: '{key}' holds {z[key].dtype}, expected {'numbers' if kind == 'f' else 'integers'}")
+        if z["eps"].size != 1 or z["segments"].ndim != 3 or z["box"].ndim != 3:
+            raise FormatError(f"{path}: inconsistent quadtree arrays")
+        tree = cls(
+            z["segments"].astype(np.float64), z["box"].astype(np.float64), z["child"].astype(np.int64),
+            z["depth"].astype(np.int64), z["offsets"].astype(np.int64), z["walls"].astype(np.int64),
+            float(z["eps"].reshape(())),
+        )
         n, N = len(tree.box), len(tree.segments)
+        child = tree.child
         if (
-            tree.segments.shape[1:] != (2, 2) or tree.box.shape != (n, 2, 2) or tree.child.shape != (n,)
-            or tree.offsets.shape != (n + 1,) or tree.offsets[-1] != len(tree.walls)
+            n == 0 or tree.segments.shape[1:] != (2, 2) or tree.box.shape != (n, 2, 2) or child.shape != (n,)
+            or tree.depth.shape != (n,) or tree.offsets.shape != (n + 1,) or tree.walls.ndim != 1
+            or tree.offsets[0] != 0 or tree.offsets[-1] != len(tree.walls) or (np.diff(tree.offsets) < 0).any()
             or (len(tree.walls) and (tree.walls.min() < 0 or tree.walls.max() >= N))
-            or (tree.child >= n).any()
+            or ((child != -1) & ((child <= np.arange(n)) | (child + 3 >= n))).any()
+            or (tree.depth < 0).any() or tree.depth[0] != 0
+            or not (np.isfinite(tree.segments).all() and np.isfinite(tree.box).all() and math.isfinite(tree.eps))
         ):
             raise FormatError(f"{path}: inconsistent quadtree arrays")
+        kids = child[child != -1]
+        if len(kids) and (tree.depth[kids] != tree.depth[child != -1] + 1).any():
+            raise FormatError(f"{path}: inconsistent quadtree arrays (child depths)")
         return tree

@@ -51,18 +51,25 @@ class MatchResult:
 
 def _bundle_dir(ref: str | Path, kind: str, defaults: tuple[str, ...]) -> Path:
     """A bundle folder from a path or a bundled name (``box`` -> the bundled arenas/box,
-    inside the installed package or the checkout: tanktool/content.py)."""
-    from ..content import bundled_dir, bundled_names
+    inside the installed package or the checkout: tanktool/content.py).
 
-    p = Path(ref)
-    if p.exists():
-        return p
-    home = bundled_dir(kind)
-    for base in ([home] if home is not None else []) + [Path.cwd() / kind]:
-        if (base / str(ref)).is_dir():
-            return base / str(ref)
-    have = bundled_names(kind)
+    A bundled name is a plain folder name: ``../../etc`` is looked up as a path only,
+    never below ``arenas/`` or ``vehicles/``."""
     err = ArenaError if kind == "arenas" else VehicleError
+    if not isinstance(ref, (str, Path)) or not str(ref) or "\0" in str(ref) or len(str(ref)) > 4096:
+        raise err(f"{str(ref)[:80]!r}: not a {kind[:-1]} name or folder")
+    p = Path(ref)
+    try:
+        if p.exists():
+            return p
+    except (OSError, ValueError):
+        pass
+    name = str(ref)
+    if Path(name).name == name and name not in (".", ".."):
+        for base in (REPO / kind, Path.cwd() / kind):
+            if (base / name).is_dir():
+                return base / name
+    have = sorted(d.name for d in (REPO / kind).iterdir() if d.is_dir()) if (REPO / kind).is_dir() else []
     raise err(f"{ref}: no such {kind[:-1]} (a folder path, or one of: {', '.join(have) or 'none bundled yet'})")
 
 

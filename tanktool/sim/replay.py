@@ -247,8 +247,90 @@ def encode(replay: Replay) -> bytes:
     return _PREFIX.pack(MAGIC, VERSION, len(head)) + head + zlib.compress(body, 9)
 
 
+#: what a replay may ask for: a day of simulated time (play's --seconds limit), the
+#: tanks play allows, and command data at most this many times its compressed size
+MAX_SECONDS = 86400.0
+MAX_BOTS = 64
+MAX_INFLATION = 64
+MAX_REPLAY_BYTES = 256 << 20
+DT_RANGE = (1e-4, 1.0)
+#: keys of ``options`` that run_match takes, and the values each may have
+_OPTION_VALUES = {"bot": ("agent", "scripted"), "difficulty": ("easy", "normal", "hard")}
+
+
+def _is_int(v: Any) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def check_header(header: dict[str, Any], where: str) -> None:
+    """Refuse a replay header whose setup fields are missing, of the wrong type or out
+    of range (FormatError naming ``where`` and the field): playback then never meets
+    a NaN, a zero dt, a year of simulated time or an unknown integrator."""
+    from .world import INTEGRATORS
+
+    def bad(key: str, what: str) -> FormatError:
+        return FormatError(f"{where}: replay header '{key}' {what}, got {header.get(key)!r:.60}")
+
+    bots = header["bots"]
+    if not (_is_int(bots) and 1 <= bots <= MAX_BOTS):
+        raise bad("bots", f"must be a count of tanks from 1 to {MAX_BOTS}")
+    dt = header["dt"]
+    if not (_is_number(dt) and DT_RANGE[0] <= dt <= DT_RANGE[1]):
+        raise bad("dt", f"must be a time step from {DT_RANGE[0]:g} to {DT_RANGE[1]:g} s")
+    steps = header["steps"]
+    if not (_is_int(steps) and 1 <= steps and steps * dt <= MAX_SECONDS):
+        raise bad("steps", f"must be a count of steps of at most {MAX_SECONDS:g} s of simulated time")
+    seconds = header.get("seconds", steps * dt)
+    if not (_is_number(seconds) and 0 < seconds <= MAX_SECONDS and int(round(seconds / dt)) == steps):
+        raise bad("seconds", f"must be {steps} steps x dt {dt:g} s")
+    if not (_is_int(header["seed"]) and abs(header["seed"]) < 2 ** 64):
+        raise bad("seed", "must be an integer")
+    if header["integrator"] not in INTEGRATORS:
+        raise bad("integrator", f"must be one of {', '.join(INTEGRATORS)}")
+    rng = header["rng_state"]
+    try:
+        raw = base64.b64decode(rng, validate=True) if isinstance(rng, str) else b""
+    except ValueError:
+        raw = b""
+    if len(raw) != 625 * 4 or struct.unpack_from("<I", raw, 624 * 4)[0] > 624:
+        raise bad("rng_state", "must be the base64 state of the random generator (625 words)")
+    fs = header["final_state"]
+    if not (isinstance(fs, str) and len(fs) <= 128):
+        raise bad("final_state", "must be the final state's sha256 (a string)")
+    for key in ("arena_ref", "vehicle_ref", "arena", "vehicle", "arena_sha256", "vehicle_sha256"):
+        v = header.get(key)
+        if v is not None and not (isinstance(v, str) and len(v) <= 4096 and "\0" not in v):
+            raise bad(key, "must be a string")
+    names = header.get("names")
+    if names is not None and not (isinstance(names, list) and len(names) == bots
+                                  and all(isinstance(n, str) and len(n) <= 64 for n in names)):
+        raise bad("names", f"must be {bots} tank names")
+    options = header.get("options")
+    if options is not None:
+        if not isinstance(options, dict):
+            raise bad("options", "must be an object")
+        for k, v in options.items():
+            if k not in _OPTION_VALUES or v not in _OPTION_VALUES[k]:
+                allowed = "; ".join(f"{k2}: {', '.join(vs)}" for k2, vs in _OPTION_VALUES.items())
+                raise FormatError(f"{where}: replay header 'options' {k}={v!r:.40} is not a match option ({allowed})")
+    player = header.get("player")
+    if player is not None and not (_is_int(player) and 0 <= player < bots):
+        raise bad("player", f"must be a tank index 0..{bots - 1}")
+
+
 def decode(data: bytes, path: str | os.PathLike = "<replay>") -> Replay:
-    """Parse replay bytes; FormatError names ``path`` and the byte offset."""
+    """Parse replay bytes; FormatError names ``path`` and the byte offset.
+
+    Everything is bounded before it is allocated: the header's size and nesting, its
+    fields (:func:`check_header`), the number of changes (no more than the steps and
+    tanks allow) and the command data, inflated to at most its declared size and to at
+    most ``MAX_INFLATION`` times its compressed bytes (a zlib bomb is refused)."""
+    from ..formats.limits import MAX_DEPTH, MAX_REPLAY_HEADER_BYTES, nesting_depth
+
     if len(data) < _PREFIX.size or data[:4] != MAGIC:
         raise FormatError(f"{path}: byte 0: not a tanktool replay (expected magic {MAGIC.decode()})")
     _, version, hlen = _PREFIX.unpack_from(data)
@@ -257,29 +339,48 @@ def decode(data: bytes, path: str | os.PathLike = "<replay>") -> Replay:
     start = _PREFIX.size
     if start + hlen > len(data):
         raise FormatError(f"{path}: byte 5: header of {hlen} bytes runs past the end of the file ({len(data)} bytes)")
+    if hlen > MAX_REPLAY_HEADER_BYTES:
+        raise FormatError(f"{path}: byte 5: header of {hlen:,} bytes, more than {MAX_REPLAY_HEADER_BYTES:,}")
     try:
         header = json.loads(data[start:start + hlen].decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as e:
+    except (UnicodeDecodeError, ValueError) as e:  # JSONDecodeError; ints of over 4300 digits
         pos = getattr(e, "pos", getattr(e, "start", 0))
         raise FormatError(f"{path}: byte {start + pos}: replay header is not valid JSON") from None
+    except RecursionError:
+        raise FormatError(f"{path}: byte {start}: replay header is nested deeper than {MAX_DEPTH} levels") from None
     if not isinstance(header, dict):
         raise FormatError(f"{path}: byte {start}: replay header must be a JSON object")
+    if nesting_depth(header) > MAX_DEPTH:
+        raise FormatError(f"{path}: byte {start}: replay header is nested deeper than {MAX_DEPTH} levels")
     need = ("bots", "steps", "seed", "dt", "integrator", "rng_state", "changes", "final_state")
     missing = [k for k in need if k not in header]
     if missing:
         raise FormatError(f"{path}: byte {start}: replay header lacks {', '.join(missing)}")
+    check_header(header, f"{path}: byte {start}")
     n = header["changes"]
     bots = header["bots"]
-    if not (isinstance(n, int) and n >= 0 and isinstance(bots, int) and bots >= 1):
-        raise FormatError(f"{path}: byte {start}: replay header 'changes'/'bots' must be counts")
+    if not (_is_int(n) and 0 <= n <= header["steps"] * bots):
+        raise FormatError(f"{path}: byte {start}: replay header 'changes' must be a count of command changes "
+                          f"(at most one per tank and step), got {n!r:.40}")
     body_at = start + hlen
+    packed = data[body_at:]
+    want = n * RECORD_BYTES
+    if want > MAX_INFLATION * len(packed) + (1 << 20):
+        raise FormatError(f"{path}: byte {body_at}: {n:,} changes ({want:,} bytes) cannot come from "
+                          f"{len(packed):,} compressed bytes (a zlib bomb?)")
     try:
-        body = zlib.decompress(data[body_at:])
+        z = zlib.decompressobj()
+        body = z.decompress(packed, want + 1)
+        if len(body) <= want and not z.eof:
+            body += z.flush()
     except zlib.error as e:
         raise FormatError(f"{path}: byte {body_at}: command data is damaged ({e})") from None
-    if len(body) != n * RECORD_BYTES:
-        raise FormatError(f"{path}: byte {body_at}: command data holds {len(body)} bytes, "
-                          f"{n} changes need {n * RECORD_BYTES}")
+    if len(body) <= want and not z.eof:
+        raise FormatError(f"{path}: byte {body_at}: command data is damaged (the compressed stream is cut short)")
+    if len(body) != want:
+        got = f"more than {want}" if len(body) > want else str(len(body))
+        raise FormatError(f"{path}: byte {body_at}: command data holds {got} bytes, "
+                          f"{n} changes need {want}")
     o = 0
     cols = []
     for dtype in ("<u4", "<u2", "<f8", "<f8", "<f8"):
@@ -294,6 +395,8 @@ def decode(data: bytes, path: str | os.PathLike = "<replay>") -> Replay:
         raise FormatError(f"{path}: byte {body_at}: a command names a tank or step outside the match")
     if n and not np.isfinite(values).all():
         raise FormatError(f"{path}: byte {body_at}: a command strength is not finite")
+    if n and (np.abs(values) > 1.0).any():
+        raise FormatError(f"{path}: byte {body_at}: a command strength is outside -1..1")
     return Replay(header, steps, tanks, values, fire.astype(bool))
 
 
@@ -309,7 +412,7 @@ def write_replay(path: str | os.PathLike, replay: Replay) -> int:
 def read_replay(path: str | os.PathLike) -> Replay:
     from ..formats.bundle import read_input
 
-    return decode(read_input(path, "a replay file"), path)
+    return decode(read_input(path, "a replay file", limit=MAX_REPLAY_BYTES), path)
 
 
 # ---------------------------------------------------------------- matches

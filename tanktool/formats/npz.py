@@ -1,0 +1,74 @@
+"""``.npz`` archives (navgrid.npz, quadtree.npz) read without trusting them.
+
+``numpy.load`` on a damaged archive raises BadZipFile, zlib.error, EOFError or
+NotImplementedError, and one whose members claim gigabytes inflates them.  Here the
+file is read through :func:`~tanktool.formats.bundle.read_input` (a regular file of
+bounded size), every member's declared size is added up *before* anything is
+inflated (zipfile then stops each member at its declared size), each ``.npy`` header
+is checked (a plain numeric dtype, a shape that matches the member's bytes, never
+pickled objects), and every failure is one FormatError naming the file.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import zipfile
+import zlib
+
+import numpy as np
+
+from ..errors import FormatError
+from .limits import MAX_NPZ_BYTES
+
+#: members one archive may have (ours have about ten)
+MAX_MEMBERS = 64
+
+
+def read_npz(path: str | os.PathLike, what: str = "an .npz file", limit: int = MAX_NPZ_BYTES) -> dict[str, np.ndarray]:
+    """The arrays of an ``.npz`` file by name (without the ``.npy``)."""
+    from .bundle import read_input
+
+    label = str(path)
+    data = read_input(path, what, limit=limit)
+    try:
+        zf = zipfile.ZipFile(io.BytesIO(data))
+        infos = zf.infolist()
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, ValueError, OSError, EOFError, NotImplementedError) as e:
+        raise FormatError(f"{label}: not {what} (not a readable zip archive: {e})") from None
+    if len(infos) > MAX_MEMBERS:
+        raise FormatError(f"{label}: {len(infos)} members, more than {MAX_MEMBERS} ({what} has about ten)")
+    total = sum(i.file_size for i in infos)
+    if total > limit:
+        raise FormatError(f"{label}: its arrays claim {total:,} bytes, more than {limit:,}")
+    out: dict[str, np.ndarray] = {}
+    for info in infos:
+        name = info.filename
+        if not name.endswith(".npy") or info.is_dir():
+            raise FormatError(f"{label}: member {name[:60]!r} is not an array (.npy)")
+        try:
+            with zf.open(info) as f:
+                version = np.lib.format.read_magic(f)
+                if version == (1, 0):
+                    shape, fortran, dtype = np.lib.format.read_array_header_1_0(f)
+                elif version == (2, 0):
+                    shape, fortran, dtype = np.lib.format.read_array_header_2_0(f)
+                else:
+                    raise ValueError(f"unsupported .npy version {version}")
+                if dtype.hasobject or dtype.kind not in "biufU" or dtype.fields is not None:
+                    raise ValueError(f"dtype {dtype} is not a plain number or text type")
+                count = 1
+                for d in shape:
+                    count *= int(d)
+                if count * dtype.itemsize > info.file_size:
+                    raise ValueError(f"shape {shape} needs {count * dtype.itemsize} bytes, the member holds fewer")
+                raw = f.read(count * dtype.itemsize)
+                if len(raw) != count * dtype.itemsize:
+                    raise ValueError("the member is cut short")
+                arr = np.frombuffer(raw, dtype=dtype).copy()
+                arr = arr.reshape(shape[::-1]).T if fortran else arr.reshape(shape)
+        except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, TypeError, SyntaxError,
+                NotImplementedError, RuntimeError) as e:
+            raise FormatError(f"{label}: member {name[:60]!r} cannot be read: {e}") from None
+        out[name[:-4]] = arr
+    return out
