@@ -9,6 +9,10 @@ the same process, pymunk (Chipmunk2D, C) steps an equivalent scene: 8 box bodies
 the same size and mass driven by changing forces and torques inside 4 static walls.
 The ratio column is our World.step rate over pymunk's.
 
+Then 8 computer agents (sim/agents, normal) drive the same arena: the CPU time of
+their calls per world step, and the one-off time of their first think (each builds
+its grid and sight map; cached per arena).
+
     python bench/sim.py [--steps N] [--seed K] [--json]
 """
 
@@ -49,8 +53,8 @@ def arenas():
     for name in found:
         info = load_match_arena(ROOT / "arenas" / name)
         if len(info.spawns) >= 8:
-            out.append((info.name, info.walls, info.spawns, info.ground))
-    return out or [(*_builtin_arena(), None)]
+            out.append((info.name, info.walls, info.spawns, info.ground, info.bounds))
+    return out or [(*_builtin_arena(), None, None)]
 
 
 def bench_ours(walls, spawns, spec: TankSpec, steps: int, seed: int, ground=None) -> dict:
@@ -69,6 +73,27 @@ def bench_ours(walls, spawns, spec: TankSpec, steps: int, seed: int, ground=None
     total = time.perf_counter() - t0
     return {"step_per_s": steps / step_time, "match_per_s": steps / total,
             "mean_shells": shells / steps, "shots": sum(t.shots for t in tanks)}
+
+
+def bench_agents(walls, spawns, spec: TankSpec, steps: int, seed: int, ground=None, bounds=None) -> dict:
+    """8 computer agents (normal) driving: CPU seconds in their calls per world step,
+    after each has set up (its grid and sight map: timed apart, once per arena)."""
+    from tanktool.sim.match import make_bots
+
+    world = World(walls, [spec] * 8, spawns, seed=seed, ground=ground, bounds=bounds)
+    bots = make_bots(world)
+    tanks = world.tanks
+    s0 = time.process_time()
+    cmds = [b(world, t) for b, t in zip(bots, tanks)]   # the first think sets each agent up
+    setup = time.process_time() - s0
+    world.step(None, cmds)
+    spent = 0.0
+    for _ in range(steps):
+        s0 = time.process_time()
+        cmds = [b(world, t) for b, t in zip(bots, tanks)]
+        spent += time.process_time() - s0
+        world.step(None, cmds)
+    return {"agent_ms_per_step": 1000.0 * spent / steps, "agent_setup_s": setup}
 
 
 def bench_pymunk(steps: int, seed: int, size=(120.0, 90.0), spec: TankSpec | None = None) -> dict | None:
@@ -123,8 +148,9 @@ def main(argv: list[str] | None = None) -> int:
     spec = load_tank_spec(vref)
     peer = bench_pymunk(args.steps, args.seed, spec=spec)
     rows = []
-    for name, walls, spawns, ground in arenas():
+    for name, walls, spawns, ground, bounds in arenas():
         ours = bench_ours(walls, spawns, spec, args.steps, args.seed, ground)
+        agents = bench_agents(walls, spawns, spec, args.steps, args.seed, ground, bounds)
         rows.append({
             "arena": name,
             "levels": int(ground.levels) if ground is not None else 1,
@@ -137,23 +163,30 @@ def main(argv: list[str] | None = None) -> int:
             "shots": ours["shots"],
             "pymunk_steps_per_s": round(peer["step_per_s"], 1) if peer else None,
             "ratio_to_pymunk": round(ours["step_per_s"] / peer["step_per_s"], 3) if peer else None,
+            "agent_ms_per_step": round(agents["agent_ms_per_step"], 3),
+            "agent_setup_s": round(agents["agent_setup_s"], 2),
         })
     result = {"benchmark": "sim", "tanks": 8, "vehicle": spec.name, "dt": 1 / 120, "steps": args.steps,
-              "goal_steps_per_s": 2000, "pymunk": peer["version"] if peer else None, "arenas": rows}
+              "goal_steps_per_s": 2000, "goal_agent_ms_per_step": 1.0, "pymunk": peer["version"] if peer else None, "arenas": rows}
     if args.json:
         print(json.dumps(result))
         return 0
     print(f"8 tanks ({spec.name}), {args.steps} steps of 1/120 s, one core; pymunk {result['pymunk']} "
           "steps 8 boxes + 4 walls in the same run")
-    head = f"{'arena':<14} {'walls':>5} {'step/s':>8} {'match/s':>8} {'x real':>7} {'shells':>6} {'pymunk/s':>9} {'ours/pymunk':>11}"
+    head = (f"{'arena':<14} {'lv':>2} {'walls':>5} {'step/s':>8} {'match/s':>8} {'x real':>7} {'shells':>6} "
+            f"{'pymunk/s':>9} {'ours/pymunk':>11} {'agents ms/step':>14} {'setup s':>7}")
     print(head)
     print("-" * len(head))
     for r in rows:
         pm = f"{r['pymunk_steps_per_s']:>9.0f}" if r["pymunk_steps_per_s"] else f"{'n/a':>9}"
         ratio = f"{r['ratio_to_pymunk']:>11.2f}" if r["ratio_to_pymunk"] else f"{'n/a':>11}"
-        print(f"{r['arena']:<14} {r['walls']:>5} {r['steps_per_s']:>8.0f} {r['match_steps_per_s']:>8.0f} "
-              f"{r['realtime_factor']:>6.0f}x {r['mean_shells_in_flight']:>6.2f} {pm} {ratio}")
-    print(f"goal: >= {result['goal_steps_per_s']} steps/s with 8 tanks")
+        lv = f"{r['levels']}{'*' if r['relief'] else ''}"
+        print(f"{r['arena']:<14} {lv:>2} {r['walls']:>5} {r['steps_per_s']:>8.0f} {r['match_steps_per_s']:>8.0f} "
+              f"{r['realtime_factor']:>6.0f}x {r['mean_shells_in_flight']:>6.2f} {pm} {ratio} "
+              f"{r['agent_ms_per_step']:>14.3f} {r['agent_setup_s']:>7.2f}")
+    print(f"goal: >= {result['goal_steps_per_s']} steps/s with 8 tanks; computer agents < "
+          f"{result['goal_agent_ms_per_step']:g} ms CPU per step for 8 (normal, after setting up); "
+          f"lv: levels, * on a ground (relief or levels)")
     return 0
 
 

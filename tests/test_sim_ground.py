@@ -199,3 +199,27 @@ def test_a_match_on_the_fort_reports_heights_and_replays_bit_for_bit(arenas):
     result, replay = record_match(info, spec, bots=4, seconds=6, seed=4)
     back = play_replay(decode(encode(replay)), info, spec)
     assert back.matches, "a replay on the fort did not end in the recorded state"
+
+
+@pytest.mark.parametrize("name", ("hills", "fort"))
+def test_the_three_sight_tests_agree(arenas, name):
+    """SolidField.blocked (one line, block by block), visible_from (one point to many)
+    and visible (all pairs) sample the same points: the same answers, line for line;
+    and a line through a deck or under a hill is blocked while one well above is not."""
+    g = arenas[name].ground
+    sf = g.solids
+    rng = np.random.default_rng(5)
+    li, ii, jj = np.nonzero(g.exists)
+    k = rng.choice(len(li), 60, replace=False)
+    pts = np.array([(g.ox + (jj[a] + 0.5) * g.cell, g.h[li[a], ii[a], jj[a]] + 1.2, g.oz + (ii[a] + 0.5) * g.cell)
+                    for a in k])
+    vis = sf.visible(pts)
+    for a in range(len(pts)):
+        row = sf.visible_from(tuple(pts[a]), pts)
+        for b in range(len(pts)):
+            if a != b:
+                assert row[b] == vis[a, b] == (not sf.blocked(tuple(pts[a]), tuple(pts[b])))
+    assert 0.05 < vis.mean() < 0.98
+    hi = pts.copy()
+    hi[:, 1] = g.h[np.isfinite(g.h)].max() + 20.0      # above everything: all visible
+    assert sf.visible(hi).all()

@@ -142,9 +142,10 @@ class NavGrid:
 
     def node_of(self, x: float, z: float) -> Node:
         """The node whose cell contains (x, z), clamped into the grid."""
-        j = int(np.clip(math.floor((x - self.origin[0]) / self.cell), 0, self.nx - 1))
-        i = int(np.clip(math.floor((z - self.origin[1]) / self.cell), 0, self.nz - 1))
-        return (i, j)
+        j = math.floor((x - float(self.origin[0])) / self.cell)   # plain floats: called per think
+        i = math.floor((z - float(self.origin[1])) / self.cell)
+        nz, nx = int(self.shape[0]), int(self.shape[1])
+        return (0 if i < 0 else nz - 1 if i >= nz else i, 0 if j < 0 else nx - 1 if j >= nx else j)
 
     def nodes_of(self, points: np.ndarray) -> np.ndarray:
         """(m, 2) nodes of (m, 2) world points, clamped into the grid."""

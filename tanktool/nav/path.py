@@ -255,6 +255,16 @@ def layered_moves(grid: NavGrid) -> tuple[np.ndarray, list[tuple[int, int, float
     return target, moves
 
 
+def _move_table(grid: NavGrid) -> tuple[list, list[float]]:
+    """layered_moves as plain lists, made once per grid (kept on it: a grid is not
+    changed once built, and an agent plans on its grid many times)."""
+    cached = grid.__dict__.get("_move_table")
+    if cached is None:
+        target, moves = layered_moves(grid)
+        cached = grid.__dict__["_move_table"] = (target.tolist(), [m[2] for m in moves])
+    return cached
+
+
 def astar_layered(grid: NavGrid, start: Node3, goal: Node3) -> list[Node3]:
     """Shortest path of valid nodes ``(level, i, j)`` across levels (ramps, steps,
     decks), 8-connected along the grid's links; ``[]`` when there is none.  The octile
@@ -267,14 +277,12 @@ def astar_layered(grid: NavGrid, start: Node3, goal: Node3) -> list[Node3]:
             raise ValueError(f"node {n} is outside the {L} x {nz} x {nx} grid")
     if not (valid[start] and valid[goal]):
         return []
-    target, moves = layered_moves(grid)
-    cost = [m[2] for m in moves]
+    table, cost = _move_table(grid)
     per = nz * nx
     s = start[0] * per + start[1] * nx + start[2]
     g = goal[0] * per + goal[1] * nx + goal[2]
     gi, gj = goal[1], goal[2]
     k2 = _SQRT2 - 2.0
-    table = target.tolist()
 
     def h(m: int) -> float:
         r = m % per

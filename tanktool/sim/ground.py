@@ -171,6 +171,8 @@ class SolidField:
     #: cell up to the highest point of the faces in it, so a line skimming a slope (or
     #: a crest) would otherwise be cut by the rise of the slope within a cell
     MARGIN = 0.3
+    #: columns per side of the blocks a line of sight skips when it passes above them
+    BLOCK = 8
 
     def __init__(self, vertices: np.ndarray, faces: np.ndarray, cs: float = 0.5, ch: float = 0.1) -> None:
         from ..geometry.heightfield import grid_for, rasterize
@@ -198,6 +200,18 @@ class SolidField:
         solid[col[owner] * ny + k] = True
         self.solid = solid
         self._bytes = solid.tobytes()     # the scalar walk indexes bytes: no numpy per sample
+        # the highest solid of each block of BLOCK x BLOCK columns (world y; -inf: none)
+        B = self.BLOCK
+        bz, bx = -(-nz // B), -(-nx // B)
+        col_top = np.full(nz * nx, -np.inf)
+        has = solid.reshape(nz * nx, ny)
+        any_ = has.any(axis=1)
+        highest = ny - 1 - np.argmax(has[:, ::-1], axis=1)
+        col_top[any_] = origin[1] + (highest[any_] + 1) * ch
+        pad = np.full((bz * B, bx * B), -np.inf)
+        pad[:nz, :nx] = col_top.reshape(nz, nx)
+        self._tops = pad.reshape(bz, B, bx, B).max(axis=(1, 3)).ravel().tolist()
+        self._bw = bx
         self.ox, self.y0, self.oz = float(origin[0]), float(origin[1]), float(origin[2])
         self.cs, self.ch, self.shape, self.ny = float(cs), float(ch), (nz, nx), ny
 
@@ -215,28 +229,67 @@ class SolidField:
 
     def blocked(self, a: tuple[float, float, float], b: tuple[float, float, float]) -> bool:
         """Whether the segment a -> b passes through the solid (sampled every half
-        cell, as :meth:`visible`; plain Python with an early exit: one line costs
-        tens of microseconds)."""
+        cell, as :meth:`visible`).  Plain Python: the segment goes block by block
+        (``BLOCK`` cells square) and only where it comes lower than the block's
+        highest solid are its samples looked up; an early exit at the first hit."""
         ax, ay, az = a
         dx, dy, dz = b[0] - ax, b[1] - ay, b[2] - az
         k = int(math.ceil(math.sqrt(dx * dx + dy * dy + dz * dz) / (0.5 * self.cs)))
+        if k < 2:
+            return False
         nz, nx = self.shape
         ny, solid = self.ny, self._bytes
-        ics, ich = 1.0 / self.cs, 1.0 / self.ch
-        ox, oz, y0 = self.ox, self.oz, self.y0 - self.MARGIN
+        cs, ch, margin = self.cs, self.ch, self.MARGIN
+        ox, oz, y0 = self.ox, self.oz, self.y0
         top = ny - 1
-        for m in range(1, k):
+        tops, bw, bs = self._tops, self._bw, self.BLOCK * self.cs
+        m = 1
+        while m < k:
             t = m / k
-            j = math.floor((ax + dx * t - ox) * ics)
-            i = math.floor((az + dz * t - oz) * ics)
-            if i < 0 or i >= nz or j < 0 or j >= nx:
-                continue
-            kk = math.floor((ay + dy * t - y0) * ich)
-            if kk >= top:
-                continue
-            if solid[(i * nx + j) * ny + (kk if kk > 0 else 0)]:
-                return True
+            x, z = ax + dx * t, az + dz * t
+            bi, bj = math.floor((z - oz) / bs), math.floor((x - ox) / bs)
+            # the samples up to where the segment leaves this block
+            t_end = 1.0
+            if dx > 0:
+                t_end = min(t_end, (ox + (bj + 1) * bs - ax) / dx)
+            elif dx < 0:
+                t_end = min(t_end, (ox + bj * bs - ax) / dx)
+            if dz > 0:
+                t_end = min(t_end, (oz + (bi + 1) * bs - az) / dz)
+            elif dz < 0:
+                t_end = min(t_end, (oz + bi * bs - az) / dz)
+            m_end = min(max(math.ceil(t_end * k - 1e-9), m + 1), k)  # samples before the block's edge
+            if 0 <= bi < len(tops) // bw and 0 <= bj < bw and \
+                    min(ay + dy * t, ay + dy * ((m_end - 1) / k)) + margin <= tops[bi * bw + bj] + ch:
+                for mm in range(m, m_end):   # the same arithmetic as inside(), to the last bit
+                    tt = mm / k
+                    j = math.floor((ax + dx * tt - ox) / cs)
+                    i = math.floor((az + dz * tt - oz) / cs)
+                    if i < 0 or i >= nz or j < 0 or j >= nx:
+                        continue
+                    kk = math.floor(((ay + dy * tt) + margin - y0) / ch)
+                    if kk >= top:
+                        continue
+                    if solid[(i * nx + j) * ny + (kk if kk > 0 else 0)]:
+                        return True
+            m = m_end
         return False
+
+    def visible_from(self, a: tuple[float, float, float], points: np.ndarray) -> np.ndarray:
+        """(n,) bool: whether the segment from ``a`` to each point keeps out of the
+        solid (the samples of :meth:`blocked`, all lines in one array lookup)."""
+        q = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        if len(q) == 0:
+            return np.zeros(0, dtype=bool)
+        p = np.asarray(a, dtype=np.float64)
+        d = q - p
+        k = np.maximum(np.ceil(np.sqrt((d * d).sum(axis=1)) / (0.5 * self.cs)).astype(np.int64), 1)
+        cnt = k - 1
+        owner = np.repeat(np.arange(len(q)), cnt)
+        t = (np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt) + 1) / k[owner]
+        s = p + d[owner] * t[:, None]
+        hit = np.bincount(owner, weights=self.inside(s[:, 0], s[:, 1], s[:, 2]), minlength=len(q))
+        return hit == 0
 
     def visible(self, points: np.ndarray, max_range: float = math.inf) -> np.ndarray:
         """(n, n) bool: whether the segment between each two points keeps out of the

@@ -55,6 +55,8 @@ def _bundle_dir(ref: str | Path, kind: str, defaults: tuple[str, ...]) -> Path:
 
     A bundled name is a plain folder name: ``../../etc`` is looked up as a path only,
     never below ``arenas/`` or ``vehicles/``."""
+    from ..content import bundled_dir, bundled_names
+
     err = ArenaError if kind == "arenas" else VehicleError
     if not isinstance(ref, (str, Path)) or not str(ref) or "\0" in str(ref) or len(str(ref)) > 4096:
         raise err(f"{str(ref)[:80]!r}: not a {kind[:-1]} name or folder")
@@ -66,10 +68,11 @@ def _bundle_dir(ref: str | Path, kind: str, defaults: tuple[str, ...]) -> Path:
         pass
     name = str(ref)
     if Path(name).name == name and name not in (".", ".."):
-        for base in (REPO / kind, Path.cwd() / kind):
+        home = bundled_dir(kind)
+        for base in ([home] if home is not None else []) + [Path.cwd() / kind]:
             if (base / name).is_dir():
                 return base / name
-    have = sorted(d.name for d in (REPO / kind).iterdir() if d.is_dir()) if (REPO / kind).is_dir() else []
+    have = bundled_names(kind)
     raise err(f"{ref}: no such {kind[:-1]} (a folder path, or one of: {', '.join(have) or 'none bundled yet'})")
 
 

@@ -573,6 +573,15 @@ class World:
         """Whether nothing stands between two tanks' eyes (range and cone aside)."""
         return not self.line_blocked(a.x, a.z, b.x, b.z, self.eye(a), self.eye(b))
 
+    def sees_all(self, a: Tank, others: Sequence[Tank]) -> list[bool]:
+        """``sees(a, b)`` for each of ``others``, in one go (on a ground: one array
+        lookup for all the lines)."""
+        g = self.ground
+        if g is None or g.mesh is None or len(others) < 2:
+            return [self.sees(a, b) for b in others]
+        pts = [(b.x, self.eye(b), b.z) for b in others]
+        return g.solids.visible_from((a.x, self.eye(a), a.z), pts).tolist()
+
     def walls_of(self, t: Tank) -> WallSet:
         """The walls a tank can hit: its level's (all walls on a flat arena)."""
         if self.ground is None or not self.level_walls:

@@ -470,6 +470,7 @@ class Views:
                 m = (b >= 0) & (a != b)
                 pairs.update(zip(a[m].tolist(), b[m].tolist()))
         self.cell_of = cell_of if layers is not None else cell_of[0]
+        self._height = height
         self.neighbours: list[list[tuple[int, float]]] = [[] for _ in range(n)]
         for a, b in pairs:
             if a < b or (b, a) not in pairs:
@@ -491,7 +492,17 @@ class Views:
             m = nearest_valid_node(self.grid.valid, n, 6)
             return int(self.cell_of[m]) if m is not None else -1
         lay = self.layers
-        m3 = nearest_valid_node3(lay.layered("valid"), lay.layered("height"), lay.node_of(x, z), y, 6)
+        i, j = lay.node_of(x, z)
+        best, best_d = -1, math.inf
+        for lv in range(self.cell_of.shape[0]):    # the node under (x, z) on each level
+            c = int(self.cell_of[lv, i, j])
+            if c >= 0:
+                d = 0.0 if y is None else abs(float(self._height[lv, i, j]) - y)
+                if d < best_d:
+                    best, best_d = c, d
+        if best >= 0:
+            return best
+        m3 = nearest_valid_node3(lay.layered("valid"), self._height, (i, j), y, 6)
         return int(self.cell_of[m3]) if m3 is not None else -1
 
     def path_distances(self, start: int) -> np.ndarray:

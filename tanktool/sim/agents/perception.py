@@ -126,10 +126,10 @@ class Senses:
     def look(self, world: "World", me: "Tank") -> list[Sighting]:
         """The live enemies in sight now, nearest first; remembered as last seen."""
         out = []
-        for o in world.tanks:
-            if o is me or not o.alive:
-                continue
-            if in_cone(me.x, me.z, me.heading, o.x, o.z, self.half_angle, self.vision_range) and world.sees(me, o):
+        cand = [o for o in world.tanks if o is not me and o.alive
+                and in_cone(me.x, me.z, me.heading, o.x, o.z, self.half_angle, self.vision_range)]
+        for o, seen in zip(cand, world.sees_all(me, cand)):
+            if seen:
                 s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z), o.heading,
                              o.y)
                 self.last_seen[o.index] = s
