@@ -109,3 +109,28 @@ def test_headless_screenshot_bad_input_exits_2(tmp_path):
 def test_screenshot_function_reports_what_it_drew(tmp_path):
     info = screenshot(tmp_path / "s.png", view="top", frames=5, arena="paper2002", bots=3, size=(320, 240))
     assert info["view"] == "top" and len(info["tanks"]) == 3 and (tmp_path / "s.png").is_file()
+
+
+def test_the_top_view_shades_a_layered_arena_by_height(tmp_path):
+    """The fort: the roof (5 m) lighter than the yard (0 m), every overlay draws on a
+    layered grid, each tank's height beside it."""
+    from tanktool.game.render_top import HEIGHT_HIGH, HEIGHT_LOW
+
+    pygame.init()
+    s = GameSession("fort", bots=4, seed=1, player=False)
+    run_frames(s, 10)
+    for overlays in ((), ("quadtree", "navgrid", "agents")):
+        v = TopView(s, SIZE)
+        for o in overlays:
+            v.toggle(o)
+        surf = pygame.Surface(SIZE)
+        v.draw(surf)
+    v = TopView(s, SIZE)
+    surf = pygame.Surface(SIZE)
+    v.draw(surf)
+    img = pygame.surfarray.array3d(surf).transpose(1, 0, 2).astype(int)
+    roof = img[int(v.to_px(70, 36)[1]), int(v.to_px(70, 36)[0])]
+    yard = img[int(v.to_px(30, 20)[1]), int(v.to_px(30, 20)[0])]
+    assert np.abs(roof - HEIGHT_HIGH).sum() < np.abs(roof - HEIGHT_LOW).sum()
+    assert np.abs(yard - HEIGHT_LOW).sum() < np.abs(yard - HEIGHT_HIGH).sum()
+    pygame.image.save(surf, str(tmp_path / "fort-top.png"))

@@ -24,6 +24,8 @@ from .hud import Hud, text
 from .session import GameSession, tank_colour
 
 FLOOR = (52, 58, 50)
+#: the walkable surface of an arena with relief or levels, from its lowest to its highest
+HEIGHT_LOW, HEIGHT_HIGH = (40, 66, 44), (196, 184, 128)
 WALL = (225, 205, 160)
 MARGIN = 24
 OVERLAYS = ("quadtree", "navgrid", "agents")
@@ -86,10 +88,42 @@ class TopView:
         (x0, z0), (x1, z1) = self.session.world.bounds.tolist()
         a, b = self.to_px(x0, z0), self.to_px(x1, z1)
         pygame.draw.rect(surf, FLOOR, pygame.Rect(a, (b[0] - a[0], b[1] - a[1])))
+        ground = getattr(self.session.world, "ground", None)
+        if ground is not None:
+            self._draw_heights(surf, ground)
         width = max(int(round(0.6 * self.scale)), 2)
         for (ax, az), (bx, bz) in self.session.world.walls.segments.tolist():
             pygame.draw.line(surf, WALL, self.to_px(ax, az), self.to_px(bx, bz), width)
         return surf
+
+    def _draw_heights(self, surf: pygame.Surface, ground: Any) -> None:
+        """The walkable surface shaded by height (its highest level where levels
+        stack: the deck over the passage), lighter when higher, with a scale bar."""
+        h = np.asarray(ground.h, dtype=np.float64)
+        top = np.where(np.isfinite(h), h, -np.inf).max(axis=0)
+        have = np.isfinite(top)
+        if not have.any():
+            return
+        lo, hi = float(top[have].min()), float(top[have].max())
+        u = np.clip((top - lo) / max(hi - lo, 1e-6), 0.0, 1.0)
+        c0, c1 = np.array(HEIGHT_LOW, float), np.array(HEIGHT_HIGH, float)
+        rgb = (c0 + (c1 - c0) * u[..., None]).astype(np.uint8)
+        rgba = np.zeros(top.shape + (4,), np.uint8)
+        rgba[..., :3] = rgb
+        rgba[..., 3] = np.where(have, 255, 0)
+        nz, nx = top.shape
+        img = pygame.image.frombuffer(np.ascontiguousarray(rgba).tobytes(), (nx, nz), "RGBA")
+        p = self.to_px(ground.ox, ground.oz)
+        q = self.to_px(ground.ox + nx * ground.cell, ground.oz + nz * ground.cell)
+        surf.blit(pygame.transform.smoothscale(img, (max(int(q[0] - p[0]), 1), max(int(q[1] - p[1]), 1))), p)
+        # the scale: low .. high, top centre (the HUD holds the corners)
+        w, bh = 120, 10
+        x, y = self.size[0] // 2 - w // 2, 24
+        for k in range(w):
+            col = tuple(int(v) for v in c0 + (c1 - c0) * (k / (w - 1)))
+            pygame.draw.line(surf, col, (x + k, y), (x + k, y + bh))
+        text(surf, f"{lo:.1f} m", (x, y - 2), 16, anchor="bottomleft")
+        text(surf, f"{hi:.1f} m", (x + w, y - 2), 16, anchor="bottomright")
 
     def _quadtree_layer(self) -> pygame.Surface:
         from ..nav.quadtree import WallQuadtree
@@ -122,9 +156,10 @@ class TopView:
 
         grid = NavGrid.load(f)
         nz, nx = grid.shape
+        valid = grid.layered("valid").any(axis=0)       # on a layered grid: valid on any level
         rgba = np.zeros((nz, nx, 4), np.uint8)
-        rgba[grid.valid] = (90, 230, 120, 90)
-        rgba[~grid.valid] = (230, 60, 60, 40)
+        rgba[valid] = (90, 230, 120, 90)
+        rgba[~valid] = (230, 60, 60, 40)
         img = pygame.image.frombuffer(np.ascontiguousarray(rgba).tobytes(), (nx, nz), "RGBA")
         ox, oz = (float(v) for v in grid.origin)
         p = self.to_px(ox, oz)
@@ -173,6 +208,10 @@ class TopView:
         if t.index == self.session.focus():
             px, pz = self.to_px(x, z)
             pygame.draw.circle(surface, (255, 255, 255), (px, pz), int(t.spec.radius * self.scale) + 4, 2)
+        if getattr(self.session.world, "ground", None) is not None and t.alive:
+            # which floor it is on: its height beside it (a deck and the passage under it look alike)
+            px, pz = self.to_px(x, z)
+            text(surface, f"{t.y:.1f} m", (int(px + t.spec.radius * self.scale) + 2, int(pz)), 15, anchor="midleft")
 
     def _vision(self, x: float, z: float, h: float, sight: float, fov: float, rays: int = 25) -> list[tuple[float, float]]:
         """The vision cone cut by the walls: rays from the tank stop at the first wall."""
