@@ -129,20 +129,9 @@ _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
 
 def _companion_files(model: Path) -> list[Path]:
     """Files a model needs beside it: an .obj's material libraries."""
-    if model.suffix.lower() != ".obj":
-        return []
-    out = []
-    try:
-        with open(model, "rb") as f:
-            for raw in f:
-                if raw.startswith(b"mtllib"):
-                    for name in raw.split()[1:]:
-                        p = model.parent / name.decode("utf-8", "replace")
-                        if p.is_file() and p.parent == model.parent:
-                            out.append(p)
-    except OSError:
-        return []
-    return out
+    from .formats.materials import mtl_libraries
+
+    return mtl_libraries(model)
 
 
 def walkable_params(cell: float | None = None, max_slope: float | None = None, climb: float | None = None,
@@ -214,6 +203,7 @@ def import_arena(
 
     from .fleet import bundled_fleet
     from .formats.bundle import sha256_file, staged_dir, write_toml
+    from .formats.materials import export_glb
     from .formats.models import default_up, detect_format, load_scene
     from .formats.walls_txt import write_walls
     from .nav.arena_levels import analyse_arena, spawn_y_needed
@@ -279,7 +269,7 @@ def import_arena(
         copied = [model, *_companion_files(model)]
         for f in copied:
             shutil.copyfile(f, tmp / f.name)
-        glb = scene.export(file_type="glb")
+        glb, textures = export_glb(model, scene, tmp, extra=[target], warn=remark)   # textures copied in
         (tmp / "model.glb").write_bytes(glb)
         header = (f"arena {name}: walls of {model.name}, the boundaries of its walkable surface "
                   f"(flat floors: cut {height:g} m above them)\n"
@@ -300,7 +290,7 @@ def import_arena(
                        for x, z, h, y in spawns],
             "source": {"file": model.name, "sha256": sha256_file(model), "up": src_up, "scale": float(scale),
                        **_plan_source(fmt, wall_height, wall_thickness)},
-            "model": {"file": "model.glb"},
+            "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
             "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
                       "count": len(walls)},
             "walkable": params.as_toml(),

@@ -17,6 +17,10 @@ source model:
   thick boxes placed outside each outline edge; stored as .3ds (Z up), so it is
   imported with ``--up z``.
 
+Every part has texture coordinates (box projection, ``TILE`` metres per repeat of its
+kind) and its material names a texture of tools/make_textures.py (``TEXTURES``), kept in
+the bundle's ``textures/`` folder; the material's colour stays as the fallback.
+
 Then each is run through ``import-arena`` (tanktool.arena.import_arena) into
 ``arenas/<name>/``.  ``make arenas`` (tools/build_arenas.py) rebuilds the derived
 files of the bundles from these sources later without re-authoring them.
@@ -34,6 +38,7 @@ import trimesh
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tools"))
 
 WALL_H = 3.0  # m, well above the 1 m cut
 SLAB = 0.5  # floor slab thickness (m)
@@ -43,6 +48,15 @@ COLOURS = {
     "wall": (0.62, 0.36, 0.27),
     "crate": (0.55, 0.42, 0.22),
     "block": (0.45, 0.47, 0.55),
+}
+
+#: metres per repeat of each kind's texture
+TILE = {"floor": 4.0, "wall": 3.0, "crate": 2.0, "block": 3.0}
+#: arena -> kind -> texture (tools/make_textures.py paints them into arenas/<name>/textures/)
+TEXTURES = {
+    "box": {"floor": "dirt", "wall": "brick", "crate": "planks"},
+    "maze": {"floor": "grass", "wall": "stone"},
+    "paper2002": {"floor": "tarmac", "wall": "concrete", "block": "concrete"},
 }
 
 #: the 2002 paper's free-space outline, completed (paper units); x right, z up
@@ -187,28 +201,41 @@ def model_paper2002() -> list[tuple[str, str, trimesh.Trimesh]]:
     return out
 
 
-def write_obj(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]]) -> None:
-    """A plain OBJ with one object per part and a material library of diffuse colours."""
+def _uv_parts(parts: list[tuple[str, str, trimesh.Trimesh]]):
+    from make_textures import box_uv
+
+    for name, kind, mesh in parts:
+        yield (name, kind, *box_uv(mesh.vertices, mesh.faces, TILE[kind]))
+
+
+def write_obj(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]], textures: dict[str, str]) -> None:
+    """A plain OBJ with one object per part, texture coordinates, and a material library
+    of diffuse colours and texture maps."""
     mtl = path.with_suffix(".mtl")
     lines = [f"# {path.name}: authored by tools/make_arena_models.py (metres, Y up)", f"mtllib {mtl.name}"]
     base = 1
-    for name, kind, mesh in parts:
+    for name, kind, verts, faces, uv in _uv_parts(parts):
         lines.append(f"o {name}")
         lines.append(f"usemtl {kind}")
-        lines += [f"v {x:.6g} {y:.6g} {z:.6g}" for x, y, z in mesh.vertices]
-        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in mesh.faces]
-        base += len(mesh.vertices)
+        lines += [f"v {x:.6g} {y:.6g} {z:.6g}" for x, y, z in verts]
+        lines += [f"vt {u:.6g} {v:.6g}" for u, v in uv]
+        lines += [f"f {a + base}/{a + base} {b + base}/{b + base} {c + base}/{c + base}" for a, b, c in faces]
+        base += len(verts)
     path.write_text("\n".join(lines) + "\n")
     used = sorted({kind for _, kind, _ in parts})
-    mtl.write_text("".join(f"newmtl {k}\nKd {COLOURS[k][0]:.3f} {COLOURS[k][1]:.3f} {COLOURS[k][2]:.3f}\n\n"
+    mtl.write_text("".join(f"newmtl {k}\nKd {COLOURS[k][0]:.3f} {COLOURS[k][1]:.3f} {COLOURS[k][2]:.3f}\n"
+                           + (f"map_Kd textures/{textures[k]}.png\n" if k in textures else "") + "\n"
                            for k in used))
 
 
-def write_3ds_model(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]]) -> None:
+def write_3ds_model(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]], textures: dict[str, str]) -> None:
     from tanktool.formats.threeds_write import write_3ds
 
     to_z_up = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.float64)  # (x, y, z) -> (x, -z, y)
-    objects = [(name, mesh.vertices @ to_z_up.T, mesh.faces, COLOURS[kind]) for name, kind, mesh in parts]
+    # 3DS keeps 8.3 names by tradition; the map names the file in the bundle's textures/ folder
+    objects = [(name, verts @ to_z_up.T, faces, COLOURS[kind], uv,
+                f"textures/{textures[kind]}.png" if kind in textures else None)
+               for name, kind, verts, faces, uv in _uv_parts(parts)]
     write_3ds(path, objects)
 
 
@@ -234,9 +261,9 @@ def main(argv: list[str] | None = None) -> int:
         parts = make()
         src = folder / file_name
         if src.suffix == ".obj":
-            write_obj(src, parts)
+            write_obj(src, parts, TEXTURES[name])
         else:
-            write_3ds_model(src, parts)
+            write_3ds_model(src, parts, TEXTURES[name])
         faces = sum(len(m.faces) for _, _, m in parts)
         print(f"{name}: wrote {src.relative_to(ROOT)} ({len(parts)} parts, {faces} faces)")
         if args.models_only:
