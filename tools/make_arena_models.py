@@ -223,9 +223,12 @@ def write_obj(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]], texture
         base += len(verts)
     path.write_text("\n".join(lines) + "\n")
     used = sorted({kind for _, kind, _ in parts})
-    mtl.write_text("".join(f"newmtl {k}\nKd {COLOURS[k][0]:.3f} {COLOURS[k][1]:.3f} {COLOURS[k][2]:.3f}\n"
-                           + (f"map_Kd textures/{textures[k]}.png\n" if k in textures else "") + "\n"
-                           for k in used))
+    # MTL multiplies map_Kd by Kd: a textured material is white (the texture's own colours);
+    # the others keep their colour
+    mtl.write_text("".join(
+        f"newmtl {k}\n" + (f"Kd 1.000 1.000 1.000\nmap_Kd textures/{textures[k]}.png\n\n" if k in textures else
+                           f"Kd {COLOURS[k][0]:.3f} {COLOURS[k][1]:.3f} {COLOURS[k][2]:.3f}\n\n")
+        for k in used))
 
 
 def write_3ds_model(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]], textures: dict[str, str]) -> None:
