@@ -5,15 +5,18 @@ For every bundled arena a match of 8 computer agents is warmed up for 60 frames,
 
 - **3D at every preset** (game/quality.py: low, medium = the default, high = everything
   on) at 1280x720 through EGL (Mesa llvmpipe here), HUD and effects included, the
-  frame read back to memory as a screenshot does (``fps``), and beside them, in the
-  same run, the **reference**: the same triangles (arena and the 8 tanks) drawn with
-  one colour, depth test, no light, texture, shadow, sky, effect or HUD, read back
-  the same way.  The presets and the reference take turns, ``--frames`` frames at a
-  time for ``--rounds`` rounds, while the match goes on (2 steps of 1/120 s between
-  frames, not timed), so each sees the same load; the **ratio** preset fps /
-  reference fps (median of the rounds) is the figure to compare across machines:
+  frame read back to memory as a screenshot does (``fps``), and beside each, in the
+  same run, its **reference**: the same triangles (arena and the 8 tanks; an arena lit
+  per vertex is split into more) drawn with one colour, depth test, no light, texture,
+  shadow, sky, effect or HUD, read back the same way.  Presets and references take
+  turns, ``--frames`` frames at a time for ``--rounds`` rounds, while the match goes on
+  (2 steps of 1/120 s between frames, not timed), so each sees the same load; the
+  **ratio** preset fps / reference fps (median of the rounds) is the figure to compare
+  across machines:
   llvmpipe renders on every core, so on a shared machine the absolute fps follow the
-  other jobs, the ratio much less;
+  other jobs, the ratio much less.  Beside them the CPU time the frame took on every
+  thread of the process (llvmpipe's rasteriser threads included: ``cpu ms/frame``),
+  which on a loaded machine moves less than the wall clock;
 - ``fps_3d_draw``: the default preset without the read-back (what a window shows,
   ``ctx.finish()`` waits for the rasteriser);
 - the top view drawn with pygame at the same size (``top fps``);
@@ -102,26 +105,34 @@ def bench_arena(name: str, frames: int, rounds: int, size: tuple[int, int], seed
     row["triangles"] = first.triangles()
     for r in renderers.values():
         r.render(1.0, 30.0)                    # compile shaders, upload, first-frame costs
-    first.render_reference(1.0)
+        r.render_reference(1.0)
     steps = max(int(round(FRAME / session.dt)), 1)
 
-    def frame_time(draw) -> float:
-        total = 0.0
+    cpu: dict[str, list[float]] = {}
+
+    def frame_time(draw, key: str) -> float:
+        total = used = 0.0
         for _ in range(frames):
             for _ in range(steps):
                 session.step()
             for other in renderers.values():
                 other.effects.sync(session, other.floor_y)
-            t = time.perf_counter()
+            t, c = time.perf_counter(), time.process_time()
             draw()
             total += time.perf_counter() - t
+            used += time.process_time() - c
+        # CPU time of every thread (llvmpipe's too) per frame: the work, whatever else runs
+        cpu.setdefault(key, []).append(1000 * used / frames)
         return frames / max(total, 1e-9)
 
-    fps: dict[str, list[float]] = {k: [] for k in ["reference", *PRESETS, "draw"]}
+    fps: dict[str, list[float]] = {k: [] for k in [*PRESETS, "draw"]}
+    ref: dict[str, list[float]] = {k: [] for k in PRESETS}
     for _ in range(rounds):
-        fps["reference"].append(frame_time(lambda: first.render_reference(1.0)))
         for p, r in renderers.items():
-            fps[p].append(frame_time(lambda r=r: r.render(1.0, 30.0)))
+            # the reference of a preset draws its triangles (the arena is split: light
+            # and fog come from its vertices), right before it
+            ref[p].append(frame_time(lambda r=r: r.render_reference(1.0), "ref " + p))
+            fps[p].append(frame_time(lambda r=r: r.render(1.0, 30.0), p))
 
         def no_readback() -> None:
             first.own_ctx = False
@@ -129,11 +140,13 @@ def bench_arena(name: str, frames: int, rounds: int, size: tuple[int, int], seed
             first.ctx.finish()
             first.own_ctx = True
 
-        fps["draw"].append(frame_time(no_readback))
-    ref = fps["reference"]
-    row["reference_fps"] = round(statistics.median(ref), 1)
-    row["presets"] = {p: {"fps": round(statistics.median(fps[p]), 1),
-                          "ratio": round(statistics.median([a / b for a, b in zip(fps[p], ref)]), 3)}
+        fps["draw"].append(frame_time(no_readback, "draw"))
+    row["reference_fps"] = round(statistics.median(ref[DEFAULT]), 1)
+    row["presets"] = {p: {"fps": round(statistics.median(fps[p]), 1), "triangles": renderers[p].triangles(),
+                          "reference_fps": round(statistics.median(ref[p]), 1),
+                          "ratio": round(statistics.median([a / b for a, b in zip(fps[p], ref[p])]), 3),
+                          "cpu_ms_frame": round(statistics.median(cpu[p]), 1),
+                          "reference_cpu_ms_frame": round(statistics.median(cpu["ref " + p]), 1)}
                       for p in PRESETS}
     row["fps_3d"] = row["presets"][DEFAULT]["fps"]
     row["fps_3d_draw"] = round(statistics.median(fps["draw"]), 1)
@@ -195,6 +208,12 @@ def main() -> None:
         cells = " ".join(f"{r['presets'][p]['fps']:>10.1f} {r['presets'][p]['ratio']:>6.3f}" for p in names)
         print(f"{r['arena']:<10} {r['triangles']:>5} {r['reference_fps']:>8.1f} {cells} {r['fps_3d_draw']:>9.1f} "
               f"{r['fps_top']:>8.1f} {r['sim_bots_ms']:>8.3f} {r['audio_ms']:>6.3f} {r['cpu_ms']:>7.3f} {r['fx_ms']:>6.3f}")
+    print()
+    head = f"{'cpu ms/frame':<12} " + " ".join(f"{p:>8} {'its ref':>8}" for p in names)
+    print(head)
+    for r in rows:
+        print(f"{r['arena']:<12} " + " ".join(f"{r['presets'][p]['cpu_ms_frame']:>8.1f} "
+                                             f"{r['presets'][p]['reference_cpu_ms_frame']:>8.1f}" for p in names))
     print(f"default preset: {DEFAULT}; everything on: {ALL_ON}.  Goals on a quiet 2-core machine: {DEFAULT} >= 60 fps, "
           f"{ALL_ON} >= 30 fps; cpu ms (sim + agents + sound) < 4 per frame")
 

@@ -17,9 +17,9 @@ source model:
   thick boxes placed outside each outline edge; stored as .3ds (Z up), so it is
   imported with ``--up z``.
 
-Every part has texture coordinates (box projection, ``TILE`` metres per repeat of its
-kind) and its material names a texture of tools/make_textures.py (``TEXTURES``), kept in
-the bundle's ``textures/`` folder; the material's colour stays as the fallback.
+Each material gets a texture of tools/make_textures.py (its ``ARENA_TEXTURES``): the
+.obj sources are given texture coordinates by ``make_textures.texture_obj`` after they
+are written, the .3ds one is written with them (box projection, in metres).
 
 Then each is run through ``import-arena`` (tanktool.arena.import_arena) into
 ``arenas/<name>/``.  ``make arenas`` (tools/build_arenas.py) rebuilds the derived
@@ -48,15 +48,6 @@ COLOURS = {
     "wall": (0.62, 0.36, 0.27),
     "crate": (0.55, 0.42, 0.22),
     "block": (0.45, 0.47, 0.55),
-}
-
-#: metres per repeat of each kind's texture
-TILE = {"floor": 4.0, "wall": 3.0, "crate": 2.0, "block": 3.0}
-#: arena -> kind -> texture (tools/make_textures.py paints them into arenas/<name>/textures/)
-TEXTURES = {
-    "box": {"floor": "dirt", "wall": "brick", "crate": "planks"},
-    "maze": {"floor": "grass", "wall": "stone"},
-    "paper2002": {"floor": "tarmac", "wall": "concrete", "block": "concrete"},
 }
 
 #: the 2002 paper's free-space outline, completed (paper units); x right, z up
@@ -201,44 +192,38 @@ def model_paper2002() -> list[tuple[str, str, trimesh.Trimesh]]:
     return out
 
 
-def _uv_parts(parts: list[tuple[str, str, trimesh.Trimesh]]):
-    from make_textures import box_uv
-
-    for name, kind, mesh in parts:
-        yield (name, kind, *box_uv(mesh.vertices, mesh.faces, TILE[kind]))
-
-
-def write_obj(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]], textures: dict[str, str]) -> None:
-    """A plain OBJ with one object per part, texture coordinates, and a material library
-    of diffuse colours and texture maps."""
+def write_obj(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]]) -> None:
+    """A plain OBJ with one object per part and a material library of diffuse colours."""
     mtl = path.with_suffix(".mtl")
     lines = [f"# {path.name}: authored by tools/make_arena_models.py (metres, Y up)", f"mtllib {mtl.name}"]
     base = 1
-    for name, kind, verts, faces, uv in _uv_parts(parts):
+    for name, kind, mesh in parts:
         lines.append(f"o {name}")
         lines.append(f"usemtl {kind}")
-        lines += [f"v {x:.6g} {y:.6g} {z:.6g}" for x, y, z in verts]
-        lines += [f"vt {u:.6g} {v:.6g}" for u, v in uv]
-        lines += [f"f {a + base}/{a + base} {b + base}/{b + base} {c + base}/{c + base}" for a, b, c in faces]
-        base += len(verts)
+        lines += [f"v {x:.6g} {y:.6g} {z:.6g}" for x, y, z in mesh.vertices]
+        lines += [f"f {a + base} {b + base} {c + base}" for a, b, c in mesh.faces]
+        base += len(mesh.vertices)
     path.write_text("\n".join(lines) + "\n")
     used = sorted({kind for _, kind, _ in parts})
-    # MTL multiplies map_Kd by Kd: a textured material is white (the texture's own colours);
-    # the others keep their colour
-    mtl.write_text("".join(
-        f"newmtl {k}\n" + (f"Kd 1.000 1.000 1.000\nmap_Kd textures/{textures[k]}.png\n\n" if k in textures else
-                           f"Kd {COLOURS[k][0]:.3f} {COLOURS[k][1]:.3f} {COLOURS[k][2]:.3f}\n\n")
-        for k in used))
+    mtl.write_text("".join(f"newmtl {k}\nKd {COLOURS[k][0]:.3f} {COLOURS[k][1]:.3f} {COLOURS[k][2]:.3f}\n\n"
+                           for k in used))
 
 
 def write_3ds_model(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]], textures: dict[str, str]) -> None:
+    """A .3ds of the parts, each with texture coordinates (box projection) and its
+    material's texture map when ``textures`` names one."""
+    from make_textures import TILE, box_uv
+
     from tanktool.formats.threeds_write import write_3ds
 
     to_z_up = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.float64)  # (x, y, z) -> (x, -z, y)
-    # 3DS keeps 8.3 names by tradition; the map names the file in the bundle's textures/ folder
-    objects = [(name, verts @ to_z_up.T, faces, COLOURS[kind], uv,
-                f"textures/{textures[kind]}.png" if kind in textures else None)
-               for name, kind, verts, faces, uv in _uv_parts(parts)]
+    objects = []
+    for name, kind, mesh in parts:
+        if kind not in textures:
+            objects.append((name, mesh.vertices @ to_z_up.T, mesh.faces, COLOURS[kind]))
+            continue
+        verts, faces, uv = box_uv(mesh.vertices, mesh.faces, TILE[textures[kind]])
+        objects.append((name, verts @ to_z_up.T, faces, COLOURS[kind], uv, f"textures/{textures[kind]}.png"))
     write_3ds(path, objects)
 
 
@@ -255,6 +240,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", choices=sorted(ARENAS), action="append")
     ap.add_argument("--models-only", action="store_true", help="write the source models, do not import")
     args = ap.parse_args(argv)
+    from make_textures import ARENA_TEXTURES, texture_obj
+
     from tanktool.arena import import_arena
 
     for name in args.only or list(ARENAS):
@@ -264,9 +251,10 @@ def main(argv: list[str] | None = None) -> int:
         parts = make()
         src = folder / file_name
         if src.suffix == ".obj":
-            write_obj(src, parts, TEXTURES[name])
+            write_obj(src, parts)
+            texture_obj(src, ARENA_TEXTURES.get(name, {}))
         else:
-            write_3ds_model(src, parts, TEXTURES[name])
+            write_3ds_model(src, parts, ARENA_TEXTURES.get(name, {}))
         faces = sum(len(m.faces) for _, _, m in parts)
         print(f"{name}: wrote {src.relative_to(ROOT)} ({len(parts)} parts, {faces} faces)")
         if args.models_only:

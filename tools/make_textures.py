@@ -11,26 +11,31 @@ All are seamless (they tile): noise is made periodic by filtering white noise in
 frequency domain, and every pattern (brick courses, planks, plates, treads) has a
 whole number of repeats across the image.  Where each one goes:
 
-=============  ===============================================  ==================
+=============  ===============================================  ==========================
 texture        what                                             used by
-=============  ===============================================  ==================
-brick          red-brown brick courses, grey-brown mortar       box walls
-dirt           packed earth with gravel and tyre ruts           box floor
-planks         weathered wooden planks with nails               box crates
-stone          grey-beige ashlar blocks                         maze walls
-grass          short dry grass over earth                       maze floor
-concrete       cast concrete panels with form-tie holes         paper2002 walls, blocks
+=============  ===============================================  ==========================
+brick          red-brown brick courses, grey-brown mortar       box, hills walls
+dirt           packed earth with gravel and tyre ruts           box floor, fort ground
+planks         weathered wooden planks with nails               box crates, fort decks
+stone          grey-beige ashlar blocks                         maze, fort walls
+grass          short dry grass over earth                       maze floor, hills
+concrete       cast concrete panels with form-tie holes         paper2002 walls, fort ramps
 tarmac         worn asphalt with patched cracks                 paper2002 floor
+rock           craggy grey rock with cracks and lichen          hills and fort rock
 camo_green     woodland camouflage over riveted plates          light tank
 camo_sand      desert camouflage over riveted plates            heavy tank
 tracks         track links with grousers                        both tanks' tracks
 steel          dark gun steel, slightly scuffed                 wheels, barrels
-=============  ===============================================  ==================
+=============  ===============================================  ==========================
 
-tools/make_arena_models.py and tools/make_vehicle_models.py give the models texture
-coordinates (box projection, in metres) and name these files; import-arena and
-import-vehicle embed them in ``model.glb`` and copy them into the bundles'
-``textures/`` folders.
+``ARENA_TEXTURES`` says which material of which arena gets which texture.  The .obj
+sources get their texture coordinates from :func:`texture_obj` (``--models``: a box
+projection per face, ``TILE`` metres per repeat, positions untouched, so walls and
+grids stay the same), the .3ds one from tools/make_arena_models.py, the tanks from
+tools/make_vehicle_models.py; import-arena and import-vehicle embed the images in
+``model.glb`` and copy them into the bundles' ``textures/`` folders.  After a new
+bundled arena: add it to ``ARENA_TEXTURES``, then ``python tools/make_textures.py
+--models`` and ``make arenas``.
 """
 
 from __future__ import annotations
@@ -133,6 +138,16 @@ def stone(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
     return img
 
 
+def rock(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
+    crags = fbm(rng, size, (48, 16, 5, 2), (0.35, 0.3, 0.2, 0.15))
+    img = colourise(crags, (92, 86, 78), (160, 152, 140))
+    ridges = np.abs(periodic_noise(rng, size, 10) - 0.5) < 0.03
+    img[ridges] *= 0.6                                        # cracks between the slabs
+    lichen = periodic_noise(rng, size, 16) > 0.8
+    img[lichen] = img[lichen] * 0.75 + np.array([110, 120, 70]) * 0.25
+    return img
+
+
 def grass(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
     patches = fbm(rng, size, (70, 25, 8), (0.5, 0.3, 0.2))
     img = colourise(patches, (88, 96, 52), (138, 142, 74))
@@ -226,18 +241,31 @@ def steel(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
 #: name -> (painter, seed)
 TEXTURES: dict[str, tuple[Callable[..., np.ndarray], int]] = {
     "brick": (brick, 11), "dirt": (dirt, 12), "planks": (planks, 13), "stone": (stone, 14),
-    "grass": (grass, 15), "concrete": (concrete, 16), "tarmac": (tarmac, 17),
+    "grass": (grass, 15), "concrete": (concrete, 16), "tarmac": (tarmac, 17), "rock": (rock, 18),
     "camo_green": (camo_green, 21), "camo_sand": (camo_sand, 22), "tracks": (tracks, 23), "steel": (steel, 24),
 }
 
-#: which bundle uses which textures
-USES = {
-    "arenas/box": ("brick", "dirt", "planks"),
-    "arenas/maze": ("stone", "grass"),
-    "arenas/paper2002": ("concrete", "tarmac"),
-    "vehicles/light": ("camo_green", "tracks", "steel"),
-    "vehicles/heavy": ("camo_sand", "tracks", "steel"),
+#: metres per repeat of each texture on an arena (box projection)
+TILE = {"brick": 3.0, "dirt": 4.0, "planks": 2.0, "stone": 3.0, "grass": 4.0, "concrete": 3.0, "tarmac": 4.0,
+        "rock": 5.0, "camo_green": 3.0, "camo_sand": 3.0, "tracks": 2.4, "steel": 1.0}
+#: bundled arena -> material (kind of part) -> texture; tools/make_arena_models.py and
+#: :func:`texture_obj` give the models texture coordinates and name these
+ARENA_TEXTURES = {
+    "box": {"floor": "dirt", "wall": "brick", "crate": "planks"},
+    "maze": {"floor": "grass", "wall": "stone"},
+    "paper2002": {"floor": "tarmac", "wall": "concrete", "block": "concrete"},
+    "hills": {"grass": "grass", "rock": "rock", "wall": "brick"},
+    "fort": {"ground": "dirt", "wall": "stone", "deck": "planks", "ramp": "concrete", "rock": "rock"},
 }
+#: which vehicle uses which textures (tools/make_vehicle_models.py names them)
+VEHICLE_TEXTURES = {"light": ("camo_green", "tracks", "steel"), "heavy": ("camo_sand", "tracks", "steel")}
+
+
+def uses() -> dict[str, tuple[str, ...]]:
+    """Bundle folder (relative to the checkout) -> the textures it needs."""
+    out = {f"arenas/{a}": tuple(sorted(set(m.values()))) for a, m in ARENA_TEXTURES.items()}
+    out.update({f"vehicles/{v}": t for v, t in VEHICLE_TEXTURES.items()})
+    return out
 
 
 def box_uv(vertices: np.ndarray, faces: np.ndarray, tile: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -270,6 +298,80 @@ def box_uv(vertices: np.ndarray, faces: np.ndarray, tile: float) -> tuple[np.nda
     return np.vstack(out_v), out_f, np.vstack(out_uv)
 
 
+def _obj_index(token: str, count: int) -> int:
+    """A 1-based (or negative, relative) OBJ index as a 0-based one."""
+    i = int(token)
+    return i - 1 if i > 0 else count + i
+
+
+def texture_obj(path: Path, textures: dict[str, str], folder: str = "textures") -> int:
+    """Give an .obj texture coordinates and its .mtl the textures: every face of a
+    material in ``textures`` that has no ``vt`` of its own gets a box projection
+    (``TILE`` metres per repeat; each corner its own ``vt``, so no vertex moves or is
+    duplicated in the file), and the material ``map_Kd <folder>/<texture>.png`` with a
+    white ``Kd`` (MTL multiplies the two).  Positions and faces stay as they were: the
+    walls and grids made from the model do not change.  Returns the faces given
+    coordinates; running it again changes nothing."""
+    lines = path.read_text().splitlines()
+    verts: list[tuple[float, float, float]] = []
+    n_vt = sum(1 for ln in lines if ln.startswith("vt "))
+    material, out, done = None, [], 0
+    for line in lines:
+        words = line.split()
+        if words[:1] == ["v"]:
+            verts.append(tuple(float(w) for w in words[1:4]))
+        elif words[:1] == ["usemtl"]:
+            material = " ".join(words[1:])
+        elif words[:1] == ["f"] and material in textures and all("/" not in w or w.split("/")[1] == ""
+                                                                   for w in words[1:]):
+            corners = [w.split("/") for w in words[1:]]
+            idx = [_obj_index(c[0], len(verts)) for c in corners]
+            p = np.array([verts[i] for i in idx], dtype=np.float64)
+            normal = np.cross(p[1] - p[0], p[2] - p[0])
+            a = int(np.argmax(np.abs(normal)))
+            u_ax, v_ax = {0: (2, 1), 1: (0, 2), 2: (0, 1)}[a]
+            tile = TILE[textures[material]]
+            for q in p:
+                out.append(f"vt {q[u_ax] / tile:.6g} {q[v_ax] / tile:.6g}")
+            face = []
+            for k, c in enumerate(corners):
+                vt = n_vt + k + 1
+                face.append(f"{c[0]}/{vt}" + (f"/{c[2]}" if len(c) > 2 and c[2] else ""))
+            n_vt += len(corners)
+            out.append("f " + " ".join(face))
+            done += 1
+            continue
+        out.append(line)
+    path.write_text("\n".join(out) + "\n")
+    for mtl in _mtl_libraries(path):
+        _texture_mtl(mtl, textures, folder)
+    return done
+
+
+def _mtl_libraries(obj: Path) -> list[Path]:
+    from tanktool.formats.materials import mtl_libraries
+
+    return mtl_libraries(obj)
+
+
+def _texture_mtl(mtl: Path, textures: dict[str, str], folder: str) -> None:
+    """Name each material's texture in an .mtl (white Kd, map_Kd), keeping what it has."""
+    blocks: list[list[str]] = [[]]
+    for line in mtl.read_text().splitlines():
+        if line.startswith("newmtl"):
+            blocks.append([])
+        blocks[-1].append(line)
+    out = []
+    for block in blocks:
+        name = block[0].split(maxsplit=1)[1].strip() if block and block[0].startswith("newmtl") else None
+        if name in textures and not any(ln.lower().startswith("map_kd") for ln in block):
+            block = [ln for ln in block if not ln.startswith("Kd ")]
+            body = [ln for ln in block[1:] if ln.strip()]
+            block = [block[0], "Kd 1.000 1.000 1.000", f"map_Kd {folder}/{textures[name]}.png", *body, ""]
+        out += block
+    mtl.write_text("\n".join(out).rstrip("\n") + "\n\n")
+
+
 def paint(name: str, size: int = SIZE) -> np.ndarray:
     """(size, size, 3) uint8 pixels of texture ``name``."""
     painter, seed = TEXTURES[name]
@@ -294,15 +396,36 @@ def write_png(pixels: np.ndarray, path: Path) -> None:
     atomic_write_bytes(path, buf.getvalue())
 
 
+def texture_arena_sources(root: Path = ROOT) -> list[str]:
+    """Texture coordinates and textures for the .obj sources of the bundled arenas (the
+    .3ds one is written with them by tools/make_arena_models.py)."""
+    done = []
+    for name, textures in ARENA_TEXTURES.items():
+        manifest = root / "arenas" / name / "arena.toml"
+        if not manifest.is_file():
+            continue
+        from tanktool.formats.bundle import read_toml
+
+        src = manifest.parent / read_toml(manifest)["source"]["file"]
+        if src.suffix.lower() == ".obj":
+            done.append(f"{src.relative_to(root)}: {texture_obj(src, textures)} faces given texture coordinates")
+    return done
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=ROOT, help="the checkout (bundles under arenas/ and vehicles/)")
     ap.add_argument("--only", action="append", help="only this bundle, e.g. arenas/box (repeatable)")
+    ap.add_argument("--models", action="store_true",
+                    help="also give the bundled arenas' .obj sources texture coordinates and name the textures "
+                         "in their .mtl (then `make arenas` rebuilds the bundles)")
     args = ap.parse_args(argv)
     cache: dict[str, np.ndarray] = {}
-    for bundle, names in USES.items():
+    for bundle, names in uses().items():
         if args.only and bundle not in args.only:
             continue
+        if not (args.out / bundle).is_dir():
+            continue                                # a bundle this checkout does not have
         folder = args.out / bundle / "textures"
         folder.mkdir(parents=True, exist_ok=True)
         for name in names:
@@ -310,6 +433,9 @@ def main(argv: list[str] | None = None) -> int:
                 cache[name] = paint(name)
             write_png(cache[name], folder / f"{name}.png")
         print(f"{bundle}/textures: {', '.join(f'{n}.png' for n in names)}")
+    if args.models:
+        for line in texture_arena_sources(args.out):
+            print(line)
     return 0
 
 

@@ -247,7 +247,7 @@ def model_textures(model: str | os.PathLike, extra: Sequence[Path] = ()) -> Mode
         path = find_texture(name, model, extra)
         if path is None:
             where = ", ".join(str(d) for d in search_dirs(model, extra)) or str(model.parent)
-            use.problem = f"not found (looked beside the model and in {where})"
+            use.problem = f"not found (looked for it as named and by its file name in {where})"
         else:
             use.problem = _check_image(path)
             use.path = None if use.problem else path

@@ -1,8 +1,9 @@
 """Where the player's gun points and where its shell would land, for the crosshair.
 
 The shell is made by the simulation's own ``sim.weapons.fire`` (the same speed, start
-point, drift with the tank's velocity and first wall on its line as a real shot), then
-followed under gravity until it meets that wall or the ground; tanks on the way are
+point, pitch, drift with the tank's velocity, and first wall on its line or, on an arena
+with relief, the time its flight first meets the model, as a real shot), then followed
+under gravity until it meets that wall, the model or the ground; tanks on the way are
 tested against their footprint circle and height.  Nothing here changes the world.
 """
 
@@ -34,9 +35,10 @@ class Aim:
 def _shell(world: Any, tank: Any) -> Any:
     from ..sim import weapons
 
+    ground = getattr(world, "ground", None)
     try:
-        return weapons.fire(tank, world.walls)
-    except TypeError:                         # a newer fire() that wants more: the plain rule
+        return weapons.fire(tank, world.walls, ground) if ground is not None else weapons.fire(tank, world.walls)
+    except TypeError:                         # a fire() of another shape: the plain rule
         spec = tank.spec
         v = spec.shell_speed
         shell = weapons.Shell(tank.index, tank.x, float(getattr(tank, "y", 0.0)) + spec.muzzle_local[1], tank.z,
@@ -55,16 +57,21 @@ def predict(world: Any, tank: Any, floor_y: float = 0.0) -> Aim:
     s = _shell(world, tank)
     x0, y0, z0 = s.x, s.y, s.z
     base = float(getattr(tank, "y", floor_y))
-    # the barrel's line: to the first wall on it, else SIGHT ahead, at muzzle height
+    # the barrel's line (at the hull's pitch): to the first wall on it, else SIGHT ahead
+    pitch = float(getattr(tank, "pitch", 0.0))
     hit = world.walls.first_hit(x0, z0, x0 + tank.c * SIGHT, z0 + tank.s * SIGHT)
     d = hit[0] * SIGHT if hit is not None else SIGHT
-    aim = (x0 + tank.c * d, y0, z0 + tank.s * d)
+    aim = (x0 + tank.c * d, y0 + math.tan(pitch) * d, z0 + tank.s * d)
     vh = math.hypot(s.vx, s.vz)
-    # the ground is the tank's own floor: 2.5D arenas have several
-    drop = max(y0 - base, 0.0)
-    t_ground = (s.vy + math.sqrt(s.vy * s.vy + 2.0 * GRAVITY * drop)) / GRAVITY
-    t_wall = s.wall_dist / vh if vh > 0 and math.isfinite(s.wall_dist) else math.inf
-    t_end = min(t_ground, t_wall)
+    stop_at = float(getattr(s, "stop_at", math.nan))
+    if not math.isnan(stop_at):               # on a ground: where the flight meets the model
+        t_end = stop_at if math.isfinite(stop_at) else SIGHT / max(vh, 1.0)
+    else:
+        # the ground is the tank's own floor
+        drop = max(y0 - base, 0.0)
+        t_ground = (s.vy + math.sqrt(s.vy * s.vy + 2.0 * GRAVITY * drop)) / GRAVITY
+        t_wall = s.wall_dist / vh if vh > 0 and math.isfinite(s.wall_dist) else math.inf
+        t_end = min(t_ground, t_wall)
 
     def at(t: float) -> tuple[float, float, float]:
         return x0 + s.vx * t, y0 + s.vy * t - 0.5 * GRAVITY * t * t, z0 + s.vz * t

@@ -73,6 +73,10 @@ def stale_display() -> str | None:
     driver = pygame.display.get_driver() if pygame.display.get_init() else ""
     if driver not in INVISIBLE_DRIVERS or requested == driver:
         return None
+    return _stale_message(driver)
+
+
+def _stale_message(driver: str, detail: str = "") -> str:
     keys = [k for k in ("DISPLAY", "WAYLAND_DISPLAY") if os.environ.get(k)]
     named = [f"{k}={os.environ[k]}" for k in keys]
     why = " and ".join(named) or "a display"
@@ -81,22 +85,35 @@ def stale_display() -> str | None:
     sock = x_display_socket(os.environ.get("DISPLAY", ""))
     if sock is not None and not sock.exists():
         hint = f" ({sock} does not exist: no X server is running there)"
-    return (f"{why} is set but no display answers there{hint}; SDL could only open its invisible "
-            f"'{driver}' driver, so nothing would be shown.  Start the display server or fix {var}, "
-            f"or unset {var} to run a headless match (or use tanktool play --headless)")
+    shown = detail or f"SDL could only open its invisible '{driver}' driver, so nothing would be shown"
+    return (f"{why} is set but no display answers there{hint}; {shown}.  Start the display server or fix "
+            f"{var}, or unset {var} to run a headless match (or use tanktool play --headless)")
 
 
 def display_problem() -> str | None:
-    """Why no window can be opened here, or None when one can."""
+    """Why no window can be opened here, or None when one can.  Raises DisplayError
+    when a display is named but is not there (see :func:`stale_display`)."""
     driver = os.environ.get("SDL_VIDEODRIVER", "")
     if driver in ("dummy", "offscreen"):
         return f"SDL_VIDEODRIVER={driver}"
     if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         return "neither DISPLAY nor WAYLAND_DISPLAY is set"
+    # only X is named: SDL need not try Wayland (which prints its own complaints) nor
+    # fall back to an invisible driver
+    only_x = not driver and os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")
+    if only_x:
+        os.environ["SDL_VIDEODRIVER"] = "x11"
     try:
         pygame.display.init()
     except pygame.error as e:
+        if only_x:
+            del os.environ["SDL_VIDEODRIVER"]
+            raise DisplayError(_stale_message("x11", f"SDL cannot open it: {e}")) from None
         return f"SDL cannot open a display: {e}"
+    stale = stale_display()
+    if stale is not None:
+        pygame.display.quit()
+        raise DisplayError(stale)
     return None
 
 
@@ -718,10 +735,6 @@ def run_window(arena: str | None = None, vehicle: str | None = None, bots: int =
     if problem is not None:
         raise NoDisplay(problem)
     pygame.init()
-    stale = stale_display()
-    if stale is not None:
-        pygame.quit()
-        raise DisplayError(stale)
     app = App(None, arena, vehicle, bots, seed, view, size, fullscreen, difficulty=difficulty, bot=bot,
               record=record, replay=replay, replay_name=replay_name, seconds=seconds)
     app.player_name, app.password = name, password

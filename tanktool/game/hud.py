@@ -309,7 +309,7 @@ class Hud:
     def _hit_markers(self, surface: "pygame.Surface", session: Any, focus: Any, facing: float | None,
                      now: float) -> list["pygame.Rect"]:
         hits = hits_taken(session, focus.index, now)
-        if not hits:
+        if not hits or not focus.alive:
             return []
         w, h = self.size
         cx, cy = w // 2, h // 2

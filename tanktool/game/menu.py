@@ -115,8 +115,9 @@ def draw_menu(app: Any, surf: "pygame.Surface") -> None:
                           x, top, line, size)
     app.preview_hits = []
     if wide:
-        pw = int(w * 0.36)
-        ph = pw * 9 // 16
+        # two 16:9 pictures one above the other, as large as the window lets them be
+        ph = min(int(w * 0.36) * 9 // 16, (h - top - 80) // 2 - 24)
+        pw = ph * 16 // 9
         px = w - pw - int(w * 0.05)
         py = top
         for kind, choice in (("arenas", m.arena), ("vehicles", m.vehicle)):
@@ -132,8 +133,6 @@ def draw_menu(app: Any, surf: "pygame.Surface") -> None:
             text(surf, caption, (rect.x + 8, rect.bottom - 6), 24, anchor="bottomleft")
             app.preview_hits.append((kind, rect))
             py += ph + 24
-            if py + ph > h - 70:
-                break
     text(surf, "up/down choose, left/right or mouse change, Enter or click select, Esc quit", (w // 2, h - 56),
          max(min(22, w // 40), 14), HELP, anchor="midtop")
     if app.notice:

@@ -336,7 +336,12 @@ class SessionEffects:
             if n < 1e-9:
                 continue
             side *= width / n
-            colour = (1.0, 0.85, 0.45, 1.0)
+            # close to the camera a tracer fades: a shell passing the lens is no bar of light
+            near = float(np.linalg.norm(head - eye))
+            fade = min(max((near - 3.0) / 9.0, 0.0), 1.0)
+            if fade <= 0.0:
+                continue
+            colour = (1.0, 0.85, 0.45, fade)
             quad = [(tail - side, -1, 0), (tail + side, 1, 0), (head + side, 1, 1),
                     (tail - side, -1, 0), (head + side, 1, 1), (head - side, -1, 1)]
             rows += [(*pt, a, b, *colour) for pt, a, b in quad]

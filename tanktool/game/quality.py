@@ -8,14 +8,15 @@ preset  shadows                    particles   sky                 textures     
 ======  =========================  ==========  ==================  ===============  ============
 low     none                       few         gradient            bilinear + mips  per vertex
 medium  1024² map, 2×2 PCF         normal      gradient + clouds   bilinear + mips  per vertex
-high    2048² map, 4 × 2×2 PCF     many        gradient + clouds   trilinear        per pixel
+high    2048² map, 2×2 PCF         many        gradient + clouds   trilinear        per pixel
 ======  =========================  ==========  ==================  ===============  ============
 
 ``medium`` is the default (bench/render.py measures every preset).  Tanks are always
-Phong-shaded per pixel; the arena too at ``high``, per vertex (its big triangles split
-to at most ``ARENA_EDGE`` metres) below it, which halves what a pixel of floor or wall
-costs the software renderer and looks the same under a light this far away.  Distance
-fog is always on: it costs little and gives the depth cue.  The settings
+Phong-shaded (per pixel); the arena too at ``high``, lit per vertex below it, which
+halves what a pixel of floor or wall costs the software renderer and looks the same
+under a light this far away (the arena's big triangles are split to at most
+``render3d.ARENA_EDGE`` metres).  Distance fog is always on: it costs little and gives
+the depth cue.  The settings
 (``$XDG_CONFIG_HOME/tanktool/settings.toml``) hold the preset, any override of shadows
 or particles, the resolution and full screen, and the player's name for network play::
 

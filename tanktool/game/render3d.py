@@ -52,7 +52,8 @@ TINT = 0.8
 FOV_Y = math.radians(60.0)
 #: the widest a particle may be on screen, as a share of the window's height
 PARTICLE_MAX_SCREEN = 0.2
-#: the longest triangle edge of an arena lit per vertex [m] (a tenth of the arena if larger)
+#: the longest triangle edge of the arena as drawn [m] (a tenth of the arena if larger):
+#: attenuation and fog come from the vertices
 ARENA_EDGE = 16.0
 HUD_VERTEX, HUD_FRAGMENT = shaders.HUD_VERTEX, shaders.HUD_FRAGMENT
 
@@ -207,6 +208,7 @@ class Renderer3D:
             if t.spec.name not in self.tank_models:
                 self.tank_models[t.spec.name] = self._vehicle_model(t.spec)
         self.textures: dict[int, Any] = {}
+        self._split: Model | None = None
         self.quality = quality or PRESETS["medium"]
         self.view = np.identity(4)
         self.proj = np.identity(4)
@@ -255,6 +257,11 @@ class Renderer3D:
                       if q.mipmaps else moderngl.LINEAR, moderngl.LINEAR)
         return tex
 
+    def _split_arena(self) -> Model:
+        if self._split is None:
+            self._split = self.arena_model.tessellated(max(ARENA_EDGE, self.span / 10.0))
+        return self._split
+
     def _gpu(self, model: Model, prog: Any) -> list[GpuBatch]:
         out = []
         for b in model.batches:
@@ -280,20 +287,16 @@ class Renderer3D:
 
         self.quality = q
         ctx = self.ctx
-        taps = 4 if q.shadows == "high" else 1
-
         def scene(per_pixel: bool) -> Any:
-            d = dict(SHADOWS=q.shadow_size > 0, SHADOW_TAPS=taps, PER_PIXEL=per_pixel)
+            d = dict(SHADOWS=q.shadow_size > 0, PER_PIXEL=per_pixel)
             return ctx.program(vertex_shader=shaders.source(shaders.SCENE_VERTEX, **d),
                                fragment_shader=shaders.source(shaders.SCENE_FRAGMENT, **d))
 
         self.prog = scene(True)                                    # tanks: always Phong per pixel
         per_pixel = q.arena_light == "pixel"
         self.arena_prog = self.prog if per_pixel else scene(False)
-        if per_pixel:
-            self.arena_shape = self.arena_model
-        else:       # light per vertex: no triangle so big that the light changes across it
-            self.arena_shape = self.arena_model.tessellated(max(ARENA_EDGE, self.span / 10.0))
+        # no triangle so big that the light's attenuation or the fog change across it
+        self.arena_shape = self._split_arena()
         self.sky_prog = ctx.program(vertex_shader=shaders.source(shaders.SKY_VERTEX),
                                     fragment_shader=shaders.source(shaders.SKY_FRAGMENT, CLOUDS=q.sky == "clouds"))
         self.arena = self._gpu(self.arena_shape, self.arena_prog)
@@ -532,7 +535,6 @@ class Renderer3D:
             set_uniform(prog, "light_vp", _gl(self.shadow_lookup(self.light_vp)))
             set_uniform(prog, "shadow_static", 1)
             set_uniform(prog, "shadow_tanks", 2)
-            set_uniform(prog, "shadow_texel", 1.0 / self.quality.shadow_size)   # only the 4-tap filter reads it
             self.static_tex.use(1)
             self.shadow_tex.use(2)
 

@@ -7,8 +7,8 @@ that is not there costs nothing.
 * **scene**: the paper's point light (D3DLIGHT8: position, range, attenuation
   1/(a0 + a1·d + a2·d²)) with Phong shading per pixel (Blinn's half vector), ambient,
   the material's texture, a team tint that keeps the texture's detail, the shadow map
-  (hardware 2×2 PCF through ``sampler2DShadow``; four of them at ``SHADOW_TAPS 4``): one
-  map of the arena drawn once, one of the tanks drawn every frame; and distance fog
+  (hardware 2×2 PCF through ``sampler2DShadow``): one map of the arena drawn once, one
+  of the tanks drawn every frame; and distance fog
   towards the horizon's colour;
 * **depth**: the shadow pass, positions only;
 * **sky**: a grid over the window at the far plane, drawn after the scene so that only
@@ -31,24 +31,24 @@ uniform mat4 model;
 uniform mat4 light_vp;        // light view-projection with the [0, 1] bias and the depth offset
 uniform vec3 eye;
 uniform float fog_k;          // visibility = 1 / (1 + fog_k * distance^2)
-#if !PER_PIXEL
 uniform vec3 light_pos;
 uniform vec3 light_colour;
-uniform vec3 attenuation;
+uniform vec3 attenuation;     // a0, a1, a2 as D3DLIGHT8's Attenuation0..2
 uniform float light_range;
-#endif
 in vec3 in_pos;
 in vec3 in_normal;
 in vec3 in_colour;
 in vec2 in_uv;
 out vec3 v_colour;
 out vec2 v_uv;
+out float v_visible;          // the fog's visibility
 #if PER_PIXEL
-out vec3 v_pos;
 out vec3 v_normal;
+out vec3 v_to_light;          // affine in the position: interpolated exactly, normalised per pixel
+out vec3 v_to_eye;
+out float v_att;
 #else
 out vec3 v_direct;            // the point light's diffuse light at this vertex
-out float v_visible;          // the fog's visibility at this vertex
 #endif
 #if SHADOWS
 out vec4 v_light;
@@ -57,17 +57,19 @@ void main() {
     vec4 world = model * vec4(in_pos, 1.0);
     v_colour = in_colour;
     v_uv = in_uv;
-#if PER_PIXEL
-    v_pos = world.xyz;
-    v_normal = mat3(model) * in_normal;
-#else
-    vec3 n = normalize(mat3(model) * in_normal);
     vec3 to_light = light_pos - world.xyz;
     float d = length(to_light);
     float att = d > light_range ? 0.0 : 1.0 / (attenuation.x + attenuation.y * d + attenuation.z * d * d);
+    vec3 to_eye = eye - world.xyz;
+    v_visible = 1.0 / (1.0 + fog_k * dot(to_eye, to_eye));
+#if PER_PIXEL
+    v_normal = mat3(model) * in_normal;
+    v_to_light = to_light;
+    v_to_eye = to_eye;
+    v_att = att;
+#else
+    vec3 n = normalize(mat3(model) * in_normal);
     v_direct = light_colour * (max(dot(n, to_light / d), 0.0) * att);
-    vec3 view = eye - world.xyz;
-    v_visible = 1.0 / (1.0 + fog_k * dot(view, view));
 #endif
 #if SHADOWS
     v_light = light_vp * world;
@@ -76,13 +78,14 @@ void main() {
 }
 """
 
-# PER_PIXEL 1 is Phong shading: the normal interpolated and the point light, its
-# attenuation, Blinn's specular and the fog worked out for every pixel, with square
-# roots as inversesqrt, the specular power as five squarings and the fog a rational
-# function of the squared distance (llvmpipe's pow and exp cost more than the rest of
-# the shader together).  PER_PIXEL 0 lights each vertex (as Direct3D 8's fixed pipeline
-# lit the paper's arena) and leaves the pixel its texture and its shadow: the arena at
-# the low and medium presets, its big triangles split first (game/meshes.py).
+# PER_PIXEL 1 is Phong shading: the normal, the direction to the light and the one to
+# the eye interpolated and normalised for every pixel, the diffuse term and Blinn's
+# specular (its power as five squarings: llvmpipe's pow costs more than the rest of
+# the shader) worked out there; only the attenuation and the fog, which change slowly,
+# come from the vertices (the arena's big triangles are split for them, game/meshes.py).
+# PER_PIXEL 0 lights each vertex (as Direct3D 8's fixed pipeline lit the paper's arena)
+# and leaves the pixel its texture and its shadow: the arena at the low and medium
+# presets.
 SCENE_FRAGMENT = """
 uniform vec3 ambient;
 uniform vec3 tint;
@@ -94,39 +97,27 @@ uniform float alpha;
 uniform vec3 fog_colour;
 uniform sampler2D tex;
 #if PER_PIXEL
-uniform vec3 light_pos;
 uniform vec3 light_colour;
-uniform vec3 attenuation;     // a0, a1, a2 as D3DLIGHT8's Attenuation0..2
-uniform float light_range;
-uniform vec3 eye;
-uniform float fog_k;
-in vec3 v_pos;
 in vec3 v_normal;
+in vec3 v_to_light;
+in vec3 v_to_eye;
+in float v_att;
 #else
 in vec3 v_direct;
-in float v_visible;
 #endif
 #if SHADOWS
 uniform sampler2DShadow shadow_static;    // the arena, drawn once
 uniform sampler2DShadow shadow_tanks;     // the tanks, every frame
-uniform float shadow_texel;
 in vec4 v_light;
 #endif
 in vec3 v_colour;
 in vec2 v_uv;
+in float v_visible;
 out vec4 frag;
 
 float shadowed() {
 #if SHADOWS
-#if SHADOW_TAPS == 4
-    float o = 0.75 * shadow_texel * v_light.w;      // offsets before the divide by w
-    float s = 0.25 * (textureProj(shadow_static, v_light + vec4(o, o, 0.0, 0.0))
-                    + textureProj(shadow_static, v_light + vec4(-o, o, 0.0, 0.0))
-                    + textureProj(shadow_static, v_light + vec4(o, -o, 0.0, 0.0))
-                    + textureProj(shadow_static, v_light + vec4(-o, -o, 0.0, 0.0)));
-#else
     float s = textureProj(shadow_static, v_light);
-#endif
     if (s > 0.0) s *= textureProj(shadow_tanks, v_light);
     return s;
 #else
@@ -143,27 +134,17 @@ void main() {
     }
 #if PER_PIXEL
     vec3 n = normalize(v_normal);
-    vec3 to_light = light_pos - v_pos;
-    float dl2 = dot(to_light, to_light);
-    float inv_dl = inversesqrt(dl2);
-    vec3 l = to_light * inv_dl;
-    float d = dl2 * inv_dl;
-    float att = d > light_range ? 0.0 : 1.0 / (attenuation.x + attenuation.y * d + attenuation.z * dl2);
+    vec3 l = normalize(v_to_light);
     float diffuse = max(dot(n, l), 0.0);
-    vec3 view = eye - v_pos;
-    float v2 = dot(view, view);
-    vec3 h = normalize(l + view * inversesqrt(v2));
-    float spec = max(dot(n, h), 0.0);
+    float spec = max(dot(n, normalize(l + normalize(v_to_eye))), 0.0);
     spec *= spec; spec *= spec; spec *= spec; spec *= spec; spec *= spec;      // ^32
-    float lit = att;
+    float lit = v_att;
     if (diffuse > 0.0) lit *= shadowed();
     vec3 colour = base * (ambient + light_colour * (diffuse * lit)) + (0.25 * spec * lit) * light_colour + emissive;
-    float visible = 1.0 / (1.0 + fog_k * v2);
 #else
     vec3 colour = base * (ambient + v_direct * (v_direct.g > 0.0 ? shadowed() : 1.0)) + emissive;
-    float visible = v_visible;
 #endif
-    frag = vec4(mix(fog_colour, colour, visible), alpha);
+    frag = vec4(mix(fog_colour, colour, v_visible), alpha);
 }
 """
 

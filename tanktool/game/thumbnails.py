@@ -52,7 +52,7 @@ def render_model(model: Any, size: tuple[int, int], eye: Any, target: Any, light
     ctx = _context(ctx)
     w, h = size
     fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size)], depth_attachment=ctx.depth_renderbuffer(size))
-    d = dict(SHADOWS=0, SHADOW_TAPS=1, PER_PIXEL=1)
+    d = dict(SHADOWS=0, PER_PIXEL=1)
     prog = ctx.program(vertex_shader=shaders.source(shaders.SCENE_VERTEX, **d),
                        fragment_shader=shaders.source(shaders.SCENE_FRAGMENT, **d))
     made = [fbo, prog]
