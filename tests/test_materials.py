@@ -207,3 +207,28 @@ def test_bundled_content_is_textured(root_dir, bundle):
     assert all("CC0" in Image.open(folder / n).info.get("License", "") for n in names)
     m = load_model(str(folder / "model.glb"))
     assert sum(b.triangles for b in m.batches if b.image is not None) == m.triangles   # every face textured
+
+
+def test_glb_embedded_textures_kept(tmp_path):
+    # a .glb carries its images: they reach the bundle's model.glb, nothing to copy
+    import trimesh
+    from PIL import Image
+
+    from tanktool.game.meshes import load_model
+
+    scene = trimesh.Scene()
+    for obj, mat, v, f in box_parts():
+        uv = np.column_stack([v[:, 0] / 4, v[:, 2] / 4])
+        img = Image.fromarray(np.full((4, 4, 3), (20, 140, 60) if mat == "ground" else (160, 50, 40), np.uint8))
+        vis = trimesh.visual.TextureVisuals(uv=uv, material=trimesh.visual.material.PBRMaterial(
+            name=mat, baseColorTexture=img))
+        scene.add_geometry(trimesh.Trimesh(v, f, visual=vis, process=False), geom_name=obj)
+    model = tmp_path / "yard.glb"
+    model.write_bytes(scene.export(file_type="glb"))
+    out = tmp_path / "yard"
+    r = CliRunner().invoke(cli, ["import-arena", str(model), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "warning" not in r.output and not (out / "textures").exists()
+    m = load_model(str(out / "model.glb"))
+    colours = {tuple(int(c) for c in b.image[0, 0, :3]) for b in m.batches if b.image is not None}
+    assert colours == {(20, 140, 60), (160, 50, 40)}

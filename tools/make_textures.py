@@ -69,16 +69,24 @@ def _grid(size: int) -> tuple[np.ndarray, np.ndarray]:
     return x.astype(float), y.astype(float)
 
 
-# ---------------------------------------------------------------- textures
-def brick(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
-    rows, cols = 8, 4                    # a 3 m tile: 0.375 m courses, 0.75 m bricks
+def courses(size: int, rows: int, cols: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Running bond (each course shifted half a block): per pixel its course, its block
+    in the course and its distance to the nearest joint [px]."""
     x, y = _grid(size)
     rh, cw = size / rows, size / cols
     row = (y // rh).astype(int)
     shifted = (x + (row % 2) * cw / 2) % size
-    col = (shifted // cw).astype(int)
-    mortar = np.minimum(np.minimum(y % rh, rh - y % rh), np.minimum(shifted % cw, cw - shifted % cw)) < 2.2
-    tone = rng.uniform(0.75, 1.15, (rows, cols))[row, col % cols]
+    col = (shifted // cw).astype(int) % cols
+    joint = np.minimum(np.minimum(y % rh, rh - y % rh), np.minimum(shifted % cw, cw - shifted % cw))
+    return row, col, joint
+
+
+# ---------------------------------------------------------------- textures
+def brick(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
+    rows, cols = 8, 4                    # a 3 m tile: 0.375 m courses, 0.75 m bricks
+    row, col, joint = courses(size, rows, cols)
+    mortar = joint < 2.2
+    tone = rng.uniform(0.75, 1.15, (rows, cols))[row, col]
     grain = fbm(rng, size, (18, 6, 2), (0.5, 0.3, 0.2))
     img = colourise(grain, (120, 52, 36), (178, 86, 58)) * tone[..., None]
     soot = periodic_noise(rng, size, 50)
@@ -124,13 +132,8 @@ def planks(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
 
 def stone(rng: np.random.Generator, size: int = SIZE) -> np.ndarray:
     rows, cols = 4, 3                    # a 3 m tile: 0.75 m blocks, 1 m long
-    x, y = _grid(size)
-    rh, cw = size / rows, size / cols
-    row = (y // rh).astype(int)
-    shifted = (x + (row % 2) * cw / 2) % size
-    col = (shifted // cw).astype(int)
-    joint = np.minimum(np.minimum(y % rh, rh - y % rh), np.minimum(shifted % cw, cw - shifted % cw))
-    tone = rng.uniform(0.85, 1.1, (rows, cols))[row, col % cols]
+    row, col, joint = courses(size, rows, cols)
+    tone = rng.uniform(0.85, 1.1, (rows, cols))[row, col]
     img = colourise(fbm(rng, size, (30, 10, 3), (0.5, 0.3, 0.2)), (118, 112, 98), (178, 170, 150)) * tone[..., None]
     img *= np.clip(joint / 4.0, 0.45, 1.0)[..., None]          # bevelled joints read as depth
     moss = periodic_noise(rng, size, 20)

@@ -161,9 +161,6 @@ def load_settings(path: str | os.PathLike | None = None) -> Settings:
 
 def save_settings(settings: Settings, path: str | os.PathLike | None = None) -> Path:
     """Write the settings atomically (creating the config folder); returns the path."""
-    from ..formats.bundle import write_toml
+    from .input import save_config
 
-    path = Path(path) if path is not None else settings_path()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_toml(path, settings.to_dict())
-    return path
+    return save_config(Path(path) if path is not None else settings_path(), settings.to_dict())
