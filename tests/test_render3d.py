@@ -172,3 +172,23 @@ def test_headless_3d_screenshot_cli(tmp_path):
     assert r.exit_code == 0, r.output
     img = pygame.surfarray.array3d(pygame.image.load(str(out)))
     assert img.shape[:2] == (320, 180) and img.std() > 10
+
+
+def test_far_tanks_drop_their_small_parts():
+    from tanktool.game.render3d import Renderer3D
+
+    s = GameSession("box", bots=2, seed=0, player=True)
+    r = Renderer3D(s, SIZE)
+    try:
+        name = s.world.tanks[0].spec.name
+        near, far = r.tanks[name], r.tanks_far[name]
+        assert sum(b.triangles for b in far) < sum(b.triangles for b in near) / 3     # no wheels
+        r.render(hud=False)
+        eye = r._eye
+        me, other = s.world.tanks[0], s.world.tanks[1]
+        assert r._lod(me, r._tank_model_matrix(me, 1.0), eye) is near          # the chase camera's own tank
+        other.place(me.x + 55.0 * me.c, me.z + 55.0 * me.s, 0.0)
+        r._placed.clear()
+        assert r._lod(other, r._tank_model_matrix(other, 1.0), eye) is far     # 55 m away: a few dozen pixels
+    finally:
+        r.release()

@@ -61,9 +61,16 @@ class Batch:
         return float(max(0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2], 0.05))
 
 
+#: parts smaller than this share of the model's size (wheels, a muzzle brake) are left
+#: out of its far version
+FAR_PART = 0.15
+
+
 @dataclass
 class Model:
     batches: list[Batch] = field(default_factory=list)
+    #: the same model without its small parts, for when it is far away (None: no such parts)
+    far: "Model | None" = None
 
     @property
     def triangles(self) -> int:
@@ -150,22 +157,38 @@ def mesh_vertices(mesh: Any) -> tuple[np.ndarray, np.ndarray | None]:
     return out.astype("f4"), image
 
 
-def model_from_meshes(meshes: list[Any]) -> Model:
-    """Group meshes into batches by texture image (same pixels, one batch)."""
+def _batches(parts: list[tuple[np.ndarray, np.ndarray | None, bool]]) -> list[Batch]:
+    """Parts (vertices, image, closed) grouped into batches by texture image."""
     groups: dict[Any, tuple[list[np.ndarray], np.ndarray | None, list[bool]]] = {}
+    for arr, image, closed in parts:
+        key = None if image is None else (image.shape, hash(image.tobytes()))
+        arrays, _, shut = groups.setdefault(key, ([], image, []))
+        arrays.append(arr)
+        shut.append(closed)
+    batches = [Batch(np.concatenate(arrays), image, all(shut)) for arrays, image, shut in groups.values()]
+    # floors last: what stands on them is drawn first and hides floor pixels from the
+    # (per pixel costly) lighting; the depth test then rejects them cheaply
+    batches.sort(key=lambda b: b.floor_share())
+    return batches
+
+
+def model_from_meshes(meshes: list[Any]) -> Model:
+    """Group meshes into batches by texture image (same pixels, one batch), and the far
+    version without the parts smaller than FAR_PART of the whole."""
+    parts, sizes = [], []
     for m in meshes:
         if len(m.faces) == 0:
             continue
         arr, image = mesh_vertices(m)
-        key = None if image is None else (image.shape, hash(image.tobytes()))
-        parts, _, closed = groups.setdefault(key, ([], image, []))
-        parts.append(arr)
-        closed.append(_is_closed(m.vertices, m.faces))
-    batches = [Batch(np.concatenate(parts), image, all(closed)) for parts, image, closed in groups.values()]
-    # floors last: what stands on them is drawn first and hides floor pixels from the
-    # (per pixel costly) lighting; the depth test then rejects them cheaply
-    batches.sort(key=lambda b: b.floor_share())
-    return Model(batches)
+        parts.append((arr, image, _is_closed(m.vertices, m.faces)))
+        sizes.append(float(np.linalg.norm(np.ptp(np.asarray(m.vertices), axis=0))))
+    model = Model(_batches(parts))
+    if parts:
+        whole = float(np.linalg.norm(np.ptp(np.concatenate([p[0][:, :3] for p in parts]), axis=0)))
+        big = [p for p, size in zip(parts, sizes) if size >= FAR_PART * whole]
+        if big and len(big) < len(parts):
+            model.far = Model(_batches(big))
+    return model
 
 
 def tessellate(vertices: np.ndarray, max_edge: float) -> np.ndarray:

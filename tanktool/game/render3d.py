@@ -52,6 +52,8 @@ TINT = 0.8
 FOV_Y = math.radians(60.0)
 #: the widest a particle may be on screen, as a share of the window's height
 PARTICLE_MAX_SCREEN = 0.2
+#: a tank smaller than this on screen [px] is drawn without its small parts (wheels...)
+LOD_PIXELS = 70.0
 #: the longest triangle edge of the arena as drawn [m] (a tenth of the arena if larger):
 #: attenuation and fog come from the vertices
 ARENA_EDGE = 16.0
@@ -301,6 +303,9 @@ class Renderer3D:
                                     fragment_shader=shaders.source(shaders.SKY_FRAGMENT, CLOUDS=q.sky == "clouds"))
         self.arena = self._gpu(self.arena_shape, self.arena_prog)
         self.tanks = {name: self._gpu(m, self.prog) for name, m in self.tank_models.items()}
+        # far away (and in the shadow map) a tank is drawn without its small parts
+        self.tanks_far = {name: self._gpu(m.far, self.prog) if m.far is not None else self.tanks[name]
+                          for name, m in self.tank_models.items()}
         self.cloud_tex = None
         if q.sky == "clouds":
             pix = cloud_pixels()
@@ -397,7 +402,7 @@ class Renderer3D:
         for t in self.session.world.tanks:
             by_kind.setdefault(t.spec.name, []).append(self._tank_model_matrix(t, alpha))
         self._draw_shadows(self.shadow_fbo, self.tank_shadow_size,
-                           [(self.tanks[name], models) for name, models in by_kind.items()])
+                           [(self.tanks_far[name], models) for name, models in by_kind.items()])
 
     def _sky_grid(self, nx: int = 24, ny: int = 16) -> Any:
         """Rows of quads over the window, bottom row first (drawn from the horizon up)."""
@@ -505,7 +510,8 @@ class Renderer3D:
             if s.focus() == t.index and self.camera == "first-person":
                 continue            # we are inside it
             tint = np.array(tank_colour(t.index)) / 255.0 if t.alive else np.array((0.08, 0.07, 0.06))
-            self._draw(self.prog, self.tanks[t.spec.name], pv, self._tank_model_matrix(t, alpha), tint, TINT)
+            model = self._tank_model_matrix(t, alpha)
+            self._draw(self.prog, self._lod(t, model, eye), pv, model, tint, TINT)
         self._draw(self.arena_prog, self.arena, pv, np.identity(4), (0, 0, 0), 0.0)
         self._draw_sky(pv, eye)
         self._draw_effects(pv, eye, alpha)
@@ -558,6 +564,12 @@ class Renderer3D:
             set_uniform(prog, "tex_luma", b.luma)
             b.vao.render()
         self.ctx.disable(moderngl.CULL_FACE)
+
+    def _lod(self, t: Any, model: np.ndarray, eye: np.ndarray) -> list[GpuBatch]:
+        """A tank's batches: without its small parts when it is under LOD_PIXELS tall on screen."""
+        d = float(np.linalg.norm(model[:3, 3] - eye))
+        tall = t.spec.height / max(2.0 * d * math.tan(FOV_Y / 2), 1e-6) * self.size[1]
+        return self.tanks[t.spec.name] if tall >= LOD_PIXELS else self.tanks_far[t.spec.name]
 
     def _draw_sky(self, pv: np.ndarray, eye: np.ndarray) -> None:
         import moderngl
@@ -690,8 +702,11 @@ class Renderer3D:
         ctx.disable(moderngl.BLEND)
         self.flat_prog["colour"].value = (0.5, 0.5, 0.5)
         for t in s.world.tanks:
-            self.flat_prog["mvp"].write(_gl(pv @ self._tank_model_matrix(t, alpha)))
-            for b in self.tanks[t.spec.name]:
+            if s.focus() == t.index and self.camera == "first-person":
+                continue
+            model = self._tank_model_matrix(t, alpha)
+            self.flat_prog["mvp"].write(_gl(pv @ model))
+            for b in self._lod(t, model, eye):
                 b.flat_vao.render()
         self.flat_prog["mvp"].write(_gl(pv))
         for b in self.arena:
@@ -702,10 +717,12 @@ class Renderer3D:
         w, h = self.size
         return np.frombuffer(data, np.uint8).reshape(h, w, 3)[::-1].copy()
 
-    def triangles(self) -> int:
-        """Triangles of the arena and the tanks in one frame."""
-        return self.arena_shape.triangles + sum(self.tank_models[t.spec.name].triangles
-                                                for t in self.session.world.tanks)
+    def triangles(self, alpha: float = 1.0) -> int:
+        """Triangles of the arena and the tanks in the frame the camera sees now."""
+        _, _, eye = self.matrices(alpha)
+        return sum(b.triangles for b in self.arena) + sum(
+            sum(b.triangles for b in self._lod(t, self._tank_model_matrix(t, alpha), eye))
+            for t in self.session.world.tanks)
 
     def release(self) -> None:
         if self.own_ctx:
