@@ -335,9 +335,12 @@ class SessionEffects:
             n = np.linalg.norm(side)
             if n < 1e-9:
                 continue
-            side *= width / n
-            # close to the camera a tracer fades: a shell passing the lens is no bar of light
-            near = float(np.linalg.norm(head - eye))
+            # close to the camera a tracer thins and fades, judged by its nearest point (a
+            # ribbon is long): a shell passing the lens is no bar of light across the view
+            ab = head - tail
+            k = float(np.clip(np.dot(eye - tail, ab) / max(float(np.dot(ab, ab)), 1e-9), 0.0, 1.0))
+            near = float(np.linalg.norm(tail + k * ab - eye))
+            side *= min(width, 0.004 * near) / n            # at most a few pixels wide
             fade = min(max((near - 3.0) / 9.0, 0.0), 1.0)
             if fade <= 0.0:
                 continue

@@ -188,8 +188,12 @@ class Renderer3D:
         quad = np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype="f4")
         self._quad = ctx.buffer(quad.tobytes())
         self.hud_vao = ctx.vertex_array(self.hud_prog, [(self._quad, "2f", "in_pos")])
-        self.hud_tex = ctx.texture(self.size, 4)
-        self.hud_tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        # two HUD textures used in turn: writing the one the last frame blended would wait
+        # for that frame to be drawn
+        self.hud_texs = [ctx.texture(self.size, 4), ctx.texture(self.size, 4)]
+        for tex in self.hud_texs:
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.hud_tex = self.hud_texs[0]
         self._hud = None
         self._hud_rects: list[Any] = []
         self._placed: dict[tuple, np.ndarray] = {}       # tank matrices of this frame (shadow and scene)
@@ -664,6 +668,7 @@ class Renderer3D:
         rects = self._hud.draw(surf, self.session, fps, alpha, message, view=f"3D {self.camera}",
                                project=self.project, facing=self.camera_yaw())
         self._hud_rects = rects
+        self.hud_tex = self.hud_texs[1] if self.hud_tex is self.hud_texs[0] else self.hud_texs[0]
         for r in rects:
             if r.w > 0 and r.h > 0:
                 self.hud_tex.write(pygame.image.tobytes(surf.subsurface(r), "RGBA"), viewport=(r.x, r.y, r.w, r.h))
