@@ -159,28 +159,10 @@ _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
 
 
 def _companion_files(model: Path) -> list[Path]:
-    """Files a model needs beside it: an .obj's material libraries (regular files in
-    the model's own folder only)."""
-    from .errors import FormatError
-    from .formats.bundle import bundle_file, read_input
+    """Files a model needs beside it: an .obj's material libraries."""
+    from .formats.materials import mtl_libraries
 
-    if model.suffix.lower() != ".obj":
-        return []
-    out: list[Path] = []
-    try:
-        data = read_input(model, "an .obj model")
-    except FormatError:
-        return []
-    for raw in data.splitlines():
-        if raw.startswith(b"mtllib"):
-            for name in raw.split()[1:]:
-                try:
-                    p = bundle_file(model.parent, name.decode("utf-8", "replace"), "mtllib")
-                except FormatError:
-                    continue
-                if p.is_file() and not p.is_symlink() and p.parent == model.parent and p not in out:
-                    out.append(p)
-    return out
+    return mtl_libraries(model)
 
 
 def walkable_params(cell: float | None = None, max_slope: float | None = None, climb: float | None = None,
@@ -252,6 +234,7 @@ def import_arena(
 
     from .fleet import bundled_fleet
     from .formats.bundle import check_replaceable, sha256_file, staged_dir, write_toml
+    from .formats.materials import export_glb
     from .formats.models import default_up, detect_format, load_scene
     from .formats.walls_txt import write_walls
     from .nav.arena_levels import analyse_arena, spawn_y_needed
@@ -322,7 +305,7 @@ def import_arena(
         copied = [model, *companions]
         for f in copied:
             shutil.copyfile(f, tmp / f.name)
-        glb = scene.export(file_type="glb")
+        glb, textures = export_glb(model, scene, tmp, extra=[target], warn=remark)   # textures copied in
         (tmp / "model.glb").write_bytes(glb)
         header = (f"arena {name}: walls of {model.name}, the boundaries of its walkable surface "
                   f"(flat floors: cut {height:g} m above them)\n"
@@ -344,7 +327,7 @@ def import_arena(
             "source": {"file": model.name, "sha256": sha256_file(tmp / model.name), "up": src_up,
                        "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness),
                        **({"companions": [f.name for f in companions]} if companions else {})},
-            "model": {"file": "model.glb"},
+            "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
             "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
                       "count": len(walls)},
             "walkable": params.as_toml(),

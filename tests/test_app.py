@@ -72,8 +72,9 @@ def test_pause_restart_menu_quit(app):
 
 
 def test_seconds_ends_a_window_match(make_app, tmp_path):
-    # --seconds in the window: the match ends after that much simulated time, and the
-    # menu comes back saying why (the recording, if any, is written then)
+    # --seconds in the window: the match ends after that much simulated time, the end
+    # screen says why over the final scoreboard (the recording, if any, is written
+    # then), and Enter goes back to the menu
     rec = tmp_path / "m.ttr"
     app = make_app((480, 320), bots=1, seconds=0.5, record=rec)
     goto(app, "start")
@@ -81,8 +82,15 @@ def test_seconds_ends_a_window_match(make_app, tmp_path):
     taken = sum(app.advance(0.25) for _ in range(4))
     assert taken == 60                      # 0.5 s at 120 steps/s, then no more
     assert app.session.world.steps == 60
-    assert app.state == "menu" and "time up" in app.notice and "0.5 s" in app.notice
+    assert app.state == "over" and "time up" in app.over_reason and "0.5 s" in app.over_reason
     assert rec.is_file() and any("60 steps" in line for line in app.saved)
+    app.frame(0.016)                        # the end screen draws: reason and scoreboard
+    from tanktool.game.scoreboard import final_rows
+
+    rows = final_rows(app.session)
+    assert {r["name"] for r in rows} == {"you", "bot1"} and all(r["shots"] >= r["hits"] >= 0 for r in rows)
+    press(app, pygame.K_RETURN)
+    assert app.state == "menu" and "time up" in app.notice
     app.frame(0.016)                        # the menu draws with the notice
     goto(app, "start")                      # a new match gets the same length
     press(app, pygame.K_RETURN)

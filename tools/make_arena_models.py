@@ -21,6 +21,10 @@ source model:
   thick boxes placed outside each outline edge; stored as .3ds (Z up), so it is
   imported with ``--up z``.
 
+Each material gets a texture of tools/make_textures.py (its ``ARENA_TEXTURES``): the
+.obj sources are given texture coordinates by ``make_textures.texture_obj`` after they
+are written, the .3ds one is written with them (box projection, in metres).
+
 Then each is run through ``import-arena`` (tanktool.arena.import_arena) into
 ``arenas/<name>/``.  ``make arenas`` (tools/build_arenas.py) rebuilds the derived
 files of the bundles from these sources later without re-authoring them.
@@ -38,6 +42,7 @@ import trimesh
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "tools"))
 
 WALL_H = 3.0  # m, well above the 1 m cut
 SLAB = 0.5  # floor slab thickness (m)
@@ -214,11 +219,21 @@ def write_obj(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]]) -> None
                            for k in used))
 
 
-def write_3ds_model(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]]) -> None:
+def write_3ds_model(path: Path, parts: list[tuple[str, str, trimesh.Trimesh]], textures: dict[str, str]) -> None:
+    """A .3ds of the parts, each with texture coordinates (box projection) and its
+    material's texture map when ``textures`` names one."""
+    from make_textures import TILE, box_uv
+
     from tanktool.formats.threeds_write import write_3ds
 
     to_z_up = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.float64)  # (x, y, z) -> (x, -z, y)
-    objects = [(name, mesh.vertices @ to_z_up.T, mesh.faces, COLOURS[kind]) for name, kind, mesh in parts]
+    objects = []
+    for name, kind, mesh in parts:
+        if kind not in textures:
+            objects.append((name, mesh.vertices @ to_z_up.T, mesh.faces, COLOURS[kind]))
+            continue
+        verts, faces, uv = box_uv(mesh.vertices, mesh.faces, TILE[textures[kind]])
+        objects.append((name, verts @ to_z_up.T, faces, COLOURS[kind], uv, f"textures/{textures[kind]}.png"))
     write_3ds(path, objects)
 
 
@@ -250,6 +265,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--only", choices=sorted(ARENAS), action="append")
     ap.add_argument("--models-only", action="store_true", help="write the source models, do not import")
     args = ap.parse_args(argv)
+    from make_textures import ARENA_TEXTURES, texture_obj
+
     from tanktool.arena import import_arena
 
     for name in args.only or list(ARENAS):
@@ -260,8 +277,9 @@ def main(argv: list[str] | None = None) -> int:
         src = folder / file_name
         if src.suffix == ".obj":
             write_obj(src, parts)
+            texture_obj(src, ARENA_TEXTURES.get(name, {}))
         else:
-            write_3ds_model(src, parts)
+            write_3ds_model(src, parts, ARENA_TEXTURES.get(name, {}))
         faces = sum(len(m.faces) for _, _, m in parts)
         print(f"{name}: wrote {src.relative_to(ROOT)} ({len(parts)} parts, {faces} faces)")
         if args.models_only:

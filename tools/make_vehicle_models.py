@@ -3,7 +3,10 @@
 Each tank is built from closed parts — hull (with a sloped glacis), two tracks with
 road wheels, turret, barrel with a muzzle brake — each with its own material colour,
 facing +x, in metres, Y up; written as .3ds (Z up) by the project's 3DS writer, then
-run through import-vehicle.  Run it once to (re)create the bundles from scratch; `make
+run through import-vehicle.  Every part has texture coordinates (a planar projection,
+``TILE`` metres per repeat, on its own vertices) and its material names a texture of tools/make_textures.py
+(``TEXTURES``: camouflage for the body, links for the tracks, steel for the running
+gear and gun), found in ``vehicles/<name>/textures/`` when the bundle is built.  Run it once to (re)create the bundles from scratch; `make
 vehicles` (tools/build_vehicles.py) rebuilds the derived files from the stored .3ds.
 
     python tools/make_vehicle_models.py [--only light] [--out vehicles]
@@ -22,6 +25,16 @@ import trimesh
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+
+#: part kind -> texture, per tank (tools/make_textures.py paints them)
+TEXTURES = {
+    "light": {"hull": "camo_green", "turret": "camo_green", "mantlet": "camo_green", "track": "tracks",
+              "wheel": "steel", "barrel": "steel", "muzzle": "steel"},
+    "heavy": {"hull": "camo_sand", "turret": "camo_sand", "mantlet": "camo_sand", "track": "tracks",
+              "wheel": "steel", "barrel": "steel", "muzzle": "steel"},
+}
+#: metres per repeat of each texture
+TILE = {"camo_green": 3.0, "camo_sand": 3.0, "tracks": 2.4, "steel": 1.0}
 
 
 @dataclass
@@ -144,10 +157,25 @@ def tank_scene(s: TankSpec) -> trimesh.Scene:
     return scene
 
 
+def tank_uv(yup: np.ndarray, tile: float) -> np.ndarray:
+    """Per-vertex texture coordinates of a part without splitting its vertices: one
+    sheared planar projection, u = x + z/2, v = y + z/2 (Y up), ``tile`` metres per
+    repeat.  Sides, roofs and fronts all get a non-degenerate mapping, and the part keeps
+    exactly the vertices the hull points and sphere tree are computed from."""
+    return np.column_stack([yup[:, 0] + 0.5 * yup[:, 2], yup[:, 1] + 0.5 * yup[:, 2]]) / tile
+
+
 def write_tank_3ds(spec: TankSpec, path: Path) -> None:
+    """The tank as a .3ds (Z up): one object per part, with texture coordinates and
+    its texture's file name (in the bundle's textures/ folder)."""
     from tanktool.formats.threeds_write import scene_to_3ds_objects, write_3ds
 
-    write_3ds(path, scene_to_3ds_objects(tank_scene(spec)))
+    objects = []
+    for part, verts, faces, rgb in scene_to_3ds_objects(tank_scene(spec)):   # Z-up, one colour per part
+        texture = TEXTURES[spec.name][part.split("_")[0]]
+        yup = np.column_stack([verts[:, 0], verts[:, 2], -verts[:, 1]])      # Z-up (x, y, z) is (x, z, -y)
+        objects.append((part, verts, faces, rgb, tank_uv(yup, TILE[texture]), f"textures/{texture}.png"))
+    write_3ds(path, objects)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -156,9 +184,16 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", action="append", help="build only this tank (repeatable)")
     ap.add_argument("--out", type=Path, default=ROOT / "vehicles")
+    ap.add_argument("--models-only", action="store_true",
+                    help="only (re)write each bundle's source .3ds; `make vehicles` then rebuilds the rest "
+                         "keeping the bundle's hand-tuned [drive] table")
     args = ap.parse_args(argv)
     for spec in SPECS:
         if args.only and spec.name not in args.only:
+            continue
+        if args.models_only:
+            write_tank_3ds(spec, args.out / spec.name / f"{spec.name}.3ds")
+            print(f"{spec.name}: wrote {args.out / spec.name / f'{spec.name}.3ds'}")
             continue
         with tempfile.TemporaryDirectory() as tmp:
             src = Path(tmp) / f"{spec.name}.3ds"

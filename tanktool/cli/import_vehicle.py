@@ -177,6 +177,7 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
 
     from ..formats.bundle import (atomic_write_bytes, atomic_write_text, check_replaceable, dumps_toml,
                                   sha256_file, staged_dir)
+    from ..formats.materials import export_glb
     from ..formats.models import default_up, detect_format, load_scene
     from ..formats.vehicle_bundle import write_hull
     from ..geometry.mass import drive_defaults, sig, to_scale
@@ -221,7 +222,8 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
     with staged_dir(out, force=force, manifest="vehicle.toml") as tmp:
         source_name = model.name
         shutil.copyfile(model, tmp / source_name)
-        atomic_write_bytes(tmp / "model.glb", scene.export(file_type="glb"))
+        glb, textures = export_glb(model, scene, tmp, extra=[out], warn=warnings.append)   # textures copied in
+        atomic_write_bytes(tmp / "model.glb", glb)
         write_hull(tmp / "hull.txt", hull, header)
         write_spheres(tmp / "spheres.txt", tree, header)
         plot_vehicle(tmp / "preview.png", mesh, hull, tree,
@@ -236,7 +238,7 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
             "source": {"file": source_name, "sha256": sha256_file(tmp / source_name), "up": up_used,
                        "forward": forward, "scale": float(scale),
                        "vehicle_frame_offset": [to_scale(x, size) for x in offset]},
-            "model": {"file": "model.glb"},
+            "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
             "mass": {"mass": sig(mp.mass), "inertia": sig(mp.inertia),
                      "centre_of_mass": [to_scale(x, size) for x in mp.centre_of_mass],
                      "method": mp.method, "volume": sig(mp.volume),

@@ -361,6 +361,29 @@ def _obj_materials(model: Path) -> set[str]:
     return out
 
 
+def _texture_folders(folder: Path, doc: dict[str, Any]) -> set[str]:
+    """The sub-folders (``textures/``) holding the textures ``[model] textures`` lists,
+    when they hold nothing else: a file a user put there keeps the folder his."""
+    model = doc.get("model")
+    listed = model.get("textures") if isinstance(model, dict) else None
+    if not isinstance(listed, list):
+        return set()
+    listed_set = {t for t in listed if isinstance(t, str)}
+    tops = {t.split("/")[0] for t in listed_set if "/" in t}
+    out = set()
+    for top in tops:
+        sub = folder / top
+        if sub.is_symlink() or not sub.is_dir():
+            continue
+        try:
+            inside = {f"{top}/{n}" for n in os.listdir(sub)}
+        except OSError:
+            continue
+        if inside <= listed_set:
+            out.add(top)
+    return out
+
+
 def bundle_files(folder: Path, doc: dict[str, Any], manifest: str) -> set[str]:
     """Names of the files a bundle written by tanktool holds (its own, not a user's)."""
     names = {manifest, *_STANDARD.get(manifest, ())}
@@ -370,6 +393,7 @@ def bundle_files(folder: Path, doc: dict[str, Any], manifest: str) -> set[str]:
     derived = doc.get("derived")
     if isinstance(derived, dict):
         names.update(str(k) for k in derived)
+    names |= _texture_folders(folder, doc)
     src = doc.get("source")
     if isinstance(src, dict):
         comp = src.get("companions")

@@ -24,8 +24,12 @@ past the buffer crashes whatever uses the mesh, an external URI reads any file.
   scene root that is also a child; transforms of finite numbers; the triangles of
   every instance together at most ``MAX_FACES``.
 
+* images: only PNG or JPEG held in a bufferView, at most ``MAX_IMAGE_PIXELS`` by
+  their header (read without decoding); any other image, the textures naming it and
+  the materials' references to those are dropped (the colour stays).
+
 It returns a :class:`Gltf` whose document is *sanitised*: one binary buffer, no
-URIs, no images, textures, cameras, skins or animations, only the keys meshes need,
+URIs, cameras, skins or animations, only the keys meshes and their colour textures need,
 so :func:`sanitized_glb` hands trimesh a file that cannot read anything else.
 Errors are FormatErrors naming the file and the place: a byte offset for the
 container, a JSON path (``accessors[3].byteStride``) for the document.
@@ -57,6 +61,9 @@ INDEX_TYPES = (5121, 5123, 5125)
 #: attributes each span the whole view; 8 leaves room for real files)
 ACCESSOR_BUDGET = 8
 #: extensions that change how geometry is stored: without them the numbers are wrong
+#: the largest embedded texture (pixels, by its header): 4096 x 4096
+MAX_IMAGE_PIXELS = 4096 * 4096
+_IMAGE_TYPES = {"image/png": b"\x89PNG\r\n\x1a\n", "image/jpeg": b"\xff\xd8"}
 _GEOMETRY_EXTENSIONS = ("KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_mesh_quantization")
 TRIANGLES, STRIP, FAN = 4, 5, 6
 
@@ -337,12 +344,12 @@ def _meshes(d: _Doc, doc: dict, g: Gltf, materials: int) -> tuple[list[dict], li
                 raise d.fail(f"{pw}.attributes.POSITION", "must be a float VEC3 accessor")
             n = pa["count"]
             new_attrs = {"POSITION": pos}
-            for name in ("NORMAL", "COLOR_0"):
+            for name in ("NORMAL", "COLOR_0", "TEXCOORD_0"):
                 if name in attrs:
                     k = d.index(attrs, name, f"{pw}.attributes", len(accessors), "accessor")
                     if accessors[k]["count"] != n:
                         raise d.fail(f"{pw}.attributes.{name}", f"has {accessors[k]['count']} elements, POSITION {n}")
-                    want = ("VEC3",) if name == "NORMAL" else ("VEC3", "VEC4")
+                    want = {"NORMAL": ("VEC3",), "COLOR_0": ("VEC3", "VEC4"), "TEXCOORD_0": ("VEC2",)}[name]
                     if accessors[k]["type"] not in want:
                         raise d.fail(f"{pw}.attributes.{name}", f"must be {' or '.join(want)}")
                     new_attrs[name] = k
@@ -375,8 +382,73 @@ def _meshes(d: _Doc, doc: dict, g: Gltf, materials: int) -> tuple[list[dict], li
     return out, faces
 
 
-def _materials(d: _Doc, doc: dict) -> list[dict]:
-    """Materials with their colours only (textures are never loaded)."""
+def _image_size(data: bytes) -> tuple[int, int] | None:
+    """(width, height) from an image's header, without decoding it; None if unreadable."""
+    import io
+
+    try:
+        from PIL import Image
+
+        with Image.open(io.BytesIO(data)) as im:
+            return im.size
+    except Exception:  # PIL raises many kinds for a damaged header
+        return None
+
+
+def _textures(doc: dict, g: Gltf) -> tuple[list[dict], list[dict], list[dict], dict[int, int]]:
+    """Sanitised images, samplers and textures, and old texture index -> new.
+
+    An image is kept only when it is a PNG or JPEG in a bufferView, no larger than
+    MAX_IMAGE_PIXELS by its header; the rest (URIs, other kinds, damaged or huge ones)
+    are dropped with the textures that name them: a model keeps its colours."""
+    views = g.doc["bufferViews"]
+    images: list[dict] = []
+    image_map: dict[int, int] = {}
+    raw_images = doc.get("images", [])
+    for i, im in enumerate(raw_images if isinstance(raw_images, list) else []):
+        if not isinstance(im, dict):
+            continue
+        vi, mime = im.get("bufferView"), im.get("mimeType")
+        if isinstance(vi, bool) or not isinstance(vi, int) or not 0 <= vi < len(views) or mime not in _IMAGE_TYPES:
+            continue
+        v = views[vi]
+        data = g.binary[v["byteOffset"]: v["byteOffset"] + v["byteLength"]]
+        if not data.startswith(_IMAGE_TYPES[mime]):
+            continue
+        size = _image_size(data)
+        if size is None or size[0] < 1 or size[1] < 1 or size[0] * size[1] > MAX_IMAGE_PIXELS:
+            continue
+        image_map[i] = len(images)
+        images.append({"bufferView": vi, "mimeType": mime})
+    samplers: list[dict] = []
+    sampler_map: dict[int, int] = {}
+    raw_samplers = doc.get("samplers", [])
+    for i, sm in enumerate(raw_samplers if isinstance(raw_samplers, list) else []):
+        if isinstance(sm, dict):
+            sampler_map[i] = len(samplers)
+            samplers.append({k: sm[k] for k in ("magFilter", "minFilter", "wrapS", "wrapT")
+                             if isinstance(sm.get(k), int) and not isinstance(sm.get(k), bool)
+                             and sm[k] in (9728, 9729, 9984, 9985, 9986, 9987, 33071, 33648, 10497)})
+    textures: list[dict] = []
+    texture_map: dict[int, int] = {}
+    raw_textures = doc.get("textures", [])
+    for i, t in enumerate(raw_textures if isinstance(raw_textures, list) else []):
+        src = t.get("source") if isinstance(t, dict) else None
+        if isinstance(src, bool) or not isinstance(src, int) or src not in image_map:
+            continue
+        tex: dict[str, Any] = {"source": image_map[src]}
+        smp = t.get("sampler")
+        if isinstance(smp, int) and not isinstance(smp, bool) and smp in sampler_map:
+            tex["sampler"] = sampler_map[smp]
+        texture_map[i] = len(textures)
+        textures.append(tex)
+    return images, samplers, textures, texture_map
+
+
+def _materials(d: _Doc, doc: dict, texture_map: dict[int, int] | None = None) -> list[dict]:
+    """Materials with their colours and colour textures (``texture_map``: the textures
+    kept, old index -> new; a reference to any other is dropped)."""
+    texture_map = texture_map or {}
     out = []
     for i, m in enumerate(d.array(doc, "materials")):
         where = f"materials[{i}]"
@@ -388,6 +460,12 @@ def _materials(d: _Doc, doc: dict) -> list[dict]:
         p2: dict[str, Any] = {}
         if colour is not None:
             p2["baseColorFactor"] = [min(max(c, 0.0), 1.0) for c in colour]
+        tex = pbr.get("baseColorTexture")
+        if isinstance(tex, dict):
+            k = tex.get("index")
+            uv = tex.get("texCoord", 0)
+            if isinstance(k, int) and not isinstance(k, bool) and k in texture_map and uv == 0:
+                p2["baseColorTexture"] = {"index": texture_map[k]}
         for key in ("metallicFactor", "roughnessFactor"):
             v = pbr.get(key)
             if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v):
@@ -479,7 +557,8 @@ def read_gltf(data: bytes, label: str, folder: Path | None = None) -> Gltf:
     g.doc["bufferViews"] = views
     g.doc["accessors"] = _accessors(d, doc, views, lengths, ACCESSOR_BUDGET * total + (1 << 20))
     g.binary = b"".join(b + b"\0" * (-len(b) % 4) for b in buffers)
-    materials = _materials(d, doc)
+    images, samplers, textures, texture_map = _textures(doc, g)
+    materials = _materials(d, doc, texture_map)
     meshes, faces = _meshes(d, doc, g, len(materials))
     nodes, parent = _nodes(d, doc, len(meshes))
     scenes_in = d.array(doc, "scenes")
@@ -521,6 +600,9 @@ def read_gltf(data: bytes, label: str, folder: Path | None = None) -> Gltf:
                   "buffers": [{"byteLength": len(g.binary)}] if g.binary else []})
     if not materials:
         del g.doc["materials"]
+    for key, items in (("images", images), ("samplers", samplers), ("textures", textures)):
+        if items and materials:
+            g.doc[key] = items
     g.faces, g.instances = count, inst
     return g
 

@@ -258,9 +258,13 @@ class _FolderResolver:
         from .bundle import bundle_file, read_input
 
         if str(name).lower().endswith(self.IMAGES):
-            raise FormatError(f"{self.label}: texture {name!r} not loaded")
+            # not decoded here (formats/materials.py reads textures, bounded); an empty
+            # answer keeps the rest of the material library (an error would drop it all)
+            return b""
         f = bundle_file(self.folder, str(name), f"{self.label}: {name!r}")
         return read_input(f, "a file the model names", label=f"{self.label}: {name!r}", limit=MAX_MODEL_BYTES)
+
+    __getitem__ = get   # the .obj loader asks for its material library as resolver[name]
 
     def namespaced(self, namespace: str) -> "_FolderResolver":
         return _FolderResolver(self.folder / namespace, self.label)

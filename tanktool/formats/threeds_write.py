@@ -1,7 +1,8 @@
 """3D Studio (.3ds) writer: the bundled models and tests are written with it.
 
-Objects are (name, vertices Z-up, faces, diffuse rgb); a mesh larger than the format's
-u16 counts is split into parts.  Colours are written both as 24-bit (for old readers)
+Objects are (name, vertices Z-up, faces, diffuse rgb), optionally followed by per-vertex
+texture coordinates (n, 2) and the file name of a diffuse texture map; a mesh larger
+than the format's u16 counts is split into parts.  Colours are written both as 24-bit (for old readers)
 and as linear floats (for an exact round trip through :mod:`.threeds`).
 """
 
@@ -17,8 +18,11 @@ from .bundle import atomic_write_bytes
 from .threeds import (
     COLOR_24, DEFAULT_COLOR, FACE_ARRAY, FACE_DTYPE, HEADER, LIN_COLOR_F, M3D_VERSION, MAIN, MASTER_SCALE,
     MAT_AMBIENT, MAT_DIFFUSE, MAT_ENTRY, MAT_NAME, MAX_COUNT, MDATA, MESH_MATRIX, MESH_VERSION, MSH_MAT_GROUP,
-    N_TRI_OBJECT, NAMED_OBJECT, POINT_ARRAY,
+    N_TRI_OBJECT, NAMED_OBJECT, POINT_ARRAY, INT_PERCENTAGE, MAT_MAPNAME, TEX_VERTS,
 )
+
+#: the diffuse texture map chunk of a material (threeds.MAP_CHUNKS names it "diffuse")
+MAT_TEXMAP = 0xA200
 
 if TYPE_CHECKING:
     import trimesh
@@ -87,13 +91,14 @@ def encode_3ds(
     """The bytes of a .3ds file holding ``objects``; see :func:`write_3ds`."""
     if not (np.isfinite(master_scale) and master_scale > 0):
         raise ValueError(f"master_scale must be a positive number, got {master_scale!r}")
-    colors: dict[tuple[float, float, float], int] = {}
+    colors: dict[tuple[tuple[float, float, float], str | None], int] = {}
     object_chunks = []
     for k, item in enumerate(objects):
         try:
-            name, vertices, faces, rgb = item
+            name, vertices, faces, rgb = item[:4]
+            uv, texture = (list(item[4:]) + [None, None])[:2]
         except (TypeError, ValueError):
-            raise ValueError(f"object {k}: expected (name, vertices, faces, rgb)") from None
+            raise ValueError(f"object {k}: expected (name, vertices, faces, rgb[, uv[, texture]])") from None
         vertices = np.asarray(vertices, dtype=np.float64)
         faces = np.asarray(faces)
         if vertices.ndim != 2 or vertices.shape[1] != 3:
@@ -111,19 +116,33 @@ def encode_3ds(
             raise ValueError(f"object {name!r}: colour must be 3 floats in 0..1, got {rgb!r}")
         if np.abs(vertices).max(initial=0.0) > np.finfo(np.float32).max:
             raise ValueError(f"object {name!r}: vertices exceed the float32 range of the format")
-        mat = colors.setdefault(rgb_t, len(colors))
-        parts = _split_mesh(vertices, faces)
-        for p, (v, f) in enumerate(parts):
+        if uv is not None:
+            uv = np.asarray(uv, dtype=np.float64)
+            if uv.shape != (len(vertices), 2) or not np.isfinite(uv).all():
+                raise ValueError(f"object {name!r}: uv must be finite (n, 2) with n = {len(vertices)} vertices")
+        if texture is not None and (not isinstance(texture, str) or not texture):
+            raise ValueError(f"object {name!r}: texture must be a file name, got {texture!r}")
+        mat = colors.setdefault((rgb_t, texture), len(colors))
+        if uv is None:
+            parts = [(v, f, None) for v, f in _split_mesh(vertices, faces)]
+        else:   # split with the UVs riding along as two more coordinates
+            parts = [(v[:, :3], f, v[:, 3:]) for v, f in _split_mesh(np.hstack([vertices, uv]), faces)]
+        for p, (v, f, t) in enumerate(parts):
             part_name = name if len(parts) == 1 else f"{name}_{p}"
-            object_chunks.append(_object_chunk(part_name, v, f, f"Material{mat}"))
+            object_chunks.append(_object_chunk(part_name, v, f, f"Material{mat}", t))
     material_chunks = [
         _chunk(
             MAT_ENTRY,
             _chunk(MAT_NAME, _name_bytes(f"Material{i}", "material")),
             _color_chunk(MAT_AMBIENT, rgb),
             _color_chunk(MAT_DIFFUSE, rgb),
+            *([] if texture is None else [_chunk(
+                MAT_TEXMAP,
+                _chunk(INT_PERCENTAGE, struct.pack("<h", 100)),
+                _chunk(MAT_MAPNAME, _name_bytes(texture, "texture")),
+            )]),
         )
-        for rgb, i in colors.items()
+        for (rgb, texture), i in colors.items()
     ]
     mdata = _chunk(
         MDATA,
@@ -135,8 +154,11 @@ def encode_3ds(
     return _chunk(MAIN, _chunk(M3D_VERSION, struct.pack("<I", 3)), mdata)
 
 
-def _object_chunk(name: str, vertices: np.ndarray, faces: np.ndarray, material: str) -> bytes:
+def _object_chunk(name: str, vertices: np.ndarray, faces: np.ndarray, material: str,
+                  uv: np.ndarray | None = None) -> bytes:
     points = np.ascontiguousarray(vertices, dtype="<f4")
+    tex = [] if uv is None else [_chunk(TEX_VERTS, struct.pack("<H", len(uv)),
+                                        np.ascontiguousarray(uv, dtype="<f4").tobytes())]
     rec = np.zeros(len(faces), dtype=FACE_DTYPE)
     rec["vertices"] = faces
     rec["flags"] = 0x0007  # all three edges visible, as 3ds Max writes them
@@ -154,6 +176,7 @@ def _object_chunk(name: str, vertices: np.ndarray, faces: np.ndarray, material: 
         _chunk(
             N_TRI_OBJECT,
             _chunk(POINT_ARRAY, struct.pack("<H", len(points)), points.tobytes()),
+            *tex,
             _chunk(MESH_MATRIX, matrix.tobytes()),
             _chunk(FACE_ARRAY, struct.pack("<H", len(faces)), rec.tobytes(), group),
         ),
@@ -172,8 +195,9 @@ def write_3ds(
     path : where to write
     objects : list of ``(name, vertices, faces, rgb)``: vertices (n, 3) float in the
         FILE's axes (Z up), faces (m, 3) int, rgb three floats 0..1 (the diffuse
-        colour).  One material is written per distinct colour; objects over 65535
-        vertices or faces are split into ``name_0``, ``name_1``, ...
+        colour); optionally ``(..., uv, texture)``: (n, 2) texture coordinates and
+        the diffuse map's file name.  One material is written per distinct colour and
+        texture; objects over 65535 vertices or faces are split into ``name_0``, ...
     master_scale : stored in the 0x0100 chunk (readers multiply vertices by it)
 
     Raises ValueError for malformed objects (nothing is written then).

@@ -1,5 +1,6 @@
-"""The game window: start menu, bindings remap screen, the match with pause, restart
-and quit, in a fixed-timestep loop.
+"""The game window: start menu (game/menu.py: previews, mouse, the settings page),
+bindings remap screen, the match with pause, restart and quit, and the end-of-match
+scoreboard, in a fixed-timestep loop.
 
 The loop follows "Fix Your Timestep": real time accumulates, the simulation takes
 whole steps of ``World.dt`` out of it (at most a quarter second per frame, so a stall
@@ -10,7 +11,10 @@ The window is an OpenGL one when moderngl can make a context on it: the 3D view
 draws straight into it, and the top view, menus and remap screen are pygame surfaces
 shown as a full-window texture.  When OpenGL is not available the window is a plain
 pygame one and only the top view is offered.  With no display at all,
-:func:`run_window` raises :class:`NoDisplay` and the CLI falls back to a headless match.
+:func:`run_window` raises :class:`NoDisplay` and the CLI falls back to a headless match;
+with a display variable that leads nowhere (``DISPLAY`` set, no X server behind it, and
+SDL falling back to its invisible ``offscreen`` driver) it raises :class:`DisplayError`:
+one clear error instead of a game running forever with nothing shown.
 """
 
 from __future__ import annotations
@@ -28,35 +32,88 @@ import pygame  # noqa: E402
 
 from ..errors import TanktoolError
 from .input import ACTIONS, Bindings, InputState, describe, input_name, load_bindings, save_bindings
+from .menu import BG, HILITE
 from .session import DIFFICULTY, GameSession
 
 RESOLUTIONS = ["1280x720", "1600x900", "1920x1080", "1024x576", "800x600"]
 MAX_FRAME = 0.25
-BG = (18, 22, 20)
-HILITE = (250, 210, 70)
 #: the menu's network address: host on it, or join the session there
 DEFAULT_ADDRESS = "127.0.0.1:5000"
 #: seconds a notice stays over the match
 NOTICE_S = 4.0
-ADDRESS_CHARS = set("0123456789.:abcdefghijklmnopqrstuvwxyz")
-MAX_PASSWORD = 64
+DEFAULT_SIZE = (1280, 720)
+#: SDL's video drivers that show nothing on any screen
+INVISIBLE_DRIVERS = ("offscreen", "dummy", "evdev")
 
 
 class NoDisplay(TanktoolError):
     """There is no screen to open the window on."""
 
 
+class DisplayError(TanktoolError):
+    """A display is named (``DISPLAY``/``WAYLAND_DISPLAY``) but cannot be used."""
+
+
+def x_display_socket(display: str) -> Path | None:
+    """The Unix socket of a local X display (``:1``, ``:1.0``, ``unix:1``), or None
+    for a remote one (``host:1``) or a name that is not a display."""
+    host, sep, rest = display.rpartition(":")
+    if not sep or host not in ("", "unix"):
+        return None
+    number = rest.split(".")[0]
+    return Path("/tmp/.X11-unix") / f"X{number}" if number.isdigit() else None
+
+
+def stale_display() -> str | None:
+    """Why the display SDL opened is no display (None when it is a real one).
+
+    ``DISPLAY=:99`` with no X server: SDL tries X11, then Wayland, then settles on its
+    ``offscreen`` driver, and a game would run on it forever with nothing shown."""
+    requested = os.environ.get("SDL_VIDEODRIVER", "")
+    driver = pygame.display.get_driver() if pygame.display.get_init() else ""
+    if driver not in INVISIBLE_DRIVERS or requested == driver:
+        return None
+    return _stale_message(driver)
+
+
+def _stale_message(driver: str, detail: str = "") -> str:
+    keys = [k for k in ("DISPLAY", "WAYLAND_DISPLAY") if os.environ.get(k)]
+    named = [f"{k}={os.environ[k]}" for k in keys]
+    why = " and ".join(named) or "a display"
+    var = " and ".join(keys) or "DISPLAY"
+    hint = ""
+    sock = x_display_socket(os.environ.get("DISPLAY", ""))
+    if sock is not None and not sock.exists():
+        hint = f" ({sock} does not exist: no X server is running there)"
+    shown = detail or f"SDL could only open its invisible '{driver}' driver, so nothing would be shown"
+    return (f"{why} is set but no display answers there{hint}; {shown}.  Start the display server or fix "
+            f"{var}, or unset {var} to run a headless match (or use tanktool play --headless)")
+
+
 def display_problem() -> str | None:
-    """Why no window can be opened here, or None when one can."""
+    """Why no window can be opened here, or None when one can.  Raises DisplayError
+    when a display is named but is not there (see :func:`stale_display`)."""
     driver = os.environ.get("SDL_VIDEODRIVER", "")
     if driver in ("dummy", "offscreen"):
         return f"SDL_VIDEODRIVER={driver}"
     if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         return "neither DISPLAY nor WAYLAND_DISPLAY is set"
+    # only X is named: SDL need not try Wayland (which prints its own complaints) nor
+    # fall back to an invisible driver
+    only_x = not driver and os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY")
+    if only_x:
+        os.environ["SDL_VIDEODRIVER"] = "x11"
     try:
         pygame.display.init()
     except pygame.error as e:
+        if only_x:
+            del os.environ["SDL_VIDEODRIVER"]
+            raise DisplayError(_stale_message("x11", f"SDL cannot open it: {e}")) from None
         return f"SDL cannot open a display: {e}"
+    stale = stale_display()
+    if stale is not None:
+        pygame.display.quit()
+        raise DisplayError(stale)
     return None
 
 
@@ -101,11 +158,14 @@ class Menu:
     address: str = DEFAULT_ADDRESS
     #: the network session's password ("" for none), typed into a field that shows only stars
     password: str = ""
+    #: the player's name in a network session (saved in the settings)
+    name: str = ""
     cursor: int = 0
 
-    ITEMS = ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen", "network", "address",
-             "password", "bindings", "start", "quit")
-    CHOICES = ("arena", "vehicle", "bots", "difficulty", "view", "resolution", "fullscreen", "network")
+    #: the main menu; resolution and full screen are on the settings page
+    ITEMS = ("arena", "vehicle", "bots", "difficulty", "view", "network", "address", "name", "password", "settings",
+             "bindings", "start", "quit")
+    CHOICES = ("arena", "vehicle", "bots", "difficulty", "view", "network")
 
     def item(self) -> str:
         return self.ITEMS[self.cursor]
@@ -171,7 +231,15 @@ class App:
                  fullscreen: bool = False, bindings: Bindings | None = None, sound: bool = True,
                  bindings_file: Path | None = None, difficulty: str = "normal", bot: str = "agent",
                  record: Path | None = None, replay: Any = None, replay_name: str = "",
-                 seconds: float | None = None) -> None:
+                 seconds: float | None = None, settings_file: Path | None = None) -> None:
+        from .quality import load_settings
+
+        #: the settings page's choices (quality, resolution, name), read at every start
+        self.settings_file = settings_file
+        self.settings = load_settings(settings_file)
+        if tuple(size) == DEFAULT_SIZE and self.settings.resolution:
+            size = tuple(int(v) for v in self.settings.resolution.split("x"))   # --size overrides the saved one
+        fullscreen = fullscreen or self.settings.fullscreen
         arenas, vehicles = bundled("arenas"), bundled("vehicles")
         self.menu = Menu(Choice("arena", arenas + ([arena] if arena and arena not in arenas else [])),
                          Choice("vehicle", vehicles + ([vehicle] if vehicle and vehicle not in vehicles else [])
@@ -188,6 +256,15 @@ class App:
             self.menu.resolution.options.insert(0, res)
         self.menu.resolution.set(res)
         self.menu.fullscreen.set(fullscreen)
+        self.menu.name = self.settings.name
+        self.settings_cursor = 0
+        self.quality = self.settings.graphics()
+        #: clickable rectangles of the screen last drawn (game/menu.py)
+        self.menu_hits: list[Any] = []
+        self.preview_hits: list[Any] = []
+        self._asked: set[tuple] = set()
+        #: why the last match ended (the end-of-match screen)
+        self.over_reason = ""
         self.seed = seed
         self.bot = bot
         self.bindings_file = bindings_file
@@ -218,7 +295,6 @@ class App:
         self.editing = False
         self.field = "address"
         self._notice_seen, self._notice_t = "", 0.0
-        self.player_name: str | None = None
         self.password: str | None = None
         #: ``--seconds``: a local match ends after this much simulated time (None: when you quit)
         self.match_seconds = seconds
@@ -236,6 +312,40 @@ class App:
     @password.setter
     def password(self, value: str | None) -> None:
         self.menu.password = value or ""
+
+    @property
+    def player_name(self) -> str | None:
+        """The name for network play: the menu's field (``--name`` or the settings fill it)."""
+        return self.menu.name or None
+
+    @player_name.setter
+    def player_name(self, value: str | None) -> None:
+        if value:
+            self.menu.name = value
+
+    def save_settings(self) -> Path | None:
+        from .menu import save
+
+        return save(self)
+
+    def apply_quality(self) -> None:
+        """The settings' graphics quality, for the 3D view from now on."""
+        self.quality = self.settings.graphics()
+        if self.r3d is not None:
+            self.r3d.set_quality(self.quality)
+
+    def preview(self, kind: str, ref: Any, size: tuple[int, int]) -> "pygame.Surface | None":
+        """A rendered preview of an arena or vehicle for the menu (game/thumbnails.py);
+        None the first time it is asked for: it is made at the next frame, so the menu
+        shows before the models are loaded."""
+        from .thumbnails import cached, preview
+
+        key = (kind, str(ref), size)
+        if cached(key) is None and key not in self._asked:
+            self._asked.add(key)
+            return None
+        ctx = self.presenter.ctx if self.presenter is not None and self.presenter.gl else None
+        return preview(kind, ref, size, ctx)
 
     def open_window(self) -> None:
         self.presenter = Presenter(self.size(), bool(self.menu.fullscreen.value), want_gl=True)
@@ -358,7 +468,7 @@ class App:
         if view == "3d":
             from .render3d import Renderer3D
 
-            self.r3d = Renderer3D(self.session, self.presenter.size, ctx=self.presenter.ctx)
+            self.r3d = Renderer3D(self.session, self.presenter.size, ctx=self.presenter.ctx, quality=self.quality)
 
     def stop(self) -> None:
         self.end_match()
@@ -376,6 +486,14 @@ class App:
         if self.state == "remap":
             self._handle_remap(event)
             return
+        if self.state == "settings":
+            from .menu import handle_settings
+
+            handle_settings(self, event)
+            return
+        if self.state == "over":
+            self._handle_over(event)
+            return
         actions = self.input.handle(event)
         if self.replay is not None and self.state in ("playing", "paused") and event.type == pygame.KEYDOWN \
                 and event.key == pygame.K_TAB and self.session is not None:
@@ -384,7 +502,9 @@ class App:
             self.notice = f"following {self.session.world.tanks[self.session.follow].name}"
             return
         if self.state == "menu":
-            self._handle_menu(event)
+            from .menu import handle_menu
+
+            handle_menu(self, event)
         elif self.state == "playing":
             for a in actions:
                 if a == "pause":
@@ -427,71 +547,6 @@ class App:
                     self.state = "menu"
                 elif event.key in (pygame.K_q, pygame.K_F10):
                     self.state = "quit"
-
-    def _handle_menu(self, event: Any) -> None:
-        m = self.menu
-        step = 0
-        if self.editing and self.field == "password":
-            if event.type == pygame.KEYDOWN:
-                if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_TAB):
-                    self.editing = False
-                elif event.key == pygame.K_BACKSPACE:
-                    m.password = m.password[:-1]
-                else:
-                    ch = getattr(event, "unicode", "") or ""
-                    if len(ch) == 1 and ch.isprintable() and len(m.password) < MAX_PASSWORD:
-                        m.password += ch
-            return
-        if self.editing:
-            if event.type == pygame.KEYDOWN:
-                if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_TAB):
-                    self.editing = False
-                    m.address = m.address.strip() or DEFAULT_ADDRESS
-                elif event.key == pygame.K_BACKSPACE:
-                    m.address = m.address[:-1]
-                else:
-                    ch = (getattr(event, "unicode", "") or "").lower()
-                    if len(ch) == 1 and ch in ADDRESS_CHARS and len(m.address) < 40:
-                        m.address += ch
-            return
-        if event.type == pygame.KEYDOWN:
-            step = {pygame.K_LEFT: -1, pygame.K_RIGHT: 1, pygame.K_a: -1, pygame.K_d: 1}.get(event.key, 0)
-            if event.key in (pygame.K_UP, pygame.K_w):
-                m.cursor = (m.cursor - 1) % len(m.ITEMS)
-            elif event.key in (pygame.K_DOWN, pygame.K_s):
-                m.cursor = (m.cursor + 1) % len(m.ITEMS)
-            elif event.key in (pygame.K_RETURN, pygame.K_SPACE, pygame.K_KP_ENTER):
-                self._activate()
-            elif event.key == pygame.K_ESCAPE:
-                self.state = "quit"
-        elif event.type == pygame.JOYHATMOTION:
-            hx, hy = event.value
-            m.cursor = (m.cursor - hy) % len(m.ITEMS)
-            step = hx
-        elif event.type == pygame.JOYBUTTONDOWN and event.button == 0:
-            self._activate()
-        if step and m.item() in m.CHOICES:
-            getattr(m, m.item()).shift(step)
-
-    def _activate(self) -> None:
-        item = self.menu.item()
-        if item == "start":
-            try:
-                self.start()
-            except TanktoolError as e:
-                self.notice = str(e)       # a broken bundle, nobody at the address: say so, stay in the menu
-        elif item == "address":
-            self.editing, self.field = True, "address"
-            self.menu.address = ""
-        elif item == "password":
-            self.editing, self.field = True, "password"
-            self.menu.password = ""
-        elif item == "bindings":
-            self.state = "remap"
-            self.remap_cursor = 0
-            self.remap_waiting = False
-        elif item == "quit":
-            self.state = "quit"
 
     def _handle_remap(self, event: Any) -> None:
         if self.remap_waiting:
@@ -540,7 +595,7 @@ class App:
                 self._replay_over()
                 self.acc = 0.0
                 break
-            if self._time_up():
+            if self._time_up() or self._match_over():
                 break
             events = self.session.step(self.input.command())
             if self.audio is not None:
@@ -557,9 +612,36 @@ class App:
             return False
         self.end_match()
         self.acc = 0.0
-        self.state = "menu"
-        self.notice = f"time up: the match lasted {self.match_seconds:g} s (--seconds)"
+        self.state = "over"
+        self.over_reason = f"time up: the match lasted {self.match_seconds:g} s (--seconds)"
+        self.notice = self.over_reason
         return True
+
+    def _match_over(self) -> bool:
+        """The simulation says the match is over (a time or score limit: ``world.over``,
+        with ``world.end_reason``, when the rules have them): the end screen."""
+        w = getattr(self.session, "world_all", getattr(self.session, "world", None))
+        if self.replay is not None or w is None or not getattr(w, "over", False):
+            return False
+        self.end_match()
+        self.acc = 0.0
+        self.state = "over"
+        self.over_reason = str(getattr(w, "end_reason", "") or "the match is over")
+        self.notice = self.over_reason
+        return True
+
+    def _handle_over(self, event: Any) -> None:
+        """The end-of-match screen: Enter, Esc, M or a click: the menu; R: the same match
+        again; Q or F10: quit."""
+        if event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
+            self.state = "menu"
+        elif event.type == pygame.KEYDOWN:
+            if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_m, pygame.K_SPACE):
+                self.state = "menu"
+            elif event.key == pygame.K_r:
+                self.start()
+            elif event.key in (pygame.K_q, pygame.K_F10):
+                self.state = "quit"
 
     def _replay_over(self) -> None:
         if self.replay_done:
@@ -592,8 +674,12 @@ class App:
 
     def draw(self) -> None:
         canvas = self.presenter.canvas
-        if self.state in ("menu", "remap"):
-            self._draw_menu(canvas) if self.state == "menu" else self._draw_remap(canvas)
+        if self.state in ("menu", "remap", "settings", "over"):
+            from .menu import draw_menu, draw_settings
+            from .scoreboard import draw_end
+
+            {"menu": draw_menu, "settings": draw_settings, "remap": lambda a, c: a._draw_remap(c),
+             "over": draw_end}[self.state](self, canvas)
             self.presenter.show(canvas)
             return
         if self.session is None:
@@ -610,43 +696,6 @@ class App:
         else:
             self.top.draw(canvas, self.alpha, self.fps, msg)
             self.presenter.show(canvas)
-
-    def _draw_menu(self, surf: "pygame.Surface") -> None:
-        from .hud import text
-
-        surf.fill(BG)
-        w, h = surf.get_size()
-        # the list shrinks to fit small windows: title, items, two lines of help
-        line = max(min(42, (h - 190) // len(self.menu.ITEMS)), 16)
-        size = max(int(line * 0.8), 14)
-        text(surf, "tanktool", (w // 2, 20), max(min(72, h // 8), 28), anchor="midtop")
-        m = self.menu
-        y = 20 + max(min(72, h // 8), 28) + 20
-        for i, item in enumerate(m.ITEMS):
-            colour = HILITE if i == m.cursor else (220, 220, 220)
-            if item in ("bindings", "start", "quit"):
-                label = {"bindings": "key and joystick bindings...", "start": "START", "quit": "quit"}[item]
-                if item == "start" and m.network.value != "off":
-                    label = f"START: {m.network.value} {m.address}"
-            elif item == "address":
-                field_text = m.address + ("_" if self.editing and self.field == "address" else "")
-                label = f"{'address':<12}  [ {field_text} ]" + ("" if self.editing or i != m.cursor else "  Enter: type")
-            elif item == "password":
-                typing = self.editing and self.field == "password"
-                field_text = "*" * len(m.password) + ("_" if typing else "") if m.password or typing else "none"
-                label = f"{'password':<12}  [ {field_text} ]" + ("" if self.editing or i != m.cursor else "  Enter: type")
-            else:
-                c = getattr(m, item)
-                v = c.value
-                shown = {True: "on", False: "off", None: "built-in box tank"}.get(v, v) if not isinstance(v, int) \
-                    or isinstance(v, bool) else v
-                label = f"{c.label:<12}  <  {shown}  >"
-            text(surf, ("> " if i == m.cursor else "  ") + label, (w // 2 - 200, y), size, colour)
-            y += line
-        text(surf, "up/down choose, left/right change, Enter select, Esc quit", (w // 2, h - 60), 24,
-             (170, 170, 170), anchor="midtop")
-        if self.notice:
-            text(surf, self.notice, (w // 2, h - 30), 22, (240, 160, 120), anchor="midtop")
 
     def _draw_remap(self, surf: "pygame.Surface") -> None:
         from .hud import text
@@ -681,7 +730,7 @@ def run_window(arena: str | None = None, vehicle: str | None = None, bots: int =
     the menu; ``network``: ("host" or "join", address) starts that network match at
     once; ``seconds``: each local match ends after that much simulated time and the
     menu comes back).  Returns the lines saying what happened (files written, network summary).
-    Raises NoDisplay when there is no screen."""
+    Raises NoDisplay when there is no screen, DisplayError when the one named is not there."""
     problem = display_problem()
     if problem is not None:
         raise NoDisplay(problem)

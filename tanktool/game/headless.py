@@ -31,9 +31,11 @@ def run_frames(session: Any, frames: int) -> None:
 def screenshot(path: str | os.PathLike, view: str = "3d", frames: int = 120, arena: str | None = None,
                vehicle: str | None = None, bots: int = 8, seed: int = 0, size: tuple[int, int] = (1280, 720),
                overlays: tuple[str, ...] = (), difficulty: str = "normal", bot: str = "agent",
-               session: Any = None) -> dict[str, Any]:
+               session: Any = None, quality: str = "medium", camera: str = "chase") -> dict[str, Any]:
     """Render ``view`` after ``frames`` frames of a bots-only match (``bot`` drivers at
-    ``difficulty``); write it to ``path``.
+    ``difficulty``); write it to ``path``.  The 3D view uses the ``quality`` preset
+    (game/quality.py; the user's settings play no part in a screenshot) and ``camera``,
+    and follows the last second of the match so that its smoke and dust are there.
 
     Returns what was drawn: ``{"path", "view", "frames", "size", "tanks": [(x, z)...]}``.
     """
@@ -55,7 +57,8 @@ def screenshot(path: str | os.PathLike, view: str = "3d", frames: int = 120, are
     pygame.font.init()
     if session is None:  # a prepared session (a replay's, game/replay_session.py) replaces the bots-only match
         session = GameSession(arena, vehicle, bots=bots, seed=seed, player=False, difficulty=difficulty, bot=bot)
-    run_frames(session, frames)
+    warm = min(frames, 60) if view == "3d" else 0      # the last second, seen by the effects
+    run_frames(session, frames - warm)
     if view == "top":
         from .render_top import TopView
 
@@ -65,10 +68,17 @@ def screenshot(path: str | os.PathLike, view: str = "3d", frames: int = 120, are
         surf = pygame.Surface(size)
         top.draw(surf, 1.0, fps=0.0)
     else:
-        from .render3d import Renderer3D
+        from .quality import preset
+        from .render3d import CAMERAS, Renderer3D
 
-        r = Renderer3D(session, size)
+        if camera not in CAMERAS:
+            raise TanktoolError(f"camera must be one of {', '.join(CAMERAS)}, got {camera!r}")
+        r = Renderer3D(session, size, quality=preset(quality))
+        r.camera = camera
         try:
+            for _ in range(warm):
+                run_frames(session, 1)
+                r.effects.sync(session, r.floor_y)
             surf = surface_from_rgb(r.render(1.0, fps=0.0))
         finally:
             r.release()

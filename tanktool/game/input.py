@@ -125,14 +125,18 @@ def load_bindings(path: str | os.PathLike | None = None) -> Bindings:
     return b
 
 
-def save_bindings(bindings: Bindings, path: str | os.PathLike | None = None) -> Path:
-    """Write the bindings atomically (creating the config folder); returns the path."""
+def save_config(path: Path, doc: dict[str, Any]) -> Path:
+    """Write a config file atomically, creating its folder; returns the path."""
     from ..formats.bundle import write_toml
 
-    path = Path(path) if path is not None else bindings_path()
     path.parent.mkdir(parents=True, exist_ok=True)
-    write_toml(path, bindings.to_dict())
+    write_toml(path, doc)
     return path
+
+
+def save_bindings(bindings: Bindings, path: str | os.PathLike | None = None) -> Path:
+    """Write the bindings atomically (creating the config folder); returns the path."""
+    return save_config(Path(path) if path is not None else bindings_path(), bindings.to_dict())
 
 
 def input_name(event: Any) -> str | None:

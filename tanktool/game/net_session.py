@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ..sim.commands import IDLE, Command
-from .session import Effect, update_effects
+from .session import Effect, pose3d, update_effects, update_feed
 
 
 class _Shown:
@@ -66,6 +66,7 @@ class NetGameSession:
         self.player = peer.number - 1
         self.drivers: list[Any] = [None] * len(self.world_all.tanks)
         self.effects: list[Effect] = []
+        self.feed: list[Any] = []
         self.last_events: list[Any] = []
         self.follow: int | None = None
         self.recorder = None             # a network match is not recorded
@@ -100,6 +101,7 @@ class NetGameSession:
         events = self.match.pump(before_step=self._before_step)
         w = self.world_all
         self.effects = update_effects(self.effects, events, w)
+        self.feed = update_feed(self.feed, events, w.t)
         for n, name in self.match.names.items():     # the players' names on the scoreboard
             w.tanks[n - 1].name = name
         self.last_events = events
@@ -149,6 +151,9 @@ class NetGameSession:
             return x1, z1, h1
         dh = math.remainder(h1 - h0, 2.0 * math.pi)
         return x0 + alpha * (x1 - x0), z0 + alpha * (z1 - z0), h0 + alpha * dh
+
+    def pose3d(self, i: int, alpha: float = 1.0) -> tuple[float, float, float, float, float, float]:
+        return pose3d(self, i, alpha)
 
     def shell_points(self, alpha: float = 1.0) -> np.ndarray:
         shells = self.world_all.shells

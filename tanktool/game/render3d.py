@@ -1,101 +1,63 @@
 """The 3D view: moderngl, OpenGL 3.3 core.
 
 Models come from the bundles' ``model.glb`` (arena in the world frame, vehicles in the
-vehicle frame), with their material colours and per-vertex normals: smooth across
-edges gentler than 35° (wheels, barrels), split at sharper ones (box edges stay hard).
-Lighting is Phong (Blinn's half vector) with one point light in the manner of the
-paper's D3DLIGHT8 — position, range, attenuation 1/(a0 + a1 d + a2 d²) — plus an
-ambient term.  Cameras: a chase camera behind the followed tank, first person from its
-turret, and an overview of the arena.  Shells, muzzle flashes and explosions are small
-emissive spheres; the HUD (``hud.py``) is a pygame surface drawn over the scene as a
-texture.
+vehicle frame) with their textures and material colours (game/meshes.py).  A frame:
 
-With no window (``ctx=None``) the renderer makes an EGL standalone context and draws
-into its own framebuffer, so screenshots work without any display.
+1. **shadow pass** (quality ``shadows`` on): the depth of the arena and the tanks seen
+   from the light into a shadow map.  The light is the paper's point light high over
+   the middle of the arena; everything lies below it, so one perspective view looking
+   down, its frustum fitted to the arena's bounding box, holds every shadow.  The
+   arena's depth is drawn once and copied in each frame; only the tanks are drawn.
+2. **scene**: tanks, then the arena (front to back: the software rasteriser skips what
+   is hidden), Phong-lit per pixel by the point light (position, range, attenuation
+   1/(a0 + a1 d + a2 d²) as D3DLIGHT8) plus ambient, textured, shadowed, fogged
+   towards the horizon (game/shaders.py).  Closed models are drawn with back faces
+   culled.
+3. **sky** at the far plane, only where nothing was drawn: gradient, the light's glow,
+   clouds.
+4. **effects**: particles (game/particles.py: muzzle flashes, fire, smoke, sparks,
+   debris, dust) and tracers, blended, never wider on screen than a share of the
+   window and faded near the camera.
+5. **HUD** (game/hud.py): a pygame surface; only the rectangles it drew are uploaded
+   and blended (a full-window blend costs a software renderer more than the scene).
+
+Tanks are placed at ``(x, y, z)`` with heading, pitch and roll when the simulation has
+them (``y``, ``pitch``, ``roll`` of a tank; 0 before), so the same code draws flat and
+terraced arenas.  Cameras: chase (pulled in when a wall would hide the tank), first
+person, overview.  With no window (``ctx=None``) the renderer makes an EGL standalone
+context and draws into its own framebuffer, so screenshots work without any display.
 """
 
 from __future__ import annotations
 
 import math
-from functools import lru_cache
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import TanktoolError
-from .session import GameSession, tank_colour
+from . import shaders
+from .meshes import STRIDE, Batch, Model, box_tank_model, load_model
+from .quality import PRESETS, Quality
+from .session import GameSession, pose3d, tank_colour
 
 CAMERAS = ("chase", "first-person", "overview")
-SKY = (0.55, 0.68, 0.82)
+#: the sky at the horizon (and the fog's colour), and overhead
+SKY = (0.66, 0.75, 0.85)
+ZENITH = (0.30, 0.48, 0.78)
 #: how much of a tank's colour is its team tint (the rest is the model's own colours)
 TINT = 0.8
-SMOOTH_ANGLE = math.radians(35.0)
-
-VERTEX = """
-#version 330 core
-uniform mat4 mvp;
-uniform mat4 model;
-in vec3 in_pos;
-in vec3 in_normal;
-in vec3 in_colour;
-out vec3 v_pos;
-out vec3 v_normal;
-out vec3 v_colour;
-void main() {
-    vec4 world = model * vec4(in_pos, 1.0);
-    v_pos = world.xyz;
-    v_normal = mat3(model) * in_normal;
-    v_colour = in_colour;
-    gl_Position = mvp * vec4(in_pos, 1.0);
-}
-"""
-
-FRAGMENT = """
-#version 330 core
-uniform vec3 light_pos;
-uniform vec3 light_colour;
-uniform vec3 attenuation;     // a0, a1, a2 as D3DLIGHT8's Attenuation0..2
-uniform float light_range;
-uniform vec3 ambient;
-uniform vec3 eye;
-uniform vec3 tint;
-uniform float tint_amount;
-uniform vec3 emissive;
-uniform float alpha;
-in vec3 v_pos;
-in vec3 v_normal;
-in vec3 v_colour;
-out vec4 frag;
-void main() {
-    vec3 base = mix(v_colour, tint, tint_amount);
-    vec3 n = normalize(v_normal);
-    vec3 to_light = light_pos - v_pos;
-    float d = length(to_light);
-    vec3 l = to_light / d;
-    float att = d > light_range ? 0.0 : 1.0 / (attenuation.x + attenuation.y * d + attenuation.z * d * d);
-    float diffuse = max(dot(n, l), 0.0);
-    vec3 h = normalize(l + normalize(eye - v_pos));
-    float spec = diffuse > 0.0 ? pow(max(dot(n, h), 0.0), 32.0) : 0.0;
-    vec3 colour = base * (ambient + light_colour * diffuse * att) + 0.25 * spec * att * light_colour + emissive;
-    frag = vec4(colour, alpha);
-}
-"""
-
-HUD_VERTEX = """
-#version 330 core
-in vec2 in_pos;
-out vec2 uv;
-void main() { uv = vec2(in_pos.x * 0.5 + 0.5, 0.5 - in_pos.y * 0.5); gl_Position = vec4(in_pos, 0.0, 1.0); }
-"""
-
-HUD_FRAGMENT = """
-#version 330 core
-uniform sampler2D hud;
-in vec2 uv;
-out vec4 frag;
-void main() { frag = texture(hud, uv); }
-"""
+FOV_Y = math.radians(60.0)
+#: the widest a particle may be on screen, as a share of the window's height
+PARTICLE_MAX_SCREEN = 0.2
+#: a tank smaller than this on screen [px] is drawn without its small parts (wheels...)
+LOD_PIXELS = 70.0
+#: the longest triangle edge of the arena as drawn [m] (a tenth of the arena if larger):
+#: attenuation and fog come from the vertices
+ARENA_EDGE = 16.0
+HUD_VERTEX, HUD_FRAGMENT = shaders.HUD_VERTEX, shaders.HUD_FRAGMENT
 
 
 # ---------------------------------------------------------------- matrices (column vectors)
@@ -103,6 +65,14 @@ def perspective(fov_y: float, aspect: float, near: float, far: float) -> np.ndar
     f = 1.0 / math.tan(fov_y / 2.0)
     return np.array([[f / aspect, 0, 0, 0], [0, f, 0, 0],
                      [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)], [0, 0, -1, 0]])
+
+
+def frustum(left: float, right: float, bottom: float, top: float, near: float, far: float) -> np.ndarray:
+    """glFrustum: an off-centre perspective (the shadow map's, fitted to the arena)."""
+    return np.array([[2 * near / (right - left), 0, (right + left) / (right - left), 0],
+                     [0, 2 * near / (top - bottom), (top + bottom) / (top - bottom), 0],
+                     [0, 0, -(far + near) / (far - near), -2 * far * near / (far - near)],
+                     [0, 0, -1, 0]])
 
 
 def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
@@ -120,114 +90,79 @@ def look_at(eye, target, up=(0.0, 1.0, 0.0)) -> np.ndarray:
     return m
 
 
-def tank_matrix(x: float, z: float, heading: float) -> np.ndarray:
-    """Vehicle frame (+x forward, +z right) to world, as ``Tank.to_world`` turns points."""
+def tank_matrix(x: float, z: float, heading: float, y: float = 0.0, pitch: float = 0.0,
+                roll: float = 0.0) -> np.ndarray:
+    """Vehicle frame (+x forward, +y up, +z right) to world, as ``Tank.to_world`` turns
+    points: heading about the world's up, then pitch (nose up) about the tank's right
+    axis, then roll (right side down) about its forward axis."""
     c, s = math.cos(heading), math.sin(heading)
-    return np.array([[c, 0, -s, x], [0, 1, 0, 0], [s, 0, c, z], [0, 0, 0, 1.0]])
+    yaw = np.array([[c, 0, -s], [0, 1, 0], [s, 0, c]])
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    pit = np.array([[cp, -sp, 0], [sp, cp, 0], [0, 0, 1]])        # about +z: +x towards +y
+    cr, sr = math.cos(roll), math.sin(roll)
+    rol = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])        # about +x: +z towards -y
+    m = np.identity(4)
+    m[:3, :3] = yaw @ pit @ rol
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+def vertex_format(prog: Any, buf: Any, fields: tuple[tuple[str, int], ...]) -> tuple:
+    """(buffer, format, names...) for interleaved float ``fields``, skipping those the
+    compiled program does not use (the compiler drops unused inputs)."""
+    parts, names = [], []
+    for name, n in fields:
+        if name in prog:
+            parts.append(f"{n}f")
+            names.append(name)
+        else:
+            parts.append(f"{n}x4")
+    return (buf, " ".join(parts), *names)
+
+
+def set_uniform(prog: Any, name: str, value: Any) -> None:
+    """Set a uniform if the compiled program kept it (unused ones are optimised away)."""
+    if name in prog:
+        if isinstance(value, bytes):
+            prog[name].write(value)
+        else:
+            prog[name].value = value
 
 
 def _gl(m: np.ndarray) -> bytes:
     return np.ascontiguousarray(m.T, dtype="f4").tobytes()   # OpenGL wants column-major
 
 
-# ---------------------------------------------------------------- meshes
-def _face_colours(mesh: Any) -> np.ndarray:
-    """(F, 3) floats in [0, 1]: face colours, or the material's main colour."""
-    vis = mesh.visual
-    if getattr(vis, "kind", None) == "face" or type(vis).__name__ == "ColorVisuals":
-        try:
-            return np.asarray(vis.face_colors, dtype=np.float64)[:, :3] / 255.0
-        except Exception:
-            pass
-    mat = getattr(vis, "material", None)
-    colour = getattr(mat, "main_color", None) if mat is not None else None
-    if colour is None:
-        colour = (180, 180, 180, 255)
-    return np.tile(np.asarray(colour[:3], dtype=np.float64) / 255.0, (len(mesh.faces), 1))
+def cloud_pixels(size: int = 256, seed: int = 7) -> np.ndarray:
+    """(size, size) uint8 seamless cloud cover for the sky."""
+    from .noise import fbm
+
+    n = fbm(np.random.default_rng(seed), size, (40, 16, 6, 2), (0.45, 0.3, 0.17, 0.08))
+    return np.round(n * 255).astype(np.uint8)
 
 
-def mesh_arrays(meshes: list[Any]) -> np.ndarray:
-    """Interleaved (n, 9) float32 vertices ``x y z nx ny nz r g b``, three per triangle."""
-    parts = []
-    for m in meshes:
-        if len(m.faces) == 0:
-            continue
-        colours = _face_colours(m)
-        tri = np.asarray(m.vertices)[m.faces]                     # (F, 3, 3)
-        fn = np.asarray(m.face_normals)                            # (F, 3)
-        vn = np.asarray(m.vertex_normals)[m.faces]                 # (F, 3, 3), smooth
-        # keep the smooth normal only where it is close to the face's own (crease angle)
-        close = np.einsum("fkc,fc->fk", vn, fn) > math.cos(SMOOTH_ANGLE)
-        normals = np.where(close[:, :, None], vn, fn[:, None, :])
-        cols = np.repeat(colours[:, None, :], 3, axis=1)
-        parts.append(np.concatenate([tri, normals, cols], axis=2).reshape(-1, 9))
-    if not parts:
-        return np.zeros((0, 9), dtype="f4")
-    return np.concatenate(parts).astype("f4")
+# ---------------------------------------------------------------- GPU side of a model
+@dataclass
+class GpuBatch:
+    vao: Any
+    depth_vao: Any
+    flat_vao: Any
+    texture: Any
+    closed: bool
+    luma: float
+    triangles: int
 
 
-@lru_cache(maxsize=16)
-def load_glb(path: str) -> np.ndarray:
-    """A bundle's model.glb as vertex arrays (scene transforms applied)."""
-    import trimesh
-
-    p = Path(path)
-    if not p.is_file():
-        raise TanktoolError(f"{p}: no such model (rebuild the bundle: tanktool import-arena / import-vehicle)")
-    try:
-        import io
-
-        from ..formats.bundle import read_input
-        from ..formats.gltf import read_gltf, sanitized_glb
-
-        # validated first (formats/gltf.py): a hostile model.glb cannot crash the game
-        glb = sanitized_glb(read_gltf(read_input(p, "a .glb model"), str(p)))
-        scene = trimesh.load(io.BytesIO(glb), file_type="glb", force="scene", process=False)
-    except Exception as e:
-        raise TanktoolError(f"{p}: cannot read the model ({e})") from None
-    meshes = []
-    for node in scene.graph.nodes_geometry:
-        transform, name = scene.graph[node]
-        g = scene.geometry[name]
-        if not hasattr(g, "faces"):
-            continue
-        m = g.copy()
-        m.merge_vertices(merge_tex=True, merge_norm=True)   # smooth normals need shared corners
-        m.apply_transform(transform)
-        meshes.append(m)
-    return mesh_arrays(meshes)
-
-
-def sphere_arrays(subdivisions: int = 1) -> np.ndarray:
-    import trimesh
-
-    m = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
-    m.visual.face_colors = (255, 255, 255, 255)
-    return mesh_arrays([m])
-
-
-def box_tank_arrays(spec: Any) -> np.ndarray:
-    """The built-in box tank (no vehicle bundle): its hull as a box."""
-    import trimesh
-
-    xs = [p[0] for p in spec.hull]
-    zs = [p[2] for p in spec.hull]
-    ext = (max(xs) - min(xs), spec.height, max(zs) - min(zs))
-    m = trimesh.creation.box(extents=ext)
-    m.apply_translation(((max(xs) + min(xs)) / 2, spec.height / 2, (max(zs) + min(zs)) / 2))
-    m.visual.face_colors = (110, 120, 80, 255)
-    return mesh_arrays([m])
-
-
-# ---------------------------------------------------------------- the renderer
 class Renderer3D:
     """Draws a :class:`GameSession` in 3D.
 
     ``ctx`` is the window's moderngl context; None makes a headless EGL context and
-    an offscreen framebuffer of ``size``.
+    an offscreen framebuffer of ``size``.  ``quality`` is a ``game.quality.Quality``
+    (default: the ``medium`` preset).
     """
 
-    def __init__(self, session: GameSession, size: tuple[int, int] = (1280, 720), ctx: Any = None) -> None:
+    def __init__(self, session: GameSession, size: tuple[int, int] = (1280, 720), ctx: Any = None,
+                 quality: Quality | None = None) -> None:
         import moderngl
 
         self.session = session
@@ -235,38 +170,57 @@ class Renderer3D:
         self.camera = "chase"
         self.own_ctx = ctx is None
         if ctx is None:
-            try:
-                ctx = moderngl.create_standalone_context(backend="egl", require=330)
-            except Exception as e:
-                raise TanktoolError(f"cannot create a headless OpenGL 3.3 context through EGL ({e}); "
-                                    "install libegl1 and libgl1-mesa-dri, or use --view top") from None
+            ctx = standalone_context()
             self.fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer(self.size)],
                                        depth_attachment=ctx.depth_renderbuffer(self.size))
         else:
             self.fbo = ctx.screen
         self.ctx = ctx
-        self.prog = ctx.program(vertex_shader=VERTEX, fragment_shader=FRAGMENT)
         self.hud_prog = ctx.program(vertex_shader=HUD_VERTEX, fragment_shader=HUD_FRAGMENT)
-        self.arena = self._vao(load_glb(str(self._arena_model())))
-        self.tank_models: dict[str, Any] = {}
-        for t in session.world.tanks:
-            if t.spec.name not in self.tank_models:
-                self.tank_models[t.spec.name] = self._vao(self._vehicle_arrays(t.spec))
-        self.sphere = self._vao(sphere_arrays())
+        self.depth_prog = ctx.program(vertex_shader=shaders.source(shaders.DEPTH_VERTEX),
+                                      fragment_shader=shaders.source(shaders.DEPTH_FRAGMENT))
+        self.flat_prog = ctx.program(vertex_shader=shaders.source(shaders.FLAT_VERTEX),
+                                     fragment_shader=shaders.source(shaders.FLAT_FRAGMENT))
+        self.particle_prog = ctx.program(vertex_shader=shaders.source(shaders.PARTICLE_VERTEX),
+                                         fragment_shader=shaders.source(shaders.PARTICLE_FRAGMENT))
+        self.beam_prog = ctx.program(vertex_shader=shaders.source(shaders.BEAM_VERTEX),
+                                     fragment_shader=shaders.source(shaders.BEAM_FRAGMENT))
         quad = np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype="f4")
-        self.hud_vao = ctx.vertex_array(self.hud_prog, [(ctx.buffer(quad.tobytes()), "2f", "in_pos")])
-        self.hud_tex = ctx.texture(self.size, 4)
-        self.hud_tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self._quad = ctx.buffer(quad.tobytes())
+        self.hud_vao = ctx.vertex_array(self.hud_prog, [(self._quad, "2f", "in_pos")])
+        # two HUD textures used in turn: writing the one the last frame blended would wait
+        # for that frame to be drawn
+        self.hud_texs = [ctx.texture(self.size, 4), ctx.texture(self.size, 4)]
+        for tex in self.hud_texs:
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self.hud_tex = self.hud_texs[0]
         self._hud = None
+        self._hud_rects: list[Any] = []
+        self._placed: dict[tuple, np.ndarray] = {}       # tank matrices of this frame (shadow and scene)
         self._eye = None
         (x0, z0), (x1, z1) = session.world.bounds.tolist()
         self.centre = ((x0 + x1) / 2, (z0 + z1) / 2)
         self.span = max(x1 - x0, z1 - z0, 1.0)
-        # the paper's single light, high over the middle of the arena
-        self.light_pos = (self.centre[0], 0.5 * self.span, self.centre[1])
+        self.arena_model = load_model(str(self._arena_model()))
+        self.floor_y = self._floor_y()
+        box = self.arena_model.bounds()
+        top = float(box[1, 1]) if self.arena_model.triangles else 3.0
+        # the paper's single light, high over the middle of the arena (above everything in it)
+        self.light_pos = (self.centre[0], max(0.5 * self.span, top + 0.25 * self.span), self.centre[1])
+        self.scene_box = np.array([[x0, min(float(box[0, 1]), self.floor_y - 1.0), z0],
+                                   [x1, max(top, self.floor_y + 6.0), z1]])
+        self.tank_models: dict[str, Model] = {}
+        for t in session.world.tanks:
+            if t.spec.name not in self.tank_models:
+                self.tank_models[t.spec.name] = self._vehicle_model(t.spec)
+        self.textures: dict[int, Any] = {}
+        self._split: Model | None = None
+        self.quality = quality or PRESETS["medium"]
         self.view = np.identity(4)
         self.proj = np.identity(4)
+        self._setup_quality(self.quality)
 
+    # ------------------------------------------------------------------ resources
     def _arena_model(self) -> Path:
         path = self.session.info.path
         if path is None:
@@ -274,21 +228,197 @@ class Renderer3D:
         from ..arena import load_arena
 
         bundle = load_arena(path)
+        self._bundle_floor = bundle.floor_y
         f = bundle.file("model")
         return f if f.name else Path(path) / "model.glb"
 
-    def _vehicle_arrays(self, spec: Any) -> np.ndarray:
+    def _floor_y(self) -> float:
+        return float(getattr(self.session.info, "floor_y", getattr(self, "_bundle_floor", 0.0)))
+
+    def _vehicle_model(self, spec: Any) -> Model:
         ref = self.session.vehicle_ref
         if ref is None:
-            return box_tank_arrays(spec)
+            return box_tank_model(spec)
         from ..sim.match import _bundle_dir
 
         folder = _bundle_dir(ref, "vehicles", ())
-        return load_glb(str(folder / "model.glb"))
+        return load_model(str(folder / "model.glb"))
 
-    def _vao(self, arrays: np.ndarray) -> Any:
-        buf = self.ctx.buffer(arrays.tobytes())
-        return self.ctx.vertex_array(self.prog, [(buf, "3f 3f 3f", "in_pos", "in_normal", "in_colour")])
+    def _texture(self, batch: Batch) -> Any:
+        """The GL texture of a batch's image (shared by batches with the same pixels)."""
+        import moderngl
+
+        if batch.image is None:
+            return None
+        key = id(batch.image)
+        if key not in self.textures:
+            img = np.ascontiguousarray(batch.image[::-1])           # OpenGL's first row is the bottom
+            tex = self.ctx.texture((img.shape[1], img.shape[0]), img.shape[2], img.tobytes())
+            tex.repeat_x = tex.repeat_y = True
+            tex.build_mipmaps()
+            self.textures[key] = tex
+        tex = self.textures[key]
+        q = self.quality
+        tex.filter = ((moderngl.LINEAR_MIPMAP_LINEAR if q.trilinear else moderngl.LINEAR_MIPMAP_NEAREST)
+                      if q.mipmaps else moderngl.LINEAR, moderngl.LINEAR)
+        return tex
+
+    def _split_arena(self) -> Model:
+        if self._split is None:
+            self._split = self.arena_model.tessellated(max(ARENA_EDGE, self.span / 10.0))
+        return self._split
+
+    def _gpu(self, model: Model, prog: Any) -> list[GpuBatch]:
+        out = []
+        for b in model.batches:
+            if not len(b.vertices):
+                continue
+            buf = self.ctx.buffer(np.ascontiguousarray(b.vertices, dtype="f4").tobytes())
+            vao = self.ctx.vertex_array(prog, [vertex_format(prog, buf, (("in_pos", 3), ("in_normal", 3),
+                                                                                 ("in_colour", 3), ("in_uv", 2)))])
+            depth = self.ctx.vertex_array(self.depth_prog, [(buf, f"3f {STRIDE - 3}x4", "in_pos")])
+            flat = self.ctx.vertex_array(self.flat_prog, [(buf, f"3f {STRIDE - 3}x4", "in_pos")])
+            out.append(GpuBatch(vao, depth, flat, self._texture(b), b.closed, b.mean_luma(), b.triangles))
+        return out
+
+    def set_quality(self, quality: Quality) -> None:
+        """Switch the quality (shaders, shadow map, particle level)."""
+        if quality != self.quality:
+            self._setup_quality(quality)
+
+    def _setup_quality(self, q: Quality) -> None:
+        import moderngl
+
+        from .particles import SessionEffects
+
+        self.quality = q
+        ctx = self.ctx
+        def scene(per_pixel: bool) -> Any:
+            d = dict(SHADOWS=q.shadow_size > 0, PER_PIXEL=per_pixel)
+            return ctx.program(vertex_shader=shaders.source(shaders.SCENE_VERTEX, **d),
+                               fragment_shader=shaders.source(shaders.SCENE_FRAGMENT, **d))
+
+        self.prog = scene(True)                                    # tanks: always Phong per pixel
+        per_pixel = q.arena_light == "pixel"
+        self.arena_prog = self.prog if per_pixel else scene(False)
+        # no triangle so big that the light's attenuation or the fog change across it
+        self.arena_shape = self._split_arena()
+        self.sky_prog = ctx.program(vertex_shader=shaders.source(shaders.SKY_VERTEX),
+                                    fragment_shader=shaders.source(shaders.SKY_FRAGMENT, CLOUDS=q.sky == "clouds"))
+        self.arena = self._gpu(self.arena_shape, self.arena_prog)
+        self.tanks = {name: self._gpu(m, self.prog) for name, m in self.tank_models.items()}
+        # far away (and in the shadow map) a tank is drawn without its small parts
+        self.tanks_far = {name: self._gpu(m.far, self.prog) if m.far is not None else self.tanks[name]
+                          for name, m in self.tank_models.items()}
+        self.cloud_tex = None
+        if q.sky == "clouds":
+            pix = cloud_pixels()
+            self.cloud_tex = ctx.texture(pix.shape[::-1], 1, pix.tobytes())
+            self.cloud_tex.repeat_x = self.cloud_tex.repeat_y = True
+            self.cloud_tex.build_mipmaps()
+            self.cloud_tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        self.shadow_fbo = None
+        if q.shadow_size:
+            n = q.shadow_size
+            self.light_vp = self._light_matrix()
+            # the arena's shadows once (it never moves), the tanks' every frame at half the size
+            self.static_tex, static_fbo = self._shadow_target(n)
+            self._draw_shadows(static_fbo, n, [(self.arena, [np.identity(4)])])
+            self.tank_shadow_size = max(n // 2, 256)
+            self.shadow_tex, self.shadow_fbo = self._shadow_target(self.tank_shadow_size)
+        self.sky_grid = self._sky_grid()
+        self.effects = SessionEffects(q.particles, seed=int(getattr(self.session.world, "seed", 0)))
+        self._particle_buf = ctx.buffer(reserve=64 * 9 * 4, dynamic=True)
+        self._corners = ctx.buffer(np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype="f4").tobytes())
+        self._beam_buf = ctx.buffer(reserve=64 * 9 * 4, dynamic=True)
+        self._make_effect_vaos()
+
+    def _make_effect_vaos(self) -> None:
+        self.particle_vao = self.ctx.vertex_array(self.particle_prog, [
+            (self._corners, "2f", "in_corner"),
+            (self._particle_buf, "4f 4f 1f/i", "in_particle", "in_rgba", "in_glow")])
+        self.beam_vao = self.ctx.vertex_array(self.beam_prog, [
+            (self._beam_buf, "3f 2f 4f", "in_pos", "in_across", "in_rgba")])
+
+    # ------------------------------------------------------------------ shadows
+    def _light_matrix(self) -> np.ndarray:
+        """The light's view-projection: from the light straight down, the frustum fitted
+        to the arena's bounding box (every corner inside)."""
+        lx, ly, lz = self.light_pos
+        view = look_at(self.light_pos, (lx, ly - 1.0, lz), up=(0.0, 0.0, -1.0))
+        (x0, y0, z0), (x1, y1, z1) = self.scene_box.tolist()
+        corners = np.array([[x, y, z, 1.0] for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)])
+        cam = (view @ corners.T).T[:, :3]
+        depth = -cam[:, 2]                                  # distance below the light
+        near = max(float(depth.min()) * 0.9, 0.1)
+        far = float(depth.max()) * 1.05 + 1.0
+        sx, sy = cam[:, 0] / depth * near, cam[:, 1] / depth * near
+        pad = 1.02
+        proj = frustum(float(sx.min()) * pad, float(sx.max()) * pad, float(sy.min()) * pad, float(sy.max()) * pad,
+                       near, far)
+        return proj @ view
+
+    @staticmethod
+    def shadow_lookup(light_vp: np.ndarray, bias: float = 0.0005) -> np.ndarray:
+        """The light's matrix as the scene shader samples with it: clip space to [0, 1]
+        texture coordinates and depth, the depth nudged towards the light."""
+        b = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5 - bias], [0, 0, 0, 1.0]])
+        return b @ light_vp
+
+    def _shadow_target(self, n: int) -> tuple[Any, Any]:
+        """A depth texture of n x n sampled with comparison (hardware PCF) and its framebuffer."""
+        import moderngl
+
+        tex = self.ctx.depth_texture((n, n))
+        tex.compare_func = "<="
+        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        tex.repeat_x = tex.repeat_y = False
+        return tex, self.ctx.framebuffer(depth_attachment=tex)
+
+    def _draw_shadows(self, fbo: Any, n: int, groups: list[tuple[list[GpuBatch], list[np.ndarray]]]) -> None:
+        """Depth from the light of each group's batches placed at each of its model matrices."""
+        import moderngl
+
+        ctx = self.ctx
+        fbo.use()
+        ctx.viewport = (0, 0, n, n)
+        ctx.enable(moderngl.DEPTH_TEST)
+        fbo.clear(depth=1.0)
+        ctx.polygon_offset = (1.5, 2.0)
+        for batches, models in groups:
+            for model in models:
+                self.depth_prog["mvp"].write(_gl(self.light_vp @ model))
+                for b in batches:
+                    # closed models cast from their back faces: the lit side never shadows itself
+                    if b.closed:
+                        ctx.enable(moderngl.CULL_FACE)
+                        ctx.cull_face = "front"
+                    else:
+                        ctx.disable(moderngl.CULL_FACE)
+                    b.depth_vao.render()
+        ctx.cull_face = "back"
+        ctx.disable(moderngl.CULL_FACE)
+        ctx.polygon_offset = (0.0, 0.0)
+
+    def _shadow_pass(self, alpha: float) -> None:
+        """The tanks' shadow map for this frame."""
+        by_kind: dict[str, list[np.ndarray]] = {}
+        for t in self.session.world.tanks:
+            by_kind.setdefault(t.spec.name, []).append(self._tank_model_matrix(t, alpha))
+        self._draw_shadows(self.shadow_fbo, self.tank_shadow_size,
+                           [(self.tanks_far[name], models) for name, models in by_kind.items()])
+
+    def _sky_grid(self, nx: int = 24, ny: int = 16) -> Any:
+        """Rows of quads over the window, bottom row first (drawn from the horizon up)."""
+        self.sky_cols, self.sky_rows = nx, ny
+        xs, ys = np.linspace(-1, 1, nx + 1), np.linspace(-1, 1, ny + 1)
+        quads = []
+        for i in range(ny):
+            for j in range(nx):
+                a, b, c, d = (xs[j], ys[i]), (xs[j + 1], ys[i]), (xs[j + 1], ys[i + 1]), (xs[j], ys[i + 1])
+                quads += [a, b, c, a, c, d]
+        buf = self.ctx.buffer(np.array(quads, dtype="f4").tobytes())
+        return self.ctx.vertex_array(self.sky_prog, [(buf, "2f", "in_pos")])
 
     # ------------------------------------------------------------------ camera
     def toggle_camera(self) -> str:
@@ -296,18 +426,38 @@ class Renderer3D:
         self._eye = None
         return self.camera
 
+    def _tank_model_matrix(self, t: Any, alpha: float) -> np.ndarray:
+        w = getattr(self.session, "world_all", self.session.world)
+        key = (id(w), w.steps, t.index, alpha)
+        cached = self._placed.get(key)
+        if cached is not None:
+            return cached
+        if len(self._placed) > 64:
+            self._placed.clear()
+        self._placed[key] = m = self._place(t, alpha)
+        return m
+
+    def _place(self, t: Any, alpha: float) -> np.ndarray:
+        x, y, z, h, pitch, roll = pose3d(self.session, t.index, alpha)
+        if not hasattr(t, "y"):
+            y = self.floor_y
+        return tank_matrix(x, z, h, y, pitch, roll)
+
     def camera_pose(self, alpha: float) -> tuple[np.ndarray, np.ndarray]:
         s = self.session
         t = s.focus_tank()
-        x, z, h = s.pose(t.index, alpha)
+        x, y, z, h, pitch, _ = pose3d(s, t.index, alpha)
+        if not hasattr(t, "y"):
+            y = self.floor_y
         f = np.array([math.cos(h), 0.0, math.sin(h)])
-        p = np.array([x, 0.0, z])
+        p = np.array([x, y, z])
         size = max(t.spec.radius, 1.0)
         if self.camera == "first-person":
             eye = p + np.array([0.0, t.spec.height + 0.4, 0.0]) + f * 0.3 * size
-            return eye, eye + f * 10.0 + np.array([0.0, -0.6, 0.0])
+            look = f * math.cos(pitch) + np.array([0.0, math.sin(pitch), 0.0])
+            return eye, eye + look * 10.0 + np.array([0.0, -0.6, 0.0])
         if self.camera == "overview":
-            c = np.array([self.centre[0], 0.0, self.centre[1]])
+            c = np.array([self.centre[0], self.floor_y, self.centre[1]])
             return c + np.array([0.0, 0.95 * self.span, 0.45 * self.span]), c
         eye = p - f * 4.5 * size + np.array([0.0, 2.2 * size, 0.0])
         # a wall between the tank and the camera would hide the tank: pull the camera in
@@ -321,83 +471,190 @@ class Renderer3D:
         eye, target = self.camera_pose(alpha)
         w, h = self.size
         self.view = look_at(eye, target)
-        self.proj = perspective(math.radians(60.0), w / h, 0.3, 4.0 * self.span + 100.0)
+        self.proj = perspective(FOV_Y, w / h, 0.3, 4.0 * self.span + 100.0)
+        self._eye = eye
         return self.proj, self.view, eye
 
     def project(self, point) -> tuple[float, float, float]:
         """Pixel (column, row from the top) and depth of a world point in the last frame."""
         p = self.proj @ self.view @ np.append(np.asarray(point, dtype=np.float64), 1.0)
-        ndc = p[:3] / p[3]
+        ndc = p[:3] / p[3] if abs(p[3]) > 1e-12 else np.array([0.0, 0.0, 2.0])
+        if p[3] <= 0:
+            ndc[2] = 2.0                      # behind the camera
         w, h = self.size
         return (ndc[0] + 1) / 2 * w, (1 - ndc[1]) / 2 * h, ndc[2]
 
+    def camera_yaw(self) -> float:
+        """The heading the camera looks along (for the HUD's direction markers)."""
+        fwd = -self.view[2, :3]
+        return math.atan2(fwd[2], fwd[0])
+
     # ------------------------------------------------------------------ frame
-    def render(self, alpha: float = 1.0, fps: float = 0.0, message: str | None = None, hud: bool = True) -> np.ndarray | None:
+    def render(self, alpha: float = 1.0, fps: float = 0.0, message: str | None = None,
+               hud: bool = True) -> np.ndarray | None:
         """Draw one frame; headless, return it as an (h, w, 3) uint8 array (top row first)."""
         import moderngl
 
-        ctx, prog, s = self.ctx, self.prog, self.session
+        ctx, s = self.ctx, self.session
+        proj, view, eye = self.matrices(alpha)
+        pv = proj @ view
+        hud_rects = self._prepare_hud(fps, alpha, message) if hud else []
+        self.effects.sync(s, self.floor_y)
+        if self.shadow_fbo is not None:
+            self._shadow_pass(alpha)
         self.fbo.use()
         ctx.viewport = (0, 0, *self.size)
         ctx.clear(*SKY, 1.0)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.disable(moderngl.BLEND)
-        proj, view, eye = self.matrices(alpha)
-        pv = proj @ view
-        prog["light_pos"].value = self.light_pos
-        prog["light_colour"].value = (0.8, 0.78, 0.72)
-        prog["light_range"].value = 4.0 * self.span
-        # gentle fall-off: 1 under the light, about 75 % at the arena's corners; lit
-        # tops stay just under white so colours keep their hue
-        prog["attenuation"].value = (1.0, 0.2 / self.span, 0.2 / self.span ** 2)
-        prog["ambient"].value = (0.36, 0.37, 0.4)
-        prog["eye"].value = tuple(float(v) for v in eye)
-        prog["alpha"].value = 1.0
-        self._draw(self.arena, pv, np.identity(4), (0, 0, 0), 0.0)
+        self._scene_uniforms(self.prog, eye)
+        if self.arena_prog is not self.prog:
+            self._scene_uniforms(self.arena_prog, eye)
         for t in s.world.tanks:
             if s.focus() == t.index and self.camera == "first-person":
                 continue            # we are inside it
-            x, z, h = s.pose(t.index, alpha)
             tint = np.array(tank_colour(t.index)) / 255.0 if t.alive else np.array((0.08, 0.07, 0.06))
-            amount = TINT if t.alive else 0.8
-            self._draw(self.tank_models[t.spec.name], pv, tank_matrix(x, z, h), tint, amount)
-        for p in s.shell_points(alpha):
-            m = np.diag([0.25, 0.25, 0.25, 1.0])
-            m[:3, 3] = p
-            self._draw(self.sphere, pv, m, (1.0, 0.9, 0.4), 1.0, emissive=(0.8, 0.6, 0.2))
-        if s.effects:
-            ctx.enable(moderngl.BLEND)
-            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-            for e in s.effects:
-                a = e.age(s.t)
-                if a >= 1.0:
-                    continue
-                r = {"flash": 0.7, "impact": 1.0, "explosion": 4.5}[e.kind] * (0.4 + a)
-                colour = {"flash": (1.0, 0.85, 0.4), "impact": (1.0, 0.6, 0.2), "explosion": (1.0, 0.45, 0.1)}[e.kind]
-                m = np.diag([r, r, r, 1.0])
-                m[:3, 3] = (e.x, e.y, e.z)
-                prog["alpha"].value = float(max(1.0 - a, 0.0))
-                self._draw(self.sphere, pv, m, colour, 1.0, emissive=tuple(0.8 * c for c in colour))
-            prog["alpha"].value = 1.0
-        if hud:
-            self._draw_hud(fps, alpha, message)
+            model = self._tank_model_matrix(t, alpha)
+            self._draw(self.prog, self._lod(t, model, eye), pv, model, tint, TINT)
+        self._draw(self.arena_prog, self.arena, pv, np.identity(4), (0, 0, 0), 0.0)
+        self._draw_sky(pv, eye)
+        self._draw_effects(pv, eye, alpha)
+        if hud_rects:
+            self._composite_hud(hud_rects)
         if not self.own_ctx:
             return None
         data = self.fbo.read(components=3, alignment=1)
         w, h = self.size
         return np.frombuffer(data, np.uint8).reshape(h, w, 3)[::-1].copy()
 
-    def _draw(self, vao: Any, pv: np.ndarray, model: np.ndarray, tint, amount: float,
-              emissive=(0.0, 0.0, 0.0)) -> None:
-        self.prog["mvp"].write(_gl(pv @ model))
-        self.prog["model"].write(_gl(model))
-        self.prog["tint"].value = tuple(float(c) for c in tint)
-        self.prog["tint_amount"].value = float(amount)
-        self.prog["emissive"].value = tuple(float(c) for c in emissive)
-        vao.render()
+    def _scene_uniforms(self, prog: Any, eye: np.ndarray) -> None:
+        set_uniform(prog, "light_pos", self.light_pos)
+        set_uniform(prog, "light_colour", (0.85, 0.82, 0.74))
+        set_uniform(prog, "light_range", 4.0 * self.span)
+        # gentle fall-off: 1 under the light, about 75 % at the arena's corners; lit
+        # tops stay just under white so colours keep their hue
+        set_uniform(prog, "attenuation", (1.0, 0.2 / self.span, 0.2 / self.span ** 2))
+        set_uniform(prog, "ambient", (0.34, 0.36, 0.40))
+        set_uniform(prog, "eye", tuple(float(v) for v in eye))
+        set_uniform(prog, "alpha", 1.0)
+        set_uniform(prog, "fog_colour", SKY)
+        # haze: a fifth of the colour gone at twice the arena's size (1 / (1 + k d^2) = 0.8)
+        set_uniform(prog, "fog_k", 0.25 / (2.0 * max(self.span, 40.0)) ** 2)
+        set_uniform(prog, "tex", 0)
+        if self.shadow_fbo is not None:
+            set_uniform(prog, "light_vp", _gl(self.shadow_lookup(self.light_vp)))
+            set_uniform(prog, "shadow_static", 1)
+            set_uniform(prog, "shadow_tanks", 2)
+            self.static_tex.use(1)
+            self.shadow_tex.use(2)
 
-    def _draw_hud(self, fps: float, alpha: float, message: str | None) -> None:
+    def _draw(self, prog: Any, batches: list[GpuBatch], pv: np.ndarray, model: np.ndarray, tint, amount: float,
+              emissive=(0.0, 0.0, 0.0)) -> None:
         import moderngl
+
+        set_uniform(prog, "mvp", _gl(pv @ model))
+        set_uniform(prog, "model", _gl(model))
+        set_uniform(prog, "tint", tuple(float(c) for c in tint))
+        set_uniform(prog, "tint_amount", float(amount))
+        set_uniform(prog, "emissive", tuple(float(c) for c in emissive))
+        for b in batches:
+            if b.closed:
+                self.ctx.enable(moderngl.CULL_FACE)
+            else:
+                self.ctx.disable(moderngl.CULL_FACE)
+            if b.texture is not None:
+                b.texture.use(0)
+            set_uniform(prog, "use_texture", 1.0 if b.texture is not None else 0.0)
+            set_uniform(prog, "tex_luma", b.luma)
+            b.vao.render()
+        self.ctx.disable(moderngl.CULL_FACE)
+
+    def _lod(self, t: Any, model: np.ndarray, eye: np.ndarray) -> list[GpuBatch]:
+        """A tank's batches: without its small parts when it is under LOD_PIXELS tall on screen."""
+        d = float(np.linalg.norm(model[:3, 3] - eye))
+        tall = t.spec.height / max(2.0 * d * math.tan(FOV_Y / 2), 1e-6) * self.size[1]
+        return self.tanks[t.spec.name] if tall >= LOD_PIXELS else self.tanks_far[t.spec.name]
+
+    def _draw_sky(self, pv: np.ndarray, eye: np.ndarray) -> None:
+        import moderngl
+
+        prog = self.sky_prog
+        prog["inv_view_proj"].write(_gl(np.linalg.inv(pv)))
+        prog["horizon"].value = SKY
+        prog["zenith"].value = ZENITH
+        d = np.array(self.light_pos) - np.array([self.centre[0], self.floor_y, self.centre[1]])
+        prog["sun_dir"].value = tuple(float(v) for v in (d / np.linalg.norm(d) * np.array([0.4, 1.0, 0.4])))
+        prog["eye"].value = tuple(float(v) for v in eye)
+        set_uniform(prog, "time", float(self.session.t))
+        if self.cloud_tex is not None:
+            prog["clouds"].value = 0
+            self.cloud_tex.use(0)
+        # the sky is only above the horizon: below it the clear colour (the horizon's,
+        # the fog's) shows where nothing was drawn, and the grid's lower rows are not drawn
+        fwd = -self.view[2, :3]
+        flat = np.array([fwd[0], 0.0, fwd[2]])
+        lowest = 0
+        if np.linalg.norm(flat) > 1e-6:
+            far = eye + flat / np.linalg.norm(flat) * 1e4 + np.array([0.0, -0.02 * 1e4, 0.0])
+            clip = pv @ np.append(far, 1.0)
+            if clip[3] > 0:
+                ndc_y = clip[1] / clip[3]
+                if ndc_y > 1.0:
+                    return                          # looking down: no sky in view
+                lowest = int(np.clip(math.floor((ndc_y + 1.0) / 2.0 * self.sky_rows), 0, self.sky_rows - 1))
+        self.ctx.depth_func = "<="
+        self.ctx.depth_mask = False
+        per_row = 6 * self.sky_cols
+        self.sky_grid.render(moderngl.TRIANGLES, vertices=(self.sky_rows - lowest) * per_row, first=lowest * per_row)
+        self.ctx.depth_mask = True
+        self.ctx.depth_func = "<"
+
+    def _draw_effects(self, pv: np.ndarray, eye: np.ndarray, alpha: float) -> None:
+        import moderngl
+
+        from .particles import SessionEffects
+
+        parts = self.effects.particles.instances(eye)
+        beams = SessionEffects.tracers(self.session, alpha, eye)
+        if not len(parts) and not len(beams):
+            return
+        ctx = self.ctx
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA      # premultiplied alpha
+        ctx.depth_mask = False
+        if len(beams):
+            self._upload(beams, "_beam_buf")
+            self.beam_prog["view_proj"].write(_gl(pv))
+            self.beam_vao.render(moderngl.TRIANGLES, vertices=len(beams))
+        if len(parts):
+            self._upload(parts, "_particle_buf")
+            p = self.particle_prog
+            p["view_proj"].write(_gl(pv))
+            p["cam_right"].value = tuple(float(v) for v in self.view[0, :3])
+            p["cam_up"].value = tuple(float(v) for v in self.view[1, :3])
+            p["eye"].value = tuple(float(v) for v in eye)
+            p["max_screen"].value = PARTICLE_MAX_SCREEN
+            p["tan_half_fov"].value = math.tan(FOV_Y / 2)
+            self.particle_vao.render(moderngl.TRIANGLE_STRIP, vertices=4, instances=len(parts))
+        ctx.depth_mask = True
+        ctx.disable(moderngl.BLEND)
+
+    def _upload(self, rows: np.ndarray, name: str) -> None:
+        """Write rows into a dynamic buffer, growing it (and its vertex arrays) when needed."""
+        data = np.ascontiguousarray(rows, dtype="f4").tobytes()
+        buf = getattr(self, name)
+        if len(data) > buf.size:
+            grown = max(len(data), 2 * buf.size)
+            buf.release()
+            setattr(self, name, self.ctx.buffer(reserve=grown, dynamic=True))
+            self._make_effect_vaos()
+            buf = getattr(self, name)
+        buf.write(data)
+
+    def _prepare_hud(self, fps: float, alpha: float, message: str | None) -> list[Any]:
+        """Draw the HUD on its surface and upload the rectangles it covers, before the
+        scene: a texture upload waits for the rasteriser, so done after the scene it
+        would stall the frame."""
         import pygame
 
         from .hud import Hud
@@ -406,9 +663,20 @@ class Renderer3D:
             self._hud = Hud(self.session, self.size)
             self._hud_surface = pygame.Surface(self.size, pygame.SRCALPHA)
         surf = self._hud_surface
-        surf.fill((0, 0, 0, 0))
-        rects = self._hud.draw(surf, self.session, fps, alpha, message, view=f"3D {self.camera}")
-        self.hud_tex.write(pygame.image.tobytes(surf, "RGBA"))
+        for r in self._hud_rects:                 # clear only what the last frame drew
+            surf.fill((0, 0, 0, 0), r)
+        rects = self._hud.draw(surf, self.session, fps, alpha, message, view=f"3D {self.camera}",
+                               project=self.project, facing=self.camera_yaw())
+        self._hud_rects = rects
+        self.hud_tex = self.hud_texs[1] if self.hud_tex is self.hud_texs[0] else self.hud_texs[0]
+        for r in rects:
+            if r.w > 0 and r.h > 0:
+                self.hud_tex.write(pygame.image.tobytes(surf.subsurface(r), "RGBA"), viewport=(r.x, r.y, r.w, r.h))
+        return rects
+
+    def _composite_hud(self, rects: list[Any]) -> None:
+        import moderngl
+
         self.ctx.disable(moderngl.DEPTH_TEST)
         self.ctx.enable(moderngl.BLEND)
         self.ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
@@ -422,6 +690,56 @@ class Renderer3D:
         self.ctx.scissor = None
         self.ctx.disable(moderngl.BLEND)
 
+    # ------------------------------------------------------------------ benchmark reference
+    def render_reference(self, alpha: float = 1.0) -> np.ndarray | None:
+        """The benchmark's reference: the same triangles (arena and tanks) with depth
+        test, one colour, no light, texture, shadow, sky, effects or HUD; read back
+        like :meth:`render` (the figure every quality level is divided by)."""
+        import moderngl
+
+        ctx, s = self.ctx, self.session
+        proj, view, eye = self.matrices(alpha)
+        pv = proj @ view
+        self.fbo.use()
+        ctx.viewport = (0, 0, *self.size)
+        ctx.clear(*SKY, 1.0)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.disable(moderngl.BLEND)
+        self.flat_prog["colour"].value = (0.5, 0.5, 0.5)
+        for t in s.world.tanks:
+            if s.focus() == t.index and self.camera == "first-person":
+                continue
+            model = self._tank_model_matrix(t, alpha)
+            self.flat_prog["mvp"].write(_gl(pv @ model))
+            for b in self._lod(t, model, eye):
+                b.flat_vao.render()
+        self.flat_prog["mvp"].write(_gl(pv))
+        for b in self.arena:
+            b.flat_vao.render()
+        if not self.own_ctx:
+            return None
+        data = self.fbo.read(components=3, alignment=1)
+        w, h = self.size
+        return np.frombuffer(data, np.uint8).reshape(h, w, 3)[::-1].copy()
+
+    def triangles(self, alpha: float = 1.0) -> int:
+        """Triangles of the arena and the tanks in the frame the camera sees now."""
+        _, _, eye = self.matrices(alpha)
+        return sum(b.triangles for b in self.arena) + sum(
+            sum(b.triangles for b in self._lod(t, self._tank_model_matrix(t, alpha), eye))
+            for t in self.session.world.tanks)
+
     def release(self) -> None:
         if self.own_ctx:
             self.ctx.release()
+
+
+def standalone_context() -> Any:
+    """A headless OpenGL 3.3 context through EGL (Mesa llvmpipe without a GPU)."""
+    import moderngl
+
+    try:
+        return moderngl.create_standalone_context(backend="egl", require=330)
+    except Exception as e:
+        raise TanktoolError(f"cannot create a headless OpenGL 3.3 context through EGL ({e}); "
+                            "install libegl1 and libgl1-mesa-dri, or use --view top") from None

@@ -181,7 +181,12 @@ class TopView:
             self._draw_agents(surface, alpha)
         for t in s.world.tanks:
             self._draw_tank(surface, t, alpha)
-        for x, _, z in s.shell_points(alpha).tolist():
+        for sh, (x, _, z) in zip(s.world.shells, s.shell_points(alpha).tolist()):
+            # a tracer: the shell and a streak behind it
+            speed = math.hypot(sh.vx, sh.vz) or 1.0
+            tail = min(14.0, math.hypot(x - sh.ox, z - sh.oz))
+            pygame.draw.line(surface, (255, 200, 90), self.to_px(x - sh.vx / speed * tail, z - sh.vz / speed * tail),
+                             self.to_px(x, z), max(int(0.2 * self.scale), 1))
             pygame.draw.circle(surface, (255, 240, 120), self.to_px(x, z), max(int(0.35 * self.scale), 2))
         for e in s.effects:
             a = e.age(s.t)
@@ -190,7 +195,7 @@ class TopView:
             radius = {"flash": 1.5, "impact": 1.2, "explosion": 5.0}[e.kind] * self.scale * (0.4 + a)
             colour = {"flash": (255, 230, 140), "impact": (255, 150, 60), "explosion": (255, 110, 30)}[e.kind]
             pygame.draw.circle(surface, colour, self.to_px(e.x, e.z), max(int(radius), 2), 0 if a < 0.5 else 2)
-        self.hud.draw(surface, s, fps, alpha, message, view="top view")
+        self.hud.draw(surface, s, fps, alpha, message, view="top view", to_px=self.to_px)
 
     def _draw_tank(self, surface: pygame.Surface, t: Any, alpha: float) -> None:
         x, z, h = self.session.pose(t.index, alpha)

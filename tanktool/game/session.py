@@ -39,6 +39,10 @@ class Effect:
     y: float
     z: float
     t0: float
+    #: a muzzle flash: the heading the gun points at; an impact: the unit (x, y, z) back
+    #: towards the shooter (sparks fly that way)
+    heading: float | None = None
+    back: tuple[float, float, float] | None = None
 
     def age(self, t: float) -> float:
         """0 when it starts, 1 when it is over."""
@@ -55,12 +59,35 @@ def update_effects(effects: list[Effect], events: Sequence[Event], world: World)
             tank = world.tanks[e.tank]
             mx, my, mz = tank.spec.muzzle_local
             x, z = tank.to_world(mx, mz)
-            out.append(Effect("flash", x, my, z, t))
+            out.append(Effect("flash", x, my + float(getattr(tank, "y", 0.0)), z, t, heading=tank.heading))
         elif e.kind == "hit":
-            out.append(Effect("impact", e.x, 1.2, e.z, t))
+            victim = world.tanks[e.other] if 0 <= e.other < len(world.tanks) else None
+            base = float(getattr(victim, "y", 0.0)) if victim is not None else 0.0
+            height = 0.6 * victim.spec.height if victim is not None else 1.2
+            shooter = world.tanks[e.tank] if 0 <= e.tank < len(world.tanks) else None
+            back = None
+            if shooter is not None:
+                dx, dz = shooter.x - e.x, shooter.z - e.z
+                n = math.hypot(dx, dz)
+                back = (dx / n, 0.35, dz / n) if n > 1e-9 else None
+            out.append(Effect("impact", e.x, base + height, e.z, t, back=back))
         elif e.kind == "kill":
-            out.append(Effect("explosion", e.x, 1.0, e.z, t))
+            victim = world.tanks[e.other] if 0 <= e.other < len(world.tanks) else None
+            base = float(getattr(victim, "y", 0.0)) if victim is not None else 0.0
+            top = 0.8 * victim.spec.height if victim is not None else 1.0
+            out.append(Effect("explosion", e.x, base + top, e.z, t))
     return out
+
+
+#: events the HUD shows (kill feed, hit markers) stay this long [s]
+FEED_S = 8.0
+
+
+def update_feed(feed: list[Event], events: Sequence[Event], t: float) -> list[Event]:
+    """The recent hits and kills the HUD shows: those of the last FEED_S seconds."""
+    kept = [e for e in feed if t - e.t < FEED_S]
+    kept.extend(e for e in events if e.kind in ("hit", "kill", "respawn"))
+    return kept
 
 
 Driver = Callable[[World, Any], Command]
@@ -115,6 +142,8 @@ class GameSession:
             if player:
                 self.drivers[0] = None
         self.effects: list[Effect] = []
+        #: hits, kills and respawns of the last few seconds (kill feed, hit markers)
+        self.feed: list[Event] = []
         self.prev = self._poses()
         self.last_events: list[Event] = []
         #: the tank the camera follows when there is no player (None: the first live one)
@@ -134,8 +163,10 @@ class GameSession:
     def t(self) -> float:
         return self.world.t
 
-    def _poses(self) -> list[tuple[float, float, float]]:
-        return [(*t.position, t.heading) for t in self.world.tanks]
+    def _poses(self) -> list[tuple[float, ...]]:
+        # (x, z, heading, y, pitch, roll): height and tilt when the simulation has them (2.5D)
+        return [(*t.position, t.heading, float(getattr(t, "y", 0.0)), float(getattr(t, "pitch", 0.0)),
+                 float(getattr(t, "roll", 0.0))) for t in self.world.tanks]
 
     def commands(self, player_command: Command = IDLE) -> list[Command]:
         w = self.world
@@ -153,6 +184,7 @@ class GameSession:
         if self.recorder is not None:
             self.events.extend(events)
         self.effects = update_effects(self.effects, events, w)
+        self.feed = update_feed(self.feed, events, w.t)
         self.last_events = events
         return events
 
@@ -206,7 +238,7 @@ class GameSession:
     def pose(self, i: int, alpha: float = 1.0) -> tuple[float, float, float]:
         """(x, z, heading) of tank i's vehicle-frame origin, ``alpha`` of the way from the
         previous step to the current one."""
-        x0, z0, h0 = self.prev[i]
+        x0, z0, h0 = self.prev[i][:3]
         t = self.world.tanks[i]
         x1, z1 = t.position
         h1 = t.heading
@@ -214,6 +246,11 @@ class GameSession:
             return x1, z1, h1
         dh = math.remainder(h1 - h0, 2.0 * math.pi)
         return x0 + alpha * (x1 - x0), z0 + alpha * (z1 - z0), h0 + alpha * dh
+
+    def pose3d(self, i: int, alpha: float = 1.0) -> tuple[float, float, float, float, float, float]:
+        """(x, y, z, heading, pitch, roll) of tank i between the last two steps; y, pitch
+        and roll are 0 until the simulation gives tanks a height and a tilt."""
+        return pose3d(self, i, alpha)
 
     def shell_points(self, alpha: float = 1.0) -> np.ndarray:
         """(k, 3) positions of the shells in flight."""
@@ -238,6 +275,19 @@ class GameSession:
         """(name, kills, deaths, hit points, alive) best first."""
         rows = [(t.name, t.kills, t.deaths, max(t.hp, 0.0), t.alive) for t in self.world.tanks]
         return sorted(rows, key=lambda r: (-r[1], r[2]))
+
+
+def pose3d(session: Any, i: int, alpha: float = 1.0) -> tuple[float, float, float, float, float, float]:
+    """A session's tank i as (x, y, z, heading, pitch, roll) ``alpha`` of the way from its
+    previous step (sessions that keep only (x, z, heading) give the current tilt)."""
+    x, z, h = session.pose(i, alpha)
+    t = getattr(session, "world_all", session.world).tanks[i]     # a network match shows only some
+    now = (float(getattr(t, "y", 0.0)), float(getattr(t, "pitch", 0.0)), float(getattr(t, "roll", 0.0)))
+    prev = session.prev[i][3:6] if i < len(session.prev) and len(session.prev[i]) >= 6 else now
+    if math.hypot(*(a - b for a, b in zip(t.position, session.prev[i][:2]))) > 5.0:
+        prev = now                                    # a respawn is a jump
+    y, pitch, roll = (a + alpha * (b - a) for a, b in zip(prev, now))
+    return x, y, z, h, pitch, roll
 
 
 def _stored_ref(ref: Any) -> str | None:

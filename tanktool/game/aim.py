@@ -1,0 +1,94 @@
+"""Where the player's gun points and where its shell would land, for the crosshair.
+
+The shell is made by the simulation's own ``sim.weapons.fire`` (the same speed, start
+point, pitch, drift with the tank's velocity, and first wall on its line or, on an arena
+with relief, the time its flight first meets the model, as a real shot), then followed
+under gravity until it meets that wall, the model or the ground; tanks on the way are
+tested against their footprint circle and height.  Nothing here changes the world.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+#: how far the crosshair looks along the barrel when no wall is in the way [m]
+SIGHT = 150.0
+#: samples along the flight when looking for tanks on the way
+SAMPLES = 48
+
+
+@dataclass
+class Aim:
+    """``aim``: the point the barrel points at (the first wall on its line, or SIGHT
+    metres ahead); ``impact``: where the shell stops (a wall, the ground or a tank);
+    ``target``: the index of the tank it would hit, or None; ``time``: its flight [s]."""
+
+    muzzle: tuple[float, float, float]
+    aim: tuple[float, float, float]
+    impact: tuple[float, float, float]
+    target: int | None
+    time: float
+
+
+def _shell(world: Any, tank: Any) -> Any:
+    from ..sim import weapons
+
+    ground = getattr(world, "ground", None)
+    try:
+        return weapons.fire(tank, world.walls, ground) if ground is not None else weapons.fire(tank, world.walls)
+    except TypeError:                         # a fire() of another shape: the plain rule
+        spec = tank.spec
+        v = spec.shell_speed
+        shell = weapons.Shell(tank.index, tank.x, float(getattr(tank, "y", 0.0)) + spec.muzzle_local[1], tank.z,
+                              v * tank.c + tank.vx, 0.0, v * tank.s + tank.vz, spec.shell_damage)
+        reach = math.hypot(shell.vx, shell.vz) * shell.flight_time()
+        hit = world.walls.first_hit(shell.ox, shell.oz, shell.ox + shell.ux * reach, shell.oz + shell.uz * reach)
+        if hit is not None:
+            shell.wall_dist = hit[0] * reach
+        return shell
+
+
+def predict(world: Any, tank: Any, floor_y: float = 0.0) -> Aim:
+    """The crosshair's two points for ``tank`` firing now."""
+    from ..sim.weapons import GRAVITY
+
+    s = _shell(world, tank)
+    x0, y0, z0 = s.x, s.y, s.z
+    base = float(getattr(tank, "y", floor_y))
+    # the barrel's line (at the hull's pitch): to the first wall on it, else SIGHT ahead
+    pitch = float(getattr(tank, "pitch", 0.0))
+    hit = world.walls.first_hit(x0, z0, x0 + tank.c * SIGHT, z0 + tank.s * SIGHT)
+    d = hit[0] * SIGHT if hit is not None else SIGHT
+    aim = (x0 + tank.c * d, y0 + math.tan(pitch) * d, z0 + tank.s * d)
+    vh = math.hypot(s.vx, s.vz)
+    stop_at = float(getattr(s, "stop_at", math.nan))
+    if not math.isnan(stop_at):               # on a ground: where the flight meets the model
+        t_end = stop_at if math.isfinite(stop_at) else SIGHT / max(vh, 1.0)
+    else:
+        # the ground is the tank's own floor
+        drop = max(y0 - base, 0.0)
+        t_ground = (s.vy + math.sqrt(s.vy * s.vy + 2.0 * GRAVITY * drop)) / GRAVITY
+        t_wall = s.wall_dist / vh if vh > 0 and math.isfinite(s.wall_dist) else math.inf
+        t_end = min(t_ground, t_wall)
+
+    def at(t: float) -> tuple[float, float, float]:
+        return x0 + s.vx * t, y0 + s.vy * t - 0.5 * GRAVITY * t * t, z0 + s.vz * t
+
+    target = None
+    steps = max(int(SAMPLES), 2)
+    for k in range(1, steps + 1):
+        t = t_end * k / steps
+        px, py, pz = at(t)
+        for other in world.tanks:
+            if other.index == tank.index or not other.alive:
+                continue
+            oy = float(getattr(other, "y", floor_y))
+            if (px - other.x) ** 2 + (pz - other.z) ** 2 < other.spec.radius ** 2 and oy <= py <= oy + other.spec.height:
+                target = other.index
+                t_end = t
+                break
+        if target is not None:
+            break
+    return Aim((x0, y0, z0), aim, at(t_end), target, t_end)

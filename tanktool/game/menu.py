@@ -1,0 +1,365 @@
+"""The start menu and the settings page: drawing them and what keys, joystick and
+mouse do there.
+
+The main menu lists the match's choices on the left and shows rendered previews of
+the chosen arena and vehicle on the right (game/thumbnails.py).  Keys: up/down (W/S)
+choose, left/right (A/D) change, Enter selects, Esc quits; the joystick's hat and
+button 0 do the same.  The mouse: pointing at an item selects it, a click on ``<`` or
+``>`` (or the right button) changes a choice, a click elsewhere on it moves it on, the
+wheel turns it, a click on a preview shows the next arena or vehicle, and a click on a
+field (address, name, password) starts typing there.
+
+The settings page holds the graphics quality (a preset, and shadows or particles
+overriding it), the resolution and full screen; every change is saved at once to
+``settings.toml`` (game/quality.py) and used from the next match on.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pygame
+
+from .hud import panel, text
+from .quality import NAME_CHARS, PARTICLES, PRESETS, SHADOWS, save_settings
+
+BG = (18, 22, 20)
+HILITE = (250, 210, 70)
+PLAIN = (220, 220, 220)
+HELP = (170, 170, 170)
+ADDRESS_CHARS = set("0123456789.:abcdefghijklmnopqrstuvwxyz")
+MAX_PASSWORD = 64
+FIELDS = ("address", "name", "password")
+ACTION_LABELS = {"settings": "settings...", "bindings": "key and joystick bindings...", "start": "START", "quit": "quit",
+                 "back": "back"}
+SETTINGS_ITEMS = ("quality", "shadows", "particles", "resolution", "fullscreen", "back")
+
+
+# ---------------------------------------------------------------- labels
+def _shown(value: Any) -> str:
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    if value is None:
+        return "built-in box tank"
+    return str(value)
+
+
+def item_label(app: Any, item: str, selected: bool) -> tuple[str, str]:
+    """(label, value) of a main-menu item, as drawn in two columns."""
+    m = app.menu
+    if item in ACTION_LABELS:
+        label = ACTION_LABELS[item]
+        if item == "start" and m.network.value != "off":
+            label = f"START: {m.network.value} {m.address}"
+        return label, ""
+    if item in FIELDS:
+        typing = app.editing and app.field == item
+        value = getattr(m, item)
+        if item == "password":
+            shown = "*" * len(value) + ("_" if typing else "") if value or typing else "none"
+        elif item == "name":
+            shown = value + ("_" if typing else "") if value or typing else "(for network play)"
+        else:
+            shown = value + ("_" if typing else "")
+        return item, f"[ {shown} ]" + ("" if app.editing or not selected else "  Enter: type")
+    c = getattr(m, item)
+    return c.label, f"<  {_shown(c.value)}  >"
+
+
+def settings_label(app: Any, item: str) -> tuple[str, str]:
+    s = app.settings
+    if item == "back":
+        return "back", ""
+    if item == "quality":
+        return "quality", f"<  {s.quality}  >"
+    if item in ("shadows", "particles"):
+        v = getattr(s, item)
+        preset = getattr(PRESETS[s.quality], item)
+        return item, f"<  {v if v is not None else f'as the preset ({preset})'}  >"
+    c = getattr(app.menu, item)
+    return c.label, f"<  {_shown(c.value)}  >"
+
+
+# ---------------------------------------------------------------- drawing
+def _list(surf: "pygame.Surface", labels: list[tuple[str, str]], cursor: int, x: int, y: int, line: int,
+          size: int) -> list[tuple[int, "pygame.Rect"]]:
+    """Draw a list of (label, value) in two columns; return each item's clickable rectangle."""
+    hits = []
+    w = surf.get_width()
+    column = max(int(size * 6.2), 90)
+    for i, (label, value) in enumerate(labels):
+        colour = HILITE if i == cursor else PLAIN
+        if i == cursor:
+            text(surf, ">", (x - size // 2 - 4, y), size, colour)
+        r = text(surf, label, (x, y), size, colour)
+        if value:
+            r = r.union(text(surf, value, (x + column, y), size, colour))
+        hits.append((i, pygame.Rect(x, y - 2, max(r.right - x, int(w * 0.38)), line)))
+        y += line
+    return hits
+
+
+def draw_menu(app: Any, surf: "pygame.Surface") -> None:
+    m = app.menu
+    surf.fill(BG)
+    w, h = surf.get_size()
+    title = max(min(72, h // 8), 28)
+    text(surf, "tanktool", (w // 2, 16), title, anchor="midtop")
+    top = 16 + title + 14
+    items = m.ITEMS
+    line = max(min(36, (h - top - 70) // len(items)), 14)
+    size = max(int(line * 0.8), 13)
+    wide = w >= 640
+    x = int(w * 0.06) if wide else 18
+    app.menu_hits = _list(surf, [item_label(app, it, i == m.cursor) for i, it in enumerate(items)], m.cursor,
+                          x, top, line, size)
+    app.preview_hits = []
+    if wide:
+        # two 16:9 pictures one above the other, as large as the window lets them be
+        ph = min(int(w * 0.36) * 9 // 16, (h - top - 80) // 2 - 24)
+        pw = ph * 16 // 9
+        px = w - pw - int(w * 0.05)
+        py = top
+        for kind, choice in (("arenas", m.arena), ("vehicles", m.vehicle)):
+            pic = app.preview(kind, choice.value, (pw, ph))
+            rect = pygame.Rect(px, py, pw, ph)
+            pygame.draw.rect(surf, (70, 80, 74), rect.inflate(6, 6), 3)
+            if pic is None:                      # rendered on the next frame: the menu shows first
+                surf.fill((40, 44, 42), rect)
+                text(surf, "rendering preview...", rect.center, 24, HELP, anchor="center")
+            else:
+                surf.blit(pic, rect)
+            caption = f"{'arena' if kind == 'arenas' else 'vehicle'}: {_shown(choice.value)}"
+            text(surf, caption, (rect.x + 8, rect.bottom - 6), 24, anchor="bottomleft")
+            app.preview_hits.append((kind, rect))
+            py += ph + 24
+    text(surf, "up/down choose, left/right or mouse change, Enter or click select, Esc quit", (w // 2, h - 56),
+         max(min(22, w // 40), 14), HELP, anchor="midtop")
+    if app.notice:
+        text(surf, app.notice, (w // 2, h - 30), 22, (240, 160, 120), anchor="midtop")
+
+
+def draw_settings(app: Any, surf: "pygame.Surface") -> None:
+    surf.fill(BG)
+    w, h = surf.get_size()
+    text(surf, "settings", (w // 2, 24), max(min(60, h // 9), 26), anchor="midtop")
+    line = max(min(40, (h - 200) // len(SETTINGS_ITEMS)), 16)
+    x = int(w * 0.12) if w >= 640 else 18
+    app.menu_hits = _list(surf, [settings_label(app, it) for it in SETTINGS_ITEMS], app.settings_cursor,
+                          x, 100, line, max(int(line * 0.8), 13))
+    q = app.settings.graphics()
+    lines = [f"shadows {q.shadows} ({q.shadow_size or 'no'} map), particles {q.particles}, sky {q.sky}, "
+             f"arena lit per {q.arena_light}",
+             "low keeps software OpenGL (Mesa llvmpipe) fastest; high is everything on"]
+    y = 100 + line * len(SETTINGS_ITEMS) + 16
+    rects = [text(surf, s, (x, y + 26 * i), 22, HELP) for i, s in enumerate(lines)]
+    panel(surf, rects[0].unionall(rects[1:]), (30, 36, 34, 255))
+    for i, s in enumerate(lines):
+        text(surf, s, (x, y + 26 * i), 22, HELP)
+    text(surf, "saved at once; a new resolution opens with the next match.   Esc: back", (w // 2, h - 56), 20,
+         HELP, anchor="midtop")
+    if app.notice:
+        text(surf, app.notice, (w // 2, h - 30), 22, (170, 220, 170), anchor="midtop")
+
+
+# ---------------------------------------------------------------- input
+def _choice_step(event: Any) -> int:
+    if event.type == pygame.KEYDOWN:
+        return {pygame.K_LEFT: -1, pygame.K_RIGHT: 1, pygame.K_a: -1, pygame.K_d: 1}.get(event.key, 0)
+    if event.type == getattr(pygame, "MOUSEWHEEL", -1):
+        return 1 if getattr(event, "y", 0) > 0 else -1 if getattr(event, "y", 0) < 0 else 0
+    return 0
+
+
+def _hit(app: Any, pos: tuple[int, int]) -> int | None:
+    for i, rect in getattr(app, "menu_hits", []):
+        if rect.collidepoint(pos):
+            return i
+    return None
+
+
+def _click_step(rect: "pygame.Rect", pos: tuple[int, int], button: int) -> int:
+    """A click on a choice: on its label or value's left half (or with the right
+    button) goes back, on the right half on."""
+    if button == 3 or pos[0] < rect.x + rect.w * 0.45:
+        return -1
+    return 1
+
+
+def type_into(app: Any, event: Any) -> None:
+    """A key while typing into the address, name or password field."""
+    m = app.menu
+    if event.type != pygame.KEYDOWN:
+        return
+    field = app.field
+    value = getattr(m, field)
+    if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_TAB):
+        app.editing = False
+        if field == "address":
+            from .app import DEFAULT_ADDRESS
+
+            m.address = m.address.strip() or DEFAULT_ADDRESS
+        elif field == "name":
+            app.settings.name = m.name
+            app.save_settings()
+        return
+    if event.key == pygame.K_BACKSPACE:
+        setattr(m, field, value[:-1])
+        return
+    ch = getattr(event, "unicode", "") or ""
+    if field == "address":
+        ch = ch.lower()
+        if len(ch) == 1 and ch in ADDRESS_CHARS and len(value) < 40:
+            m.address += ch
+    elif field == "name":
+        if len(ch) == 1 and NAME_CHARS.match(value + ch):
+            m.name += ch
+    elif len(ch) == 1 and ch.isprintable() and len(value) < MAX_PASSWORD:
+        m.password += ch
+
+
+def handle_menu(app: Any, event: Any) -> None:
+    m = app.menu
+    if app.editing:
+        if event.type == pygame.MOUSEBUTTONDOWN:
+            app.editing = False               # a click elsewhere ends the typing
+        else:
+            type_into(app, event)
+            return
+    step = _choice_step(event)
+    if event.type == pygame.KEYDOWN:
+        if event.key in (pygame.K_UP, pygame.K_w):
+            m.cursor = (m.cursor - 1) % len(m.ITEMS)
+        elif event.key in (pygame.K_DOWN, pygame.K_s):
+            m.cursor = (m.cursor + 1) % len(m.ITEMS)
+        elif event.key in (pygame.K_RETURN, pygame.K_SPACE, pygame.K_KP_ENTER):
+            activate(app)
+        elif event.key == pygame.K_ESCAPE:
+            app.state = "quit"
+    elif event.type == pygame.JOYHATMOTION:
+        hx, hy = event.value
+        m.cursor = (m.cursor - hy) % len(m.ITEMS)
+        step = hx
+    elif event.type == pygame.JOYBUTTONDOWN and event.button == 0:
+        activate(app)
+    elif event.type == pygame.MOUSEMOTION:
+        i = _hit(app, event.pos)
+        if i is not None:
+            m.cursor = i
+    elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 3):
+        for kind, rect in getattr(app, "preview_hits", []):
+            if rect.collidepoint(event.pos):
+                (m.arena if kind == "arenas" else m.vehicle).shift(1 if event.button == 1 else -1)
+                return
+        i = _hit(app, event.pos)
+        if i is None:
+            return
+        m.cursor = i
+        if m.item() in m.CHOICES:
+            rect = dict(app.menu_hits)[i]
+            step = _click_step(rect, event.pos, event.button)
+        elif event.button == 1:
+            activate(app)
+    if step and m.item() in m.CHOICES:
+        getattr(m, m.item()).shift(step)
+
+
+def activate(app: Any) -> None:
+    from ..errors import TanktoolError
+
+    item = app.menu.item()
+    if item == "start":
+        try:
+            app.start()
+        except TanktoolError as e:
+            app.notice = str(e)       # a broken bundle, nobody at the address: say so, stay in the menu
+    elif item in FIELDS:
+        app.editing, app.field = True, item
+        setattr(app.menu, item, "")
+    elif item == "bindings":
+        app.state = "remap"
+        app.remap_cursor = 0
+        app.remap_waiting = False
+    elif item == "settings":
+        app.state = "settings"
+        app.settings_cursor = 0
+    elif item == "quit":
+        app.state = "quit"
+
+
+def handle_settings(app: Any, event: Any) -> None:
+    n = len(SETTINGS_ITEMS)
+    step = _choice_step(event)
+    enter = False
+    if event.type == pygame.KEYDOWN:
+        if event.key in (pygame.K_UP, pygame.K_w):
+            app.settings_cursor = (app.settings_cursor - 1) % n
+        elif event.key in (pygame.K_DOWN, pygame.K_s):
+            app.settings_cursor = (app.settings_cursor + 1) % n
+        elif event.key in (pygame.K_RETURN, pygame.K_SPACE, pygame.K_KP_ENTER):
+            enter = True
+        elif event.key == pygame.K_ESCAPE:
+            app.state = "menu"
+            return
+    elif event.type == pygame.JOYHATMOTION:
+        hx, hy = event.value
+        app.settings_cursor = (app.settings_cursor - hy) % n
+        step = hx
+    elif event.type == pygame.JOYBUTTONDOWN and event.button == 0:
+        enter = True
+    elif event.type == pygame.MOUSEMOTION:
+        i = _hit(app, event.pos)
+        if i is not None:
+            app.settings_cursor = i
+    elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 3):
+        i = _hit(app, event.pos)
+        if i is None:
+            return
+        app.settings_cursor = i
+        if SETTINGS_ITEMS[i] == "back":
+            enter = True
+        else:
+            step = _click_step(dict(app.menu_hits)[i], event.pos, event.button)
+    item = SETTINGS_ITEMS[app.settings_cursor]
+    if item == "back":
+        if enter:
+            app.state = "menu"
+        return
+    if enter and not step:
+        step = 1
+    if step:
+        change_setting(app, item, step)
+
+
+def change_setting(app: Any, item: str, step: int) -> None:
+    """Turn one setting by ``step`` and save the settings."""
+    s = app.settings
+    if item == "quality":
+        names = list(PRESETS)
+        s.quality = names[(names.index(s.quality) + step) % len(names)]
+        s.shadows = s.particles = None            # a preset's own choices
+    elif item in ("shadows", "particles"):
+        options = [None, *(SHADOWS if item == "shadows" else PARTICLES)]
+        cur = getattr(s, item)
+        setattr(s, item, options[(options.index(cur) + step) % len(options)])
+    else:
+        c = getattr(app.menu, item)
+        c.shift(step)
+        if item == "resolution":
+            s.resolution = str(c.value)
+        else:
+            s.fullscreen = bool(c.value)
+    path = app.save_settings()
+    app.notice = f"{item} changed (saved to {path})" if path is not None else f"{item} changed"
+    app.apply_quality()
+
+
+def save(app: Any) -> Any:
+    """Write the settings file; returns its path (None if it could not be written)."""
+    from ..errors import TanktoolError
+
+    try:
+        return save_settings(app.settings, app.settings_file)
+    except (OSError, TanktoolError) as e:
+        app.notice = f"settings not saved: {e}"
+        return None

@@ -1,0 +1,60 @@
+"""The end-of-match screen: why the match ended and the final scoreboard.
+
+Rank, tank, kills, deaths, shots, hits and accuracy, best first (kills, then fewest
+deaths); the winner's row is marked, the player's in their colour.  Enter (or a
+click) goes back to the menu, R plays the same match again, Q quits.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pygame
+
+from .hud import panel, text
+from .menu import BG, HELP, HILITE
+from .session import tank_colour
+
+
+def final_rows(session: Any) -> list[dict[str, Any]]:
+    """The scoreboard as dicts (name, index, kills, deaths, shots, hits, accuracy), best first."""
+    tanks = {t.name: t for t in session.world.tanks}
+    rows = []
+    for name, kills, deaths, _hp, _alive in session.scoreboard():
+        t = tanks.get(name)
+        shots = int(getattr(t, "shots", 0)) if t is not None else 0
+        hits = int(getattr(t, "hits", 0)) if t is not None else 0
+        rows.append({"name": name, "index": t.index if t is not None else 0, "kills": int(kills),
+                     "deaths": int(deaths), "shots": shots, "hits": hits,
+                     "accuracy": hits / shots if shots else None})
+    return rows
+
+
+def draw_end(app: Any, surf: "pygame.Surface") -> None:
+    surf.fill(BG)
+    w, h = surf.get_size()
+    big = max(min(64, h // 9), 26)
+    text(surf, "MATCH OVER", (w // 2, 18), big, HILITE, anchor="midtop")
+    text(surf, app.over_reason or "", (w // 2, 24 + big), 24, HELP, anchor="midtop")
+    session = app.session
+    if session is None:
+        return
+    rows = final_rows(session)
+    line = max(min(30, (h - 200) // max(len(rows) + 1, 1)), 14)
+    size = max(int(line * 0.85), 13)
+    x = w // 2 - min(300, w // 2 - 10)
+    y = 40 + big + 30
+    cols = (0, 50, 200, 260, 320, 390, 450)
+    player = getattr(session, "player", None)
+    table = [(("#", "tank", "K", "D", "shots", "hits", "accuracy"), HELP)]
+    for rank, r in enumerate(rows, 1):
+        acc = f"{100 * r['accuracy']:.0f} %" if r["accuracy"] is not None else "-"
+        cells = (rank, r["name"] + ("  (winner)" if rank == 1 and r["kills"] > 0 else ""), r["kills"],
+                 r["deaths"], r["shots"], r["hits"], acc)
+        table.append((cells, tank_colour(r["index"]) if r["index"] == player else (230, 230, 225)))
+    panel(surf, pygame.Rect(x, y, min(cols[-1] + 110, w - x), line * len(table)), (30, 36, 34, 255))
+    for cells, colour in table:
+        for c, dx in zip(cells, cols):
+            text(surf, str(c), (x + dx, y), size, colour)
+        y += line
+    text(surf, "Enter or click: menu    R: play again    Q: quit", (w // 2, h - 40), 22, HELP, anchor="midtop")

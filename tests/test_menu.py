@@ -1,0 +1,116 @@
+"""The start menu with the mouse, the name field, the settings page and the previews
+(game/menu.py, game/thumbnails.py), on SDL's dummy video driver."""
+
+import ctypes.util
+
+import numpy as np
+import pygame
+import pytest
+from app_helpers import goto, press
+
+from tanktool.game.quality import load_settings
+
+
+def mouse(kind, pos, button=1):
+    return pygame.event.Event(kind, pos=pos, button=button, rel=(0, 0), buttons=(0, 0, 0))
+
+
+def centre_of(app, item):
+    i = app.menu.ITEMS.index(item)
+    return dict(app.menu_hits)[i]
+
+
+def test_mouse_points_clicks_and_turns(make_app):
+    app = make_app((800, 450), bots=2)
+    app.frame(0.016)                                  # lays out the items
+    r = centre_of(app, "difficulty")
+    app.handle(mouse(pygame.MOUSEMOTION, r.center))
+    assert app.menu.item() == "difficulty"
+    app.handle(mouse(pygame.MOUSEBUTTONDOWN, (r.right - 5, r.centery)))
+    assert app.menu.difficulty.value == "hard"        # right half: on
+    app.handle(mouse(pygame.MOUSEBUTTONDOWN, (r.x + 5, r.centery)))
+    assert app.menu.difficulty.value == "normal"      # left half: back
+    app.handle(mouse(pygame.MOUSEBUTTONDOWN, r.center, button=3))
+    assert app.menu.difficulty.value == "easy"        # the right button: back
+    app.handle(pygame.event.Event(pygame.MOUSEWHEEL, x=0, y=1, flipped=False))
+    assert app.menu.difficulty.value == "normal"      # the wheel turns the selected choice
+    app.handle(mouse(pygame.MOUSEBUTTONDOWN, centre_of(app, "start").center))
+    assert app.state == "playing"                     # a click on START starts
+
+
+def test_name_field_typed_and_saved(make_app):
+    app = make_app((480, 320), bots=1)
+    goto(app, "name")
+    press(app, pygame.K_RETURN)
+    assert app.editing and app.field == "name"
+    for ch in "al ice!":                              # a space and "!" are not name characters
+        press(app, pygame.K_a, uni=ch)
+    app.frame(0.016)
+    press(app, pygame.K_RETURN)
+    assert not app.editing and app.menu.name == "alice" and app.player_name == "alice"
+    assert load_settings().name == "alice"            # remembered for the next start
+    again = type(app)(app.presenter, arena="box", bots=1, view="top", size=(480, 320), sound=False)
+    assert again.player_name == "alice"
+
+
+def test_settings_page_changes_quality_and_saves(make_app):
+    app = make_app((640, 360), bots=1)
+    goto(app, "settings")
+    press(app, pygame.K_RETURN)
+    assert app.state == "settings"
+    app.frame(0.016)
+    press(app, pygame.K_RIGHT)                        # quality: medium -> high
+    assert app.settings.quality == "high" and app.quality.name == "high"
+    press(app, pygame.K_DOWN)
+    press(app, pygame.K_RIGHT)                        # shadows: as the preset -> off
+    assert app.settings.shadows == "off" and app.quality.shadows == "off" and app.quality.name == "custom"
+    saved = load_settings()
+    assert saved.quality == "high" and saved.shadows == "off"
+    app.frame(0.016)
+    # the mouse on the settings page: "back"
+    app.handle(mouse(pygame.MOUSEBUTTONDOWN, dict(app.menu_hits)[5].center))
+    assert app.state == "menu"
+    # a later start reads them
+    again = type(app)(app.presenter, arena="box", bots=1, view="top", size=(480, 320), sound=False)
+    assert again.quality.shadows == "off" and again.quality.particles == "high"
+
+
+def test_broken_settings_file_is_one_error(make_app, tmp_path):
+    from tanktool.errors import FormatError
+    from tanktool.game.quality import settings_path
+
+    f = settings_path()
+    f.parent.mkdir(parents=True, exist_ok=True)
+    f.write_text('particles = "lots"\n')
+    with pytest.raises(FormatError, match=r"settings.toml: particles must be one of"):
+        make_app((320, 240))
+
+
+@pytest.mark.skipif(ctypes.util.find_library("EGL") is None, reason="libEGL is not installed")
+def test_previews_are_rendered_and_clickable(make_app):
+    app = make_app((800, 450), bots=1)
+    app.frame(0.016)                                  # the first frame shows the menu at once
+    app.frame(0.016)                                  # the next renders the previews
+    kinds = [k for k, _ in app.preview_hits]
+    assert kinds == ["arenas", "vehicles"]
+    rect = dict(app.preview_hits)["arenas"]
+    pix = pygame.surfarray.array3d(app.presenter.canvas.subsurface(rect)).astype(int)
+    assert pix.std() > 15                              # a picture, not a card
+    before = app.menu.arena.value
+    app.handle(mouse(pygame.MOUSEBUTTONDOWN, rect.center))
+    assert app.menu.arena.value != before              # a click shows the next arena
+    app.frame(0.016)
+    app.frame(0.016)
+
+
+def test_end_screen_plays_again(make_app):
+    app = make_app((480, 320), bots=1, seconds=0.25)
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    while app.state == "playing":
+        app.advance(0.25)
+    assert app.state == "over"
+    app.frame(0.016)
+    press(app, pygame.K_r)
+    assert app.state == "playing" and app.session.world.steps == 0
+    np.testing.assert_equal(len(app.session.world.tanks), 2)

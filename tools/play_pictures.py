@@ -1,0 +1,118 @@
+"""The pictures of docs/play.md, rendered headless (EGL, SDL's dummy driver).
+
+    .venv/bin/python tools/play_pictures.py [--only NAME]
+
+* ``docs/arena-<name>.png``: every bundled arena in the 3D view (chase camera, the
+  default ``medium`` preset) during a match of 8 computer tanks;
+* ``docs/play-3d.png``: the maze from the overview camera at the ``high`` preset
+  (everything on);
+* ``docs/play-menu.png`` and ``docs/play-settings.png``: the start menu with its
+  previews and the settings page;
+* ``docs/play-destroyed.png``: the HUD while the followed tank is a wreck (kill feed,
+  DESTROYED, respawn countdown);
+* ``docs/play-top.png``: the top view of the maze with its three overlays.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
+DOCS = ROOT / "docs"
+SIZE = (960, 540)
+#: (frames, seed) that show each arena with tanks in view and something happening
+MOMENTS = {"box": (420, 3), "maze": (600, 5), "paper2002": (480, 3)}
+
+
+def arenas() -> list[str]:
+    from tanktool.game.app import bundled
+
+    return bundled("arenas")
+
+
+def arena_shots(only: list[str] | None) -> None:
+    from tanktool.game.headless import screenshot
+
+    for name in arenas():
+        if only and f"arena-{name}" not in only:
+            continue
+        frames, seed = MOMENTS.get(name, (480, 3))
+        shot = screenshot(DOCS / f"arena-{name}.png", frames=frames, arena=name, bots=8, seed=seed, size=SIZE)
+        print(shot["path"])
+    if not only or "play-top" in only:
+        shot = screenshot(DOCS / "play-top.png", view="top", frames=150, arena="maze", bots=6, seed=3, size=SIZE,
+                          overlays=("quadtree", "navgrid", "agents"))
+        print(shot["path"])
+    if not only or "play-3d" in only:
+        shot = screenshot(DOCS / "play-3d.png", frames=600, arena="maze", bots=8, seed=5, size=SIZE,
+                          quality="high", camera="overview")
+        print(shot["path"])
+
+
+def menu_shots(only: list[str] | None) -> None:
+    import tempfile
+
+    import pygame
+
+    from tanktool.game.app import App, Presenter
+    from tanktool.game.hud import save_png
+
+    with tempfile.TemporaryDirectory() as cfg:
+        os.environ["XDG_CONFIG_HOME"] = cfg           # the default settings, not the user's
+        pygame.display.init()
+        pygame.font.init()
+        app = App(Presenter(SIZE, False, want_gl=False), arena="maze", vehicle="heavy", bots=5, view="3d",
+                  size=SIZE, sound=False)
+        app.frame(0.0)
+        app.frame(0.0)                                 # the previews are made on the second frame
+        if not only or "play-menu" in only:
+            print(save_png(app.presenter.canvas, DOCS / "play-menu.png"))
+        app.state = "settings"
+        app.frame(0.0)
+        if not only or "play-settings" in only:
+            print(save_png(app.presenter.canvas, DOCS / "play-settings.png"))
+        app.stop()
+
+
+def destroyed_shot(only: list[str] | None) -> None:
+    if only and "play-destroyed" not in only:
+        return
+    from tanktool.game.headless import run_frames
+    from tanktool.game.hud import save_png, surface_from_rgb
+    from tanktool.game.render3d import Renderer3D
+    from tanktool.game.session import GameSession
+
+    s = GameSession("box", bots=6, seed=1, player=False)
+    for _ in range(120 * 60):                          # until someone is destroyed
+        s.step()
+        dead = [e for e in s.feed if e.kind == "kill"]
+        if dead and s.t - dead[-1].t > 0.7:
+            break
+    s.follow = dead[-1].other
+    r = Renderer3D(s, SIZE)
+    try:
+        run_frames(s, 0)
+        print(save_png(surface_from_rgb(r.render(1.0, fps=0.0)), DOCS / "play-destroyed.png"))
+    finally:
+        r.release()
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", action="append",
+                    help="arena-box, play-3d, play-top, play-menu, play-settings, play-destroyed")
+    args = ap.parse_args(argv)
+    arena_shots(args.only)
+    menu_shots(args.only)
+    destroyed_shot(args.only)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
