@@ -47,8 +47,9 @@ def wrap(a: float) -> float:
 
 @dataclass(frozen=True)
 class Sighting:
-    """One enemy seen at time ``t``: its index, centre and velocity then, distance, and
-    which way its hull (and gun) points."""
+    """One enemy seen at time ``t``: its index, centre and velocity then, distance,
+    which way its hull (and gun) points, and the seconds of spawn protection it has
+    left (a player sees its shield)."""
 
     index: int
     x: float
@@ -58,6 +59,7 @@ class Sighting:
     t: float
     distance: float
     heading: float = 0.0
+    protected: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -89,6 +91,12 @@ def can_see(walls, ox: float, oz: float, heading: float, tx: float, tz: float,
     ``walls`` is the world's ``WallSet`` (or anything with ``blocked(ax, az, bx, bz)``).
     """
     return in_cone(ox, oz, heading, tx, tz, half_angle, vision_range) and not walls.blocked(ox, oz, tx, tz)
+
+
+def _protection(world: "World", index: int) -> float:
+    """Seconds of spawn protection tank ``index`` has left (0 in worlds without it)."""
+    left = getattr(world, "protection_left", None)
+    return left(index) if left is not None else 0.0
 
 
 class Senses:
@@ -125,7 +133,8 @@ class Senses:
             if o is me or not o.alive:
                 continue
             if can_see(world.walls, me.x, me.z, me.heading, o.x, o.z, self.half_angle, self.vision_range):
-                s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z), o.heading)
+                s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z), o.heading,
+                             _protection(world, o.index))
                 self.last_seen[o.index] = s
                 out.append(s)
         out.sort(key=lambda s: (s.distance, s.index))
