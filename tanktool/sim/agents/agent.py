@@ -9,8 +9,15 @@ that returns the command for this think; ``_watch`` plays Watch and Ambush):
   three-node heuristic with memory (``navigation.Wanderer``).
 * **Search** (an enemy was seen or heard, and is not in sight): the quadrant search
   (``navigation.SearchPlan``), A* paths to each quadrant's centre.
-* **Attack** (an enemy in sight and the reaction time passed): the fuzzy controller
-  (``fuzzy.AttackController``) turns, advances or backs off, strafes to dodge, fires.
+* **Attack** (an enemy in sight and the reaction time passed): turn onto the exact
+  intercept (``aim.intercept``; the fuzzy turn rules of ``fuzzy.AttackController``
+  turn the hull), fire when the shot's predicted miss is small (``aim.predicted_miss``),
+  hold the level's fighting distance, strafe at speed, dodge seen shells
+  (``dodge.Evasion``); with ``cover``, back behind the corner it came round while
+  it reloads, and break off a fight it is losing.
+* **Hunt** (``cover`` levels, an enemy seen standing still in the last 90 s): drive
+  to the nearest place that sees it from the stand-off distance, with room to strafe
+  and out of the cone it faced, the gun on it where the way comes into its sight.
 * **Evade** (hit twice within 4 s by an enemy it cannot see): drive to the nearest of
   a few sampled nodes out of the threat's line of sight, or, with no cover near,
   strafe hard.
@@ -42,6 +49,8 @@ between, as a person holds a key)::
     any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
     Watch    --watched WATCH_STINT s, part unseen-->  Wander --all seen again--> Watch
     Wander / Watch  --kills above deaths-->       Ambush --not leading any more--> Wander / Watch
+    Attack   --losing, cover-->                   Evade
+    not Attack, not leading --a camp known, cover-->  Hunt --it is not there / forgotten--> Wander
 
 Wander, Watch and Search (not Ambush) also take a heard engine (a moving tank within
 the engine-hearing radius, through walls) as they take a heard shot.
@@ -73,7 +82,6 @@ from ..commands import IDLE, Command
 from . import aim as gun
 from .dodge import Evasion, half_extent_at, visible_shells
 from .driving import Pilot, trim
-from .fuzzy import AttackController, FIRE_THRESHOLD
 from .navigation import (Coverage, Memory, SearchPlan, Vantages, Wanderer, agent_grid, plan_path, vantages_for,
                          views_for)
 from .perception import Senses, Sighting, wrap
@@ -90,7 +98,7 @@ WATCH_PER_M = 0.004
 #: watch this long [s] before going to look at what has not been seen for a minute
 WATCH_STINT = 30.0
 #: ... if more than this fraction of the arena's blocks has not been seen for a minute
-STALE = 0.2
+STALE = 0.1
 #: a watching agent sweeps its cone this far either side of the vantage's way [rad],
 #: at this rate [rad/s]
 SWEEP = 0.35
@@ -218,7 +226,6 @@ class Agent(Pilot):
         self.goal_gain = 0.0
         self.recheck = 0.0
         self.wanderer: Wanderer | None = None
-        self.controller: AttackController | None = None
         # wander route: world points of nodes, and the walker's node and heading
         self.route: list[tuple[float, float]] = []
         self.walker: tuple[tuple[int, int], str] | None = None
@@ -308,7 +315,6 @@ class Agent(Pilot):
         self.grid = agent_grid(world, self.cell, tank.spec.radius + self.margin)
         self.memory = Memory(self.grid, region=16.0)
         self.wanderer = Wanderer(self.grid, self.memory, self.rng)
-        self.controller = AttackController(tank.spec.shell_speed)
         self.views = views_for(world, self.grid)
         self.coverage = Coverage(self.views, self.senses.half_angle, self.senses.vision_range)
         self.vantages = vantages_for(self.views, self.senses.half_angle, self.senses.vision_range)
