@@ -26,13 +26,25 @@ For every bundled arena and difficulty:
 Then the CPU cost: 8 tanks on each arena, all agents (normal) or all baseline bots,
 ``--cpu-steps`` steps; the time spent deciding per simulated step, for all 8 together.
 
+Then **dodging** (the game's rules, ``sim.rules.DEFAULT``, without spawn protection):
+on an open 400 m field a gunner that never misses its aim (it stands, turns onto the
+exact intercept of the target's true position and velocity, and fires only when
+the shot's predicted miss is under 0.5 m: every shot is on target when fired) shoots
+at a tank that holds a distance D facing it, for ``--dodge-seconds`` at each D.  The
+target either stands ("still"), strafes at full strength and flips side every 3-6 s
+("strafing"), or strafes so and dodges the shells it sees with the agents' own
+``dodge.Evasion`` (noticed 0.25 s after they come into view, the hard agent's
+reaction: "dodging").  Printed: the share of on-target shots that missed, by D.
+
     python bench/bots.py [--matches N] [--sight-runs M] [--seconds S] [--arenas a,b]
-                         [--levels easy,normal,hard] [--no-bound] [--json]
+                         [--levels easy,normal,hard] [--no-bound] [--dodge-seconds S]
+                         [--distances 10,20,...] [--json]
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import random
@@ -44,12 +56,17 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+import numpy as np  # noqa: E402
+
+from tanktool.formats.walls_txt import WallList, aux_rectangle  # noqa: E402
 from tanktool.sim.agents import DIFFICULTIES, Agent  # noqa: E402
+from tanktool.sim.agents import aim, dodge  # noqa: E402
 from tanktool.sim.agents.agent import trim  # noqa: E402
 from tanktool.sim.agents.navigation import plan_path  # noqa: E402
-from tanktool.sim.commands import IDLE  # noqa: E402
+from tanktool.sim.commands import IDLE, Command  # noqa: E402
 from tanktool.sim.driver import ScriptedDriver  # noqa: E402
 from tanktool.sim.match import load_match_arena, load_tank_spec  # noqa: E402
+from tanktool.sim.rules import DEFAULT as DEFAULT_RULES  # noqa: E402
 from tanktool.sim.world import World  # noqa: E402
 
 SAMPLE = 0.25   # seconds between stuck samples
@@ -149,6 +166,77 @@ def cpu(arena, spec, kind: str, steps: int) -> float:
     return spent / steps
 
 
+class Gunner:
+    """Stands, turns onto the exact intercept of tank ``target`` (its true state),
+    fires when a shot now would pass within ``tolerance`` m of its centre."""
+
+    def __init__(self, target: int, tolerance: float = 0.5) -> None:
+        self.target, self.tolerance = target, tolerance
+
+    def __call__(self, world, me) -> Command:
+        t = world.tanks[self.target]
+        v = me.spec.shell_speed
+        sol = aim.intercept(me.x, me.z, me.vx, me.vz, t.x, t.z, t.vx, t.vz, v)
+        if sol is None:
+            return IDLE
+        err = math.remainder(sol.heading - me.heading, 2.0 * math.pi)
+        miss = aim.predicted_miss(me.x, me.z, me.vx, me.vz, me.heading, t.x, t.z, t.vx, t.vz, v)
+        return Command(rotate=max(-1.0, min(1.0, 4.0 * err - 0.6 * me.omega)),
+                       fire=miss < self.tolerance and me.reload <= 0.0)
+
+
+class Target:
+    """Faces tank ``shooter`` at ``distance`` m; ``mode`` "still", "strafing" or
+    "dodging" (strafing, and ``dodge.Evasion`` with ``reaction``)."""
+
+    def __init__(self, shooter: int, distance: float, mode: str, rng: random.Random, reaction: float = 0.25) -> None:
+        self.shooter, self.distance, self.mode, self.rng = shooter, distance, mode, rng
+        self.side, self.flip = 1.0, 0.0
+        self.evasion = dodge.Evasion(reaction)
+
+    def __call__(self, world, me) -> Command:
+        s = world.tanks[self.shooter]
+        dx, dz = s.x - me.x, s.z - me.z
+        err = math.remainder(math.atan2(dz, dx) - me.heading, 2.0 * math.pi)
+        rotate = max(-1.0, min(1.0, 3.0 * err - 0.5 * me.omega))
+        vf = me.vx * me.c + me.vz * me.s
+        want = max(-4.0, min(4.0, 0.5 * (math.hypot(dx, dz) - self.distance)))
+        advance = max(-1.0, min(1.0, 0.5 * (want - vf)))
+        if self.mode == "still":
+            return Command(advance=advance, rotate=rotate)
+        if world.t >= self.flip:
+            self.side, self.flip = -self.side, world.t + self.rng.uniform(3.0, 6.0)
+        if self.mode == "dodging":
+            esc = self.evasion.command(world, me, [sh for sh in world.shells if sh.owner != me.index])
+            if esc is not None:
+                return Command(advance=esc[0], rotate=rotate, strafe=esc[1])
+        return Command(advance=advance, rotate=rotate, strafe=self.side)
+
+
+DODGE_MODES = ("still", "strafing", "dodging")
+
+
+def dodge_share(spec, distance: float, mode: str, seconds: float, seed: int = 0) -> tuple[int, int]:
+    """(on-target shots, hits) of a :class:`Gunner` at a :class:`Target` ``distance`` m
+    away on an open field, under the game's rules without spawn protection."""
+    size = 400.0
+    field = WallList(np.zeros((0, 2, 2)), np.zeros(0, np.int8), aux_rectangle(0.0, 0.0, size, size))
+    rules = dataclasses.replace(DEFAULT_RULES, spawn_protection=0.0)
+    c = size / 2
+    world = World(field, [spec, spec], [(c, c, 0.0), (c + distance, c, math.pi)], seed=seed, rules=rules,
+                  bounds=[[0.0, 0.0], [size, size]])
+    world.tanks[0].place(c, c, 0.0)
+    world.tanks[1].place(c + distance, c, math.pi)
+    drivers = [Gunner(1), Target(0, distance, mode, random.Random(seed))]
+    shots = hits = 0
+    for _ in range(int(round(seconds / world.dt))):
+        for e in world.step(None, [d(world, t) for d, t in zip(drivers, world.tanks)]):
+            shots += e.kind == "shot" and e.tank == 0
+            hits += e.kind == "hit" and e.tank == 0
+        world.tanks[1].hp = world.tanks[1].spec.hit_points      # it must live to be shot at again
+    return shots, hits
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--matches", type=int, default=100, help="duels per arena and difficulty (default 100)")
@@ -161,6 +249,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--arenas", default="box,maze,paper2002")
     ap.add_argument("--levels", default="easy,normal,hard")
     ap.add_argument("--vehicle", default="light")
+    ap.add_argument("--dodge-seconds", type=float, default=90.0,
+                    help="simulated seconds of shooting per distance and target (0: skip the dodging table)")
+    ap.add_argument("--distances", default="10,20,30,40,50,60", help="dodging: target distances [m]")
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     args = ap.parse_args(argv)
     spec = load_tank_spec(args.vehicle)
@@ -204,8 +295,16 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"  {arena.name} {lv}: done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
     cpu_rows = [{"arena": a.name, "agent_ms_per_step_8": 1e3 * cpu(a, spec, "agent", args.cpu_steps),
                  "baseline_ms_per_step_8": 1e3 * cpu(a, spec, "scripted", args.cpu_steps)} for a in arenas]
+    dodge_rows = []
+    if args.dodge_seconds > 0:
+        for mode in DODGE_MODES:
+            for dist in (float(v) for v in args.distances.split(",") if v):
+                n, hits = dodge_share(spec, dist, mode, args.dodge_seconds)
+                dodge_rows.append({"target": mode, "distance": dist, "on_target_shots": n, "hits": hits,
+                                   "avoided": (n - hits) / n if n else None})
     out = {"vehicle": spec.name, "seconds_per_duel": args.seconds, "sight_runs": args.sight_runs,
            "sight_cap_s": args.cap, "baseline": "sim.driver.ScriptedDriver", "rows": rows, "cpu": cpu_rows,
+           "rules": DEFAULT_RULES.to_dict(), "dodge": dodge_rows,
            "wall_clock_s": round(time.perf_counter() - t_start, 1)}
     if args.json:
         print(json.dumps(out))
@@ -230,6 +329,20 @@ def main(argv: list[str] | None = None) -> int:
     print(f"{'arena':<10} {'8 agents ms/step':>17} {'8 baseline ms/step':>19}")
     for c in cpu_rows:
         print(f"{c['arena']:<10} {c['agent_ms_per_step_8']:>17.3f} {c['baseline_ms_per_step_8']:>19.3f}")
+    if dodge_rows:
+        dists = sorted({r["distance"] for r in dodge_rows})
+        print()
+        speed = DEFAULT_RULES.shell_speed or spec.shell_speed
+        print(f"on-target shots avoided (shells {speed:g} m/s, {args.dodge_seconds:g} s at each distance; "
+              "on-target shots in brackets)")
+        print(f"{'target':<10}" + "".join(f"{d:>11.0f} m" for d in dists))
+        for mode in DODGE_MODES:
+            cells = []
+            for d in dists:
+                r = next(r for r in dodge_rows if r["target"] == mode and r["distance"] == d)
+                cells.append(f"{100 * r['avoided']:>5.0f}% ({r['on_target_shots']:>3})" if r["avoided"] is not None
+                             else f"{'-':>12}")
+            print(f"{mode:<10}" + " ".join(f"{c:>12}" for c in cells))
     print("bound: win % of an agent told where the enemy is (the same duels, normal)")
     print("goals at normal: win rate >= 80 %, < 1 bump/min, stuck < 2 %; agents for 8 tanks < 1 ms per step")
     print(f"wall clock {out['wall_clock_s']:.0f} s")

@@ -160,10 +160,19 @@ def test_agent_finds_a_stationary_enemy_in_the_maze():
 
 
 def test_agent_shoots_an_enemy_in_plain_sight():
+    """The target is under spawn protection for its first 3 s: no shell may reach it
+    then (none is shielded); then 4 hits kill it."""
     w = box_world([(20.0, 10.0), (50.0, 14.0)], headings=[0.3, math.pi])
     agent = Agent(random.Random(2), "normal")
-    assert run(w, [agent, None], 8.0, until=lambda: not w.tanks[1].alive)
-    assert w.tanks[0].kills == 1 and w.tanks[0].hits >= 4 and w.tanks[0].shots <= 6
+    events = []
+    for _ in range(int(12.0 / w.dt)):
+        events += w.step(None, [agent(w, w.tanks[0]), IDLE])
+        if not w.tanks[1].alive:
+            break
+    assert not w.tanks[1].alive and w.tanks[0].kills == 1
+    assert w.tanks[0].hits >= 4 and w.tanks[0].shots <= 8
+    assert not [e for e in events if e.kind == "shielded"]
+    assert min(e.t for e in events if e.kind == "shot") > 3.0 - 60.0 / w.tanks[0].spec.shell_speed
     assert agent.state == "attack"
 
 

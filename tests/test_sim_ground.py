@@ -182,7 +182,7 @@ def test_a_shell_fired_into_a_hill_stops_on_it(arenas):
             ahead = g.height(x + 20, z, t.level)
             if g.exists[t.level][g.cell_of(x + 20, z)] and ahead > t.y + t.spec.muzzle_local[1] + 1.0 \
                     and abs(t.pitch) < math.radians(3):
-                s = fire(t, world.walls, g)
+                s = fire(t, world.walls, world.rules, None, g)
                 assert math.isfinite(s.stop_at) and s.stop_at < 20.0 / t.spec.shell_speed * 1.5
                 return
     pytest.skip("no rise found ahead of a level spot")

@@ -12,6 +12,7 @@ from tanktool.formats.walls_txt import read_walls
 from tanktool.sim.body import TankSpec
 from tanktool.sim.collide import BruteWallIndex
 from tanktool.sim.commands import Command
+from tanktool.sim.rules import Rules
 from tanktool.sim.world import World
 
 
@@ -67,7 +68,8 @@ def test_fast_shell_hits_a_thin_tank(speed):
     walls, _ = box_arena()
     shooter = TankSpec.box("s", shell_speed=speed)
     target = TankSpec.box("t", width=2.0, length=5.0)
-    w = World(walls, [shooter, target], [(5, 10, 0), (115, 10, 0)], seed=0)
+    # the vehicle's own gun, no spawn protection: the classic rules
+    w = World(walls, [shooter, target], [(5, 10, 0), (115, 10, 0)], seed=0, rules=Rules.classic())
     w.tanks[0].place(5.0, 10.0, 0.0)
     w.tanks[1].place(110.0, 10.0, math.pi / 2)     # broadside-on: 2 m deep along the shot
     events = w.step(None, [Command(fire=True), Command()])
@@ -84,7 +86,7 @@ def test_damage_kill_respawn_and_score():
     walls, spawns = box_arena()
     shooter = TankSpec.box("s", shell_damage=40.0, fire_interval=0.5)
     target = TankSpec.box("t", hit_points=100.0)
-    w = World(walls, [shooter, target], spawns, seed=4, respawn_delay=2.0)
+    w = World(walls, [shooter, target], spawns, seed=4, respawn_delay=2.0, rules=Rules.classic())
     a, b = w.tanks
     a.place(10.0, 30.0, 0.0)
     b.place(50.0, 30.0, 0.0)

@@ -13,6 +13,12 @@ state: nothing is written into the working folder unless asked for).
 each local match ends after that much simulated time and the menu comes back.  A
 replay lasts as long as its recording, and a network match in the window until you
 quit: there ``--seconds`` is refused/ignored with a word, never silently.
+
+``--time-limit`` and ``--score-limit`` are the match's end by its rules
+(``sim.rules``): it is over when the time is up or a tank has that many kills, the
+world stops and the scoreboard says who won.  Headless, ``--seconds`` (default: the
+time limit, else 60) still caps the run.  A replay keeps the limits it was recorded
+with; network matches have none yet (refused).
 """
 
 from __future__ import annotations
@@ -81,13 +87,18 @@ def _size(text: str) -> tuple[int, int]:
 @click.option("--replay", "replay_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Play a recorded match back from this file: the same final state, bit for bit.  In the "
                    "window unless --headless, --report or --picture.")
+@click.option("--time-limit", "time_limit", type=click.FloatRange(0, 86400, min_open=True), default=None,
+              metavar="S", help="The match ends after S simulated seconds (its rules: the scoreboard says who won).")
+@click.option("--score-limit", "score_limit", type=click.IntRange(1, 1_000_000), default=None, metavar="K",
+              help="The match ends when a tank has K kills.")
 @network_options
 def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | None, seconds: float | None,
          seed: int, integrator: str, report_path: Path | None, picture: Path | None, view: str,
          frames: int | None, screenshot: Path | None, size: str, fullscreen: bool,
          host: str | None = None, join: str | None = None, player_name: str | None = None,
          password: str | None = None, difficulty: str = "normal", bot_driver: str = "agent",
-         record_path: Path | None = None, replay_path: Path | None = None) -> None:
+         record_path: Path | None = None, replay_path: Path | None = None,
+         time_limit: float | None = None, score_limit: int | None = None) -> None:
     """Play a match: bots on an arena.
 
     \b
@@ -101,9 +112,12 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --arena maze --record mine.ttr      (the window; the file holds the last match)
       tanktool play --replay mine.ttr                   (watch it in the window)
     """
+    limits = time_limit is not None or score_limit is not None
     if host is not None or join is not None:
         from .net_play import resolve_password, run_network, run_network_window
 
+        if limits:
+            raise click.UsageError("--time-limit/--score-limit: network matches have no match end yet")
         if record_path is not None or replay_path is not None:
             raise click.UsageError("network matches are not recorded: --record/--replay go without --host/--join")
         password = resolve_password(password)      # '-': typed at a prompt, once for both paths below
@@ -151,6 +165,11 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             click.echo(f"warning: --seconds {seconds:g} ignored: a replay lasts as long as its recording",
                        err=True)
             seconds = None
+        if replay_path is not None and limits:
+            click.echo("warning: --time-limit/--score-limit ignored: a replay keeps the rules it was recorded with",
+                       err=True)
+            time_limit = score_limit = None
+            limits = False
         if replay_path is not None and not headless and report_path is None and picture is None:
             # the recording in the game window; no display: the headless playback and its check
             from ..game.app import NoDisplay, run_window
@@ -179,9 +198,13 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         from ..game.app import NoDisplay, run_window
 
         try:
+            extra = _window_limits(run_window, time_limit, score_limit, seconds)
+            if "seconds" in extra:
+                seconds = extra.pop("seconds")
             saved = run_window(arena=arena, vehicle=vehicle, bots=3 if bots is None else max(bots - 1, 0),
                                seed=seed, view=view, size=(width, height), fullscreen=fullscreen,
-                               difficulty=difficulty, bot=bot_driver, record=record_path, seconds=seconds)
+                               difficulty=difficulty, bot=bot_driver, record=record_path, seconds=seconds,
+                               **extra)
             for line in saved:
                 echo(line)
             if record_path is not None and not saved:
@@ -193,7 +216,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         bots = 4 if bots is None else bots
         seconds = 20.0 if seconds is None else seconds
     bots = 8 if bots is None else bots
-    seconds = 60.0 if seconds is None else seconds
+    if seconds is None:
+        seconds = time_limit if time_limit is not None else 60.0
     replay = None
     if replay_path is not None:
         from ..sim.replay import read_replay
@@ -225,10 +249,11 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             result, tape = record_match(info, spec, bots=bots, seconds=seconds, seed=seed,
                                         arena_ref=_stored_ref(_arena_ref(arena)), vehicle_ref=_stored_ref(vref),
                                         on_progress=bar.update, integrator=integrator, bot=bot_driver,
-                                        difficulty=difficulty)
+                                        difficulty=difficulty, **_limit_options(time_limit, score_limit))
         else:
             result = run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
-                               integrator=integrator, on_progress=bar.update, bot=bot_driver, difficulty=difficulty)
+                               integrator=integrator, on_progress=bar.update, bot=bot_driver, difficulty=difficulty,
+                               time_limit=time_limit, score_limit=score_limit)
     report = result.report
     echo(scoreboard(report))
     timing = report["timing"]
@@ -254,6 +279,33 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             raise click.ClickException(f"replay diverged from the recording: final state sha256 "
                                        f"{playback.digest[:16]}..., recorded {replay.header['final_state'][:16]}...")
         echo(f"replay: final state matches the recording bit for bit (sha256 {playback.digest[:16]}...)")
+
+
+def _limit_options(time_limit: float | None, score_limit: int | None) -> dict:
+    """The limits as run_match options (only those given: a recording stores them)."""
+    return {k: v for k, v in (("time_limit", time_limit), ("score_limit", score_limit)) if v is not None}
+
+
+def _window_limits(run_window, time_limit: float | None, score_limit: int | None,
+                   seconds: float | None) -> dict:
+    """What the window is told of the match end: the rules, where it takes them
+    (``run_window(rules=...)``); else a time limit becomes the window's match length
+    (``seconds``) and a score limit is refused with a word."""
+    import inspect
+
+    if time_limit is None and score_limit is None:
+        return {}
+    if "rules" in inspect.signature(run_window).parameters:
+        from ..sim.match import match_rules
+
+        return {"rules": match_rules(None, time_limit, score_limit)}
+    out: dict = {}
+    if time_limit is not None:
+        out["seconds"] = time_limit if seconds is None else min(seconds, time_limit)
+    if score_limit is not None:
+        click.echo("warning: --score-limit is not applied in the game window yet (headless matches and the "
+                   "no-display fallback apply it)", err=True)
+    return out
 
 
 def _window_possible() -> bool:

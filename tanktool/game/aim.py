@@ -3,7 +3,8 @@
 The shell is made by the simulation's own ``sim.weapons.fire`` (the same speed, start
 point, pitch, drift with the tank's velocity, and first wall on its line or, on an arena
 with relief, the time its flight first meets the model, as a real shot), then followed
-under gravity until it meets that wall, the model or the ground; tanks on the way are
+as the rules fly it (straight by default, spent at their range) until it meets that
+wall, the model or the ground; tanks on the way are
 tested against their footprint circle and height.  Nothing here changes the world.
 """
 
@@ -33,28 +34,17 @@ class Aim:
 
 
 def _shell(world: Any, tank: Any) -> Any:
+    """The shell ``tank`` would fire now, under the world's rules, without their random
+    spread (the crosshair shows the gun's line)."""
     from ..sim import weapons
 
-    ground = getattr(world, "ground", None)
-    try:
-        return weapons.fire(tank, world.walls, ground) if ground is not None else weapons.fire(tank, world.walls)
-    except TypeError:                         # a fire() of another shape: the plain rule
-        spec = tank.spec
-        v = spec.shell_speed
-        shell = weapons.Shell(tank.index, tank.x, float(getattr(tank, "y", 0.0)) + spec.muzzle_local[1], tank.z,
-                              v * tank.c + tank.vx, 0.0, v * tank.s + tank.vz, spec.shell_damage)
-        reach = math.hypot(shell.vx, shell.vz) * shell.flight_time()
-        hit = world.walls.first_hit(shell.ox, shell.oz, shell.ox + shell.ux * reach, shell.oz + shell.uz * reach)
-        if hit is not None:
-            shell.wall_dist = hit[0] * reach
-        return shell
+    return weapons.fire(tank, world.walls, getattr(world, "rules", None), None, getattr(world, "ground", None))
 
 
 def predict(world: Any, tank: Any, floor_y: float = 0.0) -> Aim:
     """The crosshair's two points for ``tank`` firing now."""
-    from ..sim.weapons import GRAVITY
-
     s = _shell(world, tank)
+    g = s.g
     x0, y0, z0 = s.x, s.y, s.z
     base = float(getattr(tank, "y", floor_y))
     # the barrel's line (at the hull's pitch): to the first wall on it, else SIGHT ahead
@@ -63,18 +53,22 @@ def predict(world: Any, tank: Any, floor_y: float = 0.0) -> Aim:
     d = hit[0] * SIGHT if hit is not None else SIGHT
     aim = (x0 + tank.c * d, y0 + math.tan(pitch) * d, z0 + tank.s * d)
     vh = math.hypot(s.vx, s.vz)
+    t_spent = min(s.reach, SIGHT) / vh if vh > 0 else 0.0      # its range flown (or as far as we look)
     stop_at = float(getattr(s, "stop_at", math.nan))
     if not math.isnan(stop_at):               # on a ground: where the flight meets the model
-        t_end = stop_at if math.isfinite(stop_at) else SIGHT / max(vh, 1.0)
+        t_end = min(stop_at, t_spent)
     else:
         # the ground is the tank's own floor
         drop = max(y0 - base, 0.0)
-        t_ground = (s.vy + math.sqrt(s.vy * s.vy + 2.0 * GRAVITY * drop)) / GRAVITY
+        if g > 0.0:
+            t_ground = (s.vy + math.sqrt(s.vy * s.vy + 2.0 * g * drop)) / g
+        else:
+            t_ground = drop / -s.vy if s.vy < 0.0 else math.inf
         t_wall = s.wall_dist / vh if vh > 0 and math.isfinite(s.wall_dist) else math.inf
-        t_end = min(t_ground, t_wall)
+        t_end = min(t_ground, t_wall, t_spent)
 
     def at(t: float) -> tuple[float, float, float]:
-        return x0 + s.vx * t, y0 + s.vy * t - 0.5 * GRAVITY * t * t, z0 + s.vz * t
+        return x0 + s.vx * t, y0 + s.vy * t - 0.5 * g * t * t, z0 + s.vz * t
 
     target = None
     steps = max(int(SAMPLES), 2)

@@ -231,8 +231,11 @@ class App:
                  fullscreen: bool = False, bindings: Bindings | None = None, sound: bool = True,
                  bindings_file: Path | None = None, difficulty: str = "normal", bot: str = "agent",
                  record: Path | None = None, replay: Any = None, replay_name: str = "",
-                 seconds: float | None = None, settings_file: Path | None = None) -> None:
+                 seconds: float | None = None, settings_file: Path | None = None, rules: Any = None) -> None:
         from .quality import load_settings
+
+        #: the rules of every local match (``sim.rules.Rules``; None: the default ones)
+        self.rules = rules
 
         #: the settings page's choices (quality, resolution, name), read at every start
         self.settings_file = settings_file
@@ -363,7 +366,7 @@ class App:
             self.start_network()
             return
         self.session = GameSession(m.arena.value, m.vehicle.value, bots=int(m.bots.value), seed=self.seed,
-                                   difficulty=str(m.difficulty.value), player=True, bot=self.bot)
+                                   difficulty=str(m.difficulty.value), player=True, bot=self.bot, rules=self.rules)
         if self.record_path is not None:
             self.session.record()
         self._begin(str(m.view.value))
@@ -618,15 +621,18 @@ class App:
         return True
 
     def _match_over(self) -> bool:
-        """The simulation says the match is over (a time or score limit: ``world.over``,
-        with ``world.end_reason``, when the rules have them): the end screen."""
+        """The simulation says the match is over (its rules' time or score limit,
+        ``world.match``): the end screen."""
         w = getattr(self.session, "world_all", getattr(self.session, "world", None))
-        if self.replay is not None or w is None or not getattr(w, "over", False):
+        m = getattr(w, "match", None)
+        if self.replay is not None or m is None or not m.over:
             return False
         self.end_match()
         self.acc = 0.0
         self.state = "over"
-        self.over_reason = str(getattr(w, "end_reason", "") or "the match is over")
+        why = {"time": "time up", "score": "score limit reached"}.get(m.reason, "the match is over")
+        winner = w.tanks[m.winner].name if m.winner is not None else None
+        self.over_reason = f"{why}: {winner} wins" if winner else f"{why}: a draw"
         self.notice = self.over_reason
         return True
 
@@ -724,7 +730,7 @@ def run_window(arena: str | None = None, vehicle: str | None = None, bots: int =
                difficulty: str = "normal", bot: str = "agent", record: Path | None = None,
                replay: Any = None, replay_name: str = "", network: tuple[str, str] | None = None,
                name: str | None = None, password: str | None = None,
-               seconds: float | None = None) -> list[str]:
+               seconds: float | None = None, rules: Any = None) -> list[str]:
     """Open the window and play until the player quits (``record``: every match is
     recorded, the file holds the last one; ``replay``: show that recording instead of
     the menu; ``network``: ("host" or "join", address) starts that network match at
@@ -736,7 +742,7 @@ def run_window(arena: str | None = None, vehicle: str | None = None, bots: int =
         raise NoDisplay(problem)
     pygame.init()
     app = App(None, arena, vehicle, bots, seed, view, size, fullscreen, difficulty=difficulty, bot=bot,
-              record=record, replay=replay, replay_name=replay_name, seconds=seconds)
+              record=record, replay=replay, replay_name=replay_name, seconds=seconds, rules=rules)
     app.player_name, app.password = name, password
     app.open_window()
     try:

@@ -11,7 +11,7 @@ What it shows, for the followed tank (the player's, or the one a replay rides wi
 * **hit-direction markers**: an arc towards whoever just hit you, fading;
 * **"DESTROYED by ... / respawn in N s"** across the middle while you are a wreck;
   a spawn-protection line while the simulation says you are protected
-  (``tank.protected_until``, when it has one);
+  (``World.protection_left``);
 * **REPLAY** with the tape's time and the tank followed, while watching a recording;
 * a minimap drawn from the walls (bottom right).
 
@@ -342,9 +342,10 @@ class Hud:
                 lines.append(text(surface, f"by {_name(session, killer)}", (w // 2, h // 2 + 2), 30, anchor="center"))
             lines.append(text(surface, f"respawn in {left:.1f} s", (w // 2, h // 2 + 32), 30, anchor="center"))
             out.append(self._behind(surface, lines))
-        protected = getattr(focus, "protected_until", None)
-        if focus.alive and isinstance(protected, (int, float)) and protected > now:
-            out.append(self._behind(surface, [text(surface, f"spawn protection {protected - now:.1f} s (firing ends it)",
+        world = getattr(session, "world_all", getattr(session, "world", None))
+        left = world.protection_left(focus.index) if hasattr(world, "protection_left") else 0.0
+        if focus.alive and left > 0.0:
+            out.append(self._behind(surface, [text(surface, f"spawn protection {left:.1f} s (firing ends it)",
                                                    (w // 2, h - 80), 24, (140, 210, 255), anchor="center")]))
         if getattr(session, "max_steps", None) is not None:          # watching a recording
             total = session.max_steps * session.dt

@@ -103,16 +103,17 @@ class GameSession:
     player : whether tank 0 is driven by the local player (else it is a bot too)
     bot : "agent" (``sim.agents.Agent`` at ``difficulty``) or "scripted" (the simple bot)
     drivers : optional drivers for the computer tanks, instead of ``bot``
+    rules : the match's ``sim.rules.Rules`` (None: the default rules)
     """
 
     def __init__(self, arena: str | Path | None = None, vehicle: str | Path | None = None, bots: int = 3,
                  seed: int = 0, difficulty: str = "normal", player: bool = True,
-                 drivers: Sequence[Driver] | None = None, bot: str = "agent") -> None:
+                 drivers: Sequence[Driver] | None = None, bot: str = "agent", rules: Any = None) -> None:
         from ..errors import TanktoolError
         from ..sim.match import default_arena, default_vehicle, load_match_arena, load_tank_spec, make_bots
 
         self._args = dict(arena=arena, vehicle=vehicle, bots=bots, seed=seed, difficulty=difficulty,
-                          player=player, drivers=drivers, bot=bot)
+                          player=player, drivers=drivers, bot=bot, rules=rules)
         if difficulty not in DIFFICULTY:
             raise TanktoolError(f"difficulty must be one of {', '.join(DIFFICULTY)}, got {difficulty!r}")
         self.arena_ref = arena or default_arena()
@@ -127,7 +128,7 @@ class GameSession:
             raise TanktoolError("a match needs at least one tank")
         names = (["you"] if player else []) + [f"bot{i + 1}" for i in range(bots)]
         self.world = World(self.info.walls, [self.spec] * n, self.info.spawns, seed=seed, names=names,
-                           bounds=self.info.bounds, ground=getattr(self.info, "ground", None))
+                           bounds=self.info.bounds, ground=getattr(self.info, "ground", None), rules=rules)
         self.player = 0 if player else None
         if drivers is not None:
             if len(drivers) != bots:

@@ -27,12 +27,14 @@ import logging
 import math
 import random
 import time
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from ..sim.body import TankSpec
 from ..sim.commands import IDLE, Command
 from ..sim.driver import ScriptedDriver
+from ..sim.rules import DEFAULT as DEFAULT_RULES
 from ..sim.weapons import fire
 from ..sim.world import World
 from . import protocol as P
@@ -48,6 +50,12 @@ DROP_LOG_INTERVAL = 5.0
 #: ``tanktool -v`` shows this logger's INFO lines
 log = logging.getLogger("tanktool.net")
 
+
+
+#: the rules of a network match: the default ones without the random spread (each
+#: peer makes the shells of the others' shots from their messages, and a spread drawn
+#: by the shooter's generator would fly them differently on every peer)
+NET_RULES = dataclasses.replace(DEFAULT_RULES, spread=0.0)
 
 @dataclass
 class Score:
@@ -83,7 +91,8 @@ class NetMatch:
     def __post_init__(self) -> None:
         names = [f"p{n}" for n in range(1, P.MAX_PLAYERS + 1)]
         self.world = World(self.arena.walls, [self.spec] * P.MAX_PLAYERS, self.arena.spawns, seed=self.seed,
-                           names=names, bounds=self.arena.bounds, ground=getattr(self.arena, "ground", None))
+                           names=names, bounds=self.arena.bounds, ground=getattr(self.arena, "ground", None),
+                           rules=NET_RULES)
         self.me = self.world.tanks[self.peer.number - 1]
         self.world.t = self.peer.session_time()
         for t in self.world.tanks:
@@ -158,7 +167,7 @@ class NetMatch:
         tank.x, tank.z, tank.heading, tank.vx, tank.vz = shot.x, shot.z, shot.heading, shot.vx, shot.vz
         tank.c, tank.s = math.cos(shot.heading), math.sin(shot.heading)
         self.world.stand(tank, tank.y)    # the height and pitch it fired at
-        self.world.shells.append(fire(tank, self.world.walls, self.world.ground))
+        self.world.shells.append(fire(tank, self.world.walls, self.world.rules, None, self.world.ground))
         (tank.x, tank.z, tank.heading, tank.vx, tank.vz, tank.c, tank.s, tank.y, tank.level, tank.pitch,
          tank.roll) = saved
 

@@ -3,9 +3,11 @@ scripted baseline) in a world, run it for a number of simulated seconds as fast 
 the machine allows, and report.
 
 The report is one JSON-ready dict: ``arena``, ``seed``, ``seconds`` (simulated),
-``tanks`` (name, kills, deaths, shots, hits, wall_bumps, distance, position [x, z] at
-the end, ...), ``events`` (the timeline) and, under ``timing`` only, everything that
-depends on the machine's speed.  The same seed gives the same report apart from
+``rules`` (``sim.rules.Rules.to_dict``), ``match`` (limits, over, reason, winner,
+standings: ``MatchState.to_dict``), ``tanks`` (name, kills, deaths, shots, hits,
+wall_bumps, distance, position [x, z] at the end, ...), ``events`` (the timeline)
+and, under ``timing`` only, everything that depends on the machine's speed.  A match
+with a time or score limit ends there, before ``seconds`` if it comes first.  The same seed gives the same report apart from
 ``timing``.
 """
 
@@ -22,6 +24,7 @@ import numpy as np
 from ..errors import ArenaError, TanktoolError, VehicleError
 from .body import TankSpec
 from .driver import make_drivers
+from .rules import DEFAULT as DEFAULT_RULES, Rules
 from .world import DT, World
 
 REPO = Path(__file__).resolve().parent.parent.parent
@@ -143,13 +146,37 @@ def make_bots(world: World, bot: str = "agent", difficulty: str = "normal") -> l
     raise TanktoolError(f"bots must be one of {', '.join(BOT_KINDS)}, got {bot!r}")
 
 
+def match_rules(rules: Rules | dict | None = None, time_limit: float | None = None,
+                score_limit: int | None = None) -> Rules:
+    """The rules of a match: ``rules`` (a Rules, or its ``to_dict`` form; None: the
+    game's defaults) with the limits given here (when not None) put in."""
+    if isinstance(rules, dict):
+        try:
+            rules = Rules.from_dict(rules)
+        except (TypeError, ValueError) as e:
+            raise TanktoolError(str(e)) from None
+    r = DEFAULT_RULES if rules is None else rules
+    if time_limit is not None or score_limit is not None:
+        try:
+            r = r.with_limits(time_limit if time_limit is not None else r.time_limit,
+                              score_limit if score_limit is not None else r.score_limit)
+        except ValueError as e:
+            raise TanktoolError(str(e).replace("rules: time_limit", "--time-limit")
+                                .replace("rules: score_limit", "--score-limit")) from None
+    return r
+
+
 def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 60.0, seed: int = 0,
               dt: float = DT, integrator: str = "semi-implicit",
               on_progress: Callable[[int], None] | None = None, progress_every: int = 120,
               bot: str = "agent", difficulty: str = "normal",
-              wrap_drivers: Callable[[World, list], list] | None = None) -> MatchResult:
+              wrap_drivers: Callable[[World, list], list] | None = None,
+              rules: Rules | dict | None = None, time_limit: float | None = None,
+              score_limit: int | None = None) -> MatchResult:
     """Run ``bots`` tanks for ``seconds`` of simulated time, driven by computer agents
-    at ``difficulty`` (``bot="agent"``) or by the scripted baseline (``bot="scripted"``).
+    at ``difficulty`` (``bot="agent"``) or by the scripted baseline (``bot="scripted"``),
+    under ``rules`` (default: the game's, ``sim.rules.DEFAULT``) with ``time_limit``
+    and ``score_limit`` when given; a match that ends on a limit stops there.
 
     ``wrap_drivers(world, drivers) -> drivers`` may wrap or replace the drivers once
     they are made: sim/replay.py records the commands or plays a recording back."""
@@ -159,7 +186,7 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
         raise TanktoolError(f"--seconds must be a positive number, got {seconds}")
     names = [f"bot{i + 1}" for i in range(bots)]
     world = World(arena.walls, [spec] * bots, arena.spawns, seed=seed, dt=dt, integrator=integrator, names=names,
-                  bounds=arena.bounds, ground=arena.ground)
+                  bounds=arena.bounds, ground=arena.ground, rules=match_rules(rules, time_limit, score_limit))
     drivers = make_bots(world, bot, difficulty)
     if wrap_drivers is not None:
         drivers = wrap_drivers(world, drivers)
@@ -169,17 +196,22 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
     trails: list[list[tuple[float, float]]] = [[t.position] for t in world.tanks]
     tanks = world.tanks
     start = time.perf_counter()
+    done = 0
     for k in range(steps):
         commands = [d(world, t) for d, t in zip(drivers, tanks)]
         events.extend(world.step(None, commands))
+        done = k + 1
         if (k + 1) % trail_every == 0:
             for tr, t in zip(trails, tanks):
                 tr.append(t.position if t.alive else (math.nan, math.nan))
         if on_progress is not None and (k + 1) % progress_every == 0:
             on_progress(progress_every)
+        if world.match.over:
+            break
     wall = time.perf_counter() - start
-    if on_progress is not None and steps % progress_every:
-        on_progress(steps % progress_every)
+    if on_progress is not None and (steps - done // progress_every * progress_every):
+        on_progress(steps - done // progress_every * progress_every)
+    steps = done
     report = make_report(world, arena.name, spec.name, seed, events)
     report["bots"] = bot
     report["difficulty"] = difficulty if bot == "agent" else None
@@ -194,6 +226,7 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
 def make_report(world: World, arena: str, vehicle: str, seed: int, events: list) -> dict[str, Any]:
     """The match report (without ``timing``)."""
     names = world.names
+    match = world.match
     tanks = []
     for t in world.tanks:
         x, z = t.position
@@ -204,7 +237,7 @@ def make_report(world: World, arena: str, vehicle: str, seed: int, events: list)
             "heading": _r(t.heading, 4),
             "hit_points": _r(max(t.hp, 0.0), 2), "alive": t.alive,
         })
-    ranking = sorted(tanks, key=lambda d: (-d["kills"], d["deaths"], names.index(d["name"])))
+    leader = match.winner if match.over else match.leader(world)
     return {
         "arena": arena,
         "vehicle": vehicle,
@@ -213,7 +246,9 @@ def make_report(world: World, arena: str, vehicle: str, seed: int, events: list)
         "steps": world.steps,
         "dt": world.dt,
         "integrator": world.integrator,
-        "winner": ranking[0]["name"] if ranking and ranking[0]["kills"] > 0 else None,
+        "winner": names[leader] if leader is not None and world.tanks[leader].kills > 0 else None,
+        "rules": world.rules.to_dict(),
+        "match": match.to_dict(world),
         "tanks": tanks,
         "events": [e.to_dict(names) for e in events],
     }
@@ -234,7 +269,8 @@ def format_report(report: dict[str, Any]) -> str:
 
 
 def scoreboard(report: dict[str, Any]) -> str:
-    """A fixed-width table of the tanks, best first."""
+    """A fixed-width table of the tanks, best first, and, when the match has a time or
+    score limit, a line saying whether it ended, how, and who won."""
     rows = sorted(report["tanks"], key=lambda d: (-d["kills"], d["deaths"]))
     head = f"{'tank':<8} {'kills':>5} {'deaths':>6} {'shots':>5} {'hits':>4} {'bumps':>5} {'distance':>9}  position"
     lines = [head, "-" * len(head)]
@@ -242,4 +278,12 @@ def scoreboard(report: dict[str, Any]) -> str:
         x, z = d["position"]
         lines.append(f"{d['name']:<8} {d['kills']:>5} {d['deaths']:>6} {d['shots']:>5} {d['hits']:>4} "
                      f"{d['wall_bumps']:>5} {d['distance']:>8.1f}m  ({x:.1f}, {z:.1f})")
+    m = report.get("match")
+    if m and m["over"]:
+        how = (f"score limit {m['score_limit']} reached" if m["reason"] == "score"
+               else f"time limit {m['time_limit']:g} s reached")
+        who = f"{m['winner']} wins" if m["winner"] else "a draw"
+        lines.append(f"match over at {m['ended_at']:.2f} s: {how}, {who}")
+    elif m and (m["time_limit"] is not None or m["score_limit"] is not None):
+        lines.append(f"match not over after {report['seconds']:g} s (no limit reached)")
     return "\n".join(lines)

@@ -23,8 +23,10 @@ step k+1 (when ``world.steps == k``) and keeps returning it until the next recor
 tank i; before its first record a tank is idle.  The header carries the world's
 random-generator state right after the drivers were made (so playback does not
 depend on how they consumed it), fingerprints of the walls, spawns and vehicle (a
-changed arena is refused, not silently replayed into another match), and a sha256 of
-the final world state and scores so that playback can say whether it matched.
+changed arena is refused, not silently replayed into another match), the match's
+rules (``rules``: ``sim.rules.Rules.to_dict``; a recording without them was made
+before issue 19 and plays back under ``Rules.classic()``), and a sha256 of the final
+world state and scores so that playback can say whether it matched.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ from .commands import IDLE, Command
 if TYPE_CHECKING:  # pragma: no cover
     from .body import Tank, TankSpec
     from .match import ArenaInfo, MatchResult
+    from .rules import Rules
     from .world import World
 
 MAGIC = b"TTRP"
@@ -102,8 +105,8 @@ class Replay:
     """A recorded match.
 
     header : setup (``arena``, ``vehicle``, ``bots``, ``seconds``, ``seed``, ``dt``,
-             ``integrator``, ``options`` for run_match), fingerprints, ``rng_state``,
-             ``final_state`` digest
+             ``integrator``, ``options`` for run_match, ``rules``), fingerprints,
+             ``rng_state``, ``final_state`` digest
     steps : (n,) int64, the world step count at which each change was made
     tanks : (n,) int64, tank index of each change
     values : (n, 3) float64, advance / rotate / strafe
@@ -256,6 +259,8 @@ MAX_REPLAY_BYTES = 256 << 20
 DT_RANGE = (1e-4, 1.0)
 #: keys of ``options`` that run_match takes, and the values each may have
 _OPTION_VALUES = {"bot": ("agent", "scripted"), "difficulty": ("easy", "normal", "hard")}
+#: the match end's options: (exclusive low, high, whole number), as ``play`` accepts them
+_LIMIT_OPTIONS = {"time_limit": (0.0, 86400.0, False), "score_limit": (0.0, 1_000_000.0, True)}
 
 
 def _is_int(v: Any) -> bool:
@@ -314,9 +319,16 @@ def check_header(header: dict[str, Any], where: str) -> None:
         if not isinstance(options, dict):
             raise bad("options", "must be an object")
         for k, v in options.items():
+            if k in _LIMIT_OPTIONS:
+                lo, hi, whole = _LIMIT_OPTIONS[k]
+                number = _is_int(v) if whole else (isinstance(v, (int, float)) and not isinstance(v, bool))
+                if not (number and math.isfinite(v) and lo < v <= hi):
+                    raise bad(f"options.{k}", f"must be a {'whole ' if whole else ''}number in ({lo:g}, {hi:g}]")
+                continue
             if k not in _OPTION_VALUES or v not in _OPTION_VALUES[k]:
                 allowed = "; ".join(f"{k2}: {', '.join(vs)}" for k2, vs in _OPTION_VALUES.items())
-                raise FormatError(f"{where}: replay header 'options' {k}={v!r:.40} is not a match option ({allowed})")
+                raise FormatError(f"{where}: replay header 'options' {k}={v!r:.40} is not a match option "
+                                  f"({allowed}; time_limit, score_limit)")
     player = header.get("player")
     if player is not None and not (_is_int(player) and 0 <= player < bots):
         raise bad("player", f"must be a tank index 0..{bots - 1}")
@@ -428,7 +440,10 @@ def record_match(arena: "ArenaInfo", spec: "TankSpec", *, bots: int, seconds: fl
     rec = Recorder()
     result = run_match(arena, spec, bots=bots, seconds=seconds, seed=seed, on_progress=on_progress,
                        wrap_drivers=rec.wrap, **options)
-    header = match_header(arena, spec, result.world, seconds=seconds, seed=seed, arena_ref=arena_ref,
+    w = result.world
+    if w.match.over:            # ended on a limit: the recording is as long as the match was
+        seconds = w.steps * w.dt
+    header = match_header(arena, spec, w, seconds=seconds, seed=seed, arena_ref=arena_ref,
                           vehicle_ref=vehicle_ref, options=options, winner=result.report.get("winner"))
     return result, rec.replay(header)
 
@@ -446,12 +461,27 @@ def match_header(arena: "ArenaInfo", spec: "TankSpec", world: "World", *, second
         "vehicle": spec.name, "vehicle_ref": vehicle_ref, "vehicle_sha256": spec_fingerprint(spec),
         "bots": len(world.tanks), "names": world.names, "seconds": float(seconds), "seed": int(seed),
         "steps": int(world.steps), "dt": world.dt, "integrator": world.integrator,
-        "options": {k: v for k, v in (options or {}).items() if k not in ("dt", "integrator")},
+        "options": {k: v for k, v in (options or {}).items() if k not in ("dt", "integrator", "rules")},
+        "rules": world.rules.to_dict(),
         "final_state": state_digest(world),
         "winner": winner,
     }
     header.update(extra)
     return header
+
+
+def replay_rules(header: dict[str, Any]) -> "Rules":
+    """The rules a recording was made under: its ``rules``, or, for a recording made
+    before matches had rules (issue 19), ``Rules.classic()``."""
+    from .rules import Rules
+
+    d = header.get("rules")
+    if d is None:
+        return Rules.classic()
+    try:
+        return Rules.from_dict(d, "replay header: rules")
+    except (TypeError, ValueError) as e:
+        raise FormatError(str(e)) from None
 
 
 @dataclass
@@ -480,8 +510,9 @@ def play_replay(replay: Replay, arena: "ArenaInfo", spec: "TankSpec",
     dt = float(h["dt"])
     if int(round(seconds / dt)) != int(h["steps"]) or not math.isfinite(seconds):
         raise TanktoolError(f"replay header: seconds {seconds} and dt {dt} do not give {h['steps']} steps")
+    options = {k: v for k, v in dict(h.get("options") or {}).items() if k != "rules"}
     result = run_match(arena, spec, bots=int(h["bots"]), seconds=seconds, seed=int(h["seed"]), dt=dt,
                        integrator=str(h["integrator"]), on_progress=on_progress, wrap_drivers=replay.wrap,
-                       **dict(h.get("options") or {}))
+                       rules=replay_rules(h), **options)
     digest = state_digest(result.world)
     return Playback(result, digest, digest == h["final_state"])

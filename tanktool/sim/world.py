@@ -12,7 +12,10 @@ stage of the paper:
 7. collision resolution — impulses, positional correction, and back to 6 until
                           nothing collides (bounded); damage, kills
 
-and returns the step's events.  Everything random comes from the world's own seeded
+and returns the step's events.  The match's rules (``sim.rules.Rules``: the gun,
+spawn protection, where tanks spawn, the time and score limits) are the world's;
+once a limit is reached ``World.match.over`` is set and the world stops stepping.
+Everything random comes from the world's own seeded
 ``random.Random``; tanks, pairs and shells are visited in index order, so the same
 seed and the same commands give bit-identical results.
 """
@@ -32,11 +35,12 @@ from ..nav.quadtree import WallQuadtree
 from .collide import QuadtreeIndex, WallIndex, WallSet, shell_hits_tank, tank_contact, wall_contacts
 from .commands import Command
 from .resolve import SLOP, correct_walls, pair_impulse, separate_pair, wall_impulse
-from .weapons import GRAVITY, Shell, fire, fly, stop_fraction
+from .rules import DEFAULT as DEFAULT_RULES, GRAVITY, MatchState, Rules
+from .weapons import Shell, fire, fly, stop_fraction
 
 DT = 1.0 / 120.0
 INTEGRATORS = ("semi-implicit", "euler")
-EVENT_KINDS = ("shot", "hit", "kill", "wall_bump", "respawn")
+EVENT_KINDS = ("shot", "hit", "kill", "wall_bump", "respawn", "shielded", "match_end")
 #: a wall contact after this long without one counts as a new bump [s]
 BUMP_GAP = 0.25
 #: eye height over the surface of a point of sight given without one [m]
@@ -51,8 +55,10 @@ class Event:
     """Something that happened during a step.
 
     ``tank`` is the actor (shooter, killer, the tank that bumped or respawned);
-    ``other`` the victim of a hit or kill, or the wall index of a bump (-1 if none);
-    ``value`` the damage of a hit or the impulse [N s] of a bump.
+    ``other`` the victim of a hit, kill or shielded hit (a shell that met a tank under
+    spawn protection), or the wall index of a bump (-1 if none);
+    ``value`` the damage of a hit or the impulse [N s] of a bump.  ``match_end``:
+    ``tank`` is the winner (-1: a draw), at the winner's position.
     """
 
     step: int
@@ -67,8 +73,10 @@ class Event:
     def to_dict(self, names: Sequence[str] | None = None) -> dict[str, Any]:
         d: dict[str, Any] = {"t": round(self.t, 4), "step": self.step, "kind": self.kind,
                              "tank": names[self.tank] if names else self.tank}
-        if self.kind in ("hit", "kill"):
+        if self.kind in ("hit", "kill", "shielded"):
             d["victim"] = names[self.other] if names else self.other
+        if self.kind == "match_end":
+            d["tank"] = (names[self.tank] if names else self.tank) if self.tank >= 0 else None
         if self.kind == "wall_bump":
             d["wall"] = self.other
         if self.kind in ("hit", "wall_bump"):
@@ -98,13 +106,19 @@ class World:
              its surface (height, pitch and roll from it, gravity along its slopes), move
              between levels along its links and never leave it, collide with the walls of
              their own level only, and shells and sight meet the model's triangles.
+    rules : the match's rules (``sim.rules.Rules``; default ``sim.rules.DEFAULT``).
+            Every tank's spec is armed with the rules' gun (``Rules.arm``), so
+            ``tank.spec.shell_speed`` is the speed its shells leave at.
+
+    ``match`` (a ``sim.rules.MatchState``) says whether the match is over, why and
+    who won; ``protection_left(i)`` the seconds of spawn protection tank i has left.
     """
 
     def __init__(self, walls: Any, specs: Sequence[TankSpec], spawns: Any, *, seed: int = 0,
                  dt: float = DT, integrator: str = "semi-implicit", wall_index: WallIndex | None = None,
                  names: Sequence[str] | None = None, respawn_delay: float = 3.0,
                  max_iterations: int = 8, wall_slack: float = 2.0, quadtree_depth: int | None = None,
-                 bounds: Any = None, ground: Any = None) -> None:
+                 bounds: Any = None, ground: Any = None, rules: Rules | None = None) -> None:
         if integrator not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {INTEGRATORS}, got {integrator!r}")
         if not (dt > 0 and math.isfinite(dt)):
@@ -150,15 +164,23 @@ class World:
         self.respawn_delay = float(respawn_delay)
         self.max_iterations = int(max_iterations)
         self.wall_slack = float(wall_slack)
+        self.rules = DEFAULT_RULES if rules is None else rules
+        self.match = MatchState(self.rules.time_limit, self.rules.score_limit)
         order = list(range(len(self.spawns)))
         self.rng.shuffle(order)
+        if self.rules.hidden_spawns:
+            order = self._hidden_order(order, len(specs))
+        armed: dict[int, TankSpec] = {}
         self.tanks: list[Tank] = []
         for i, spec in enumerate(specs):
             x, z, h = self.spawns[order[i]]
-            t = Tank(i, spec, 0.0, 0.0, h, name=names[i] if names else None)
+            gun = armed.setdefault(id(spec), self.rules.arm(spec))
+            t = Tank(i, gun, 0.0, 0.0, h, name=names[i] if names else None)
             t.place(x, z, h)
             self.stand(t, self.spawn_y[order[i]])
             self.tanks.append(t)
+        #: simulated time until which each tank is under spawn protection
+        self.protected_until = [self.rules.spawn_protection] * len(self.tanks)
         self.shells: list[Shell] = []
         self.t = 0.0
         self.steps = 0
@@ -171,6 +193,8 @@ class World:
         dt = self.dt if dt is None else float(dt)
         if len(commands) > len(self.tanks):
             raise ValueError(f"{len(commands)} commands for {len(self.tanks)} tanks")
+        if self.match.over:
+            return []
         events: list[Event] = []
         self.steps += 1
         self.t += dt
@@ -181,13 +205,21 @@ class World:
         self.integrate(dt)
         self.vertices()
         collisions = self.detect_collisions(range(len(self.tanks)), with_shells=True)
-        if self.ground is None:
-            self.resolve_collisions(collisions, events)
-            return events
-        before = [(t.x, t.z) for t in self.tanks]
+        before = [(t.x, t.z) for t in self.tanks] if self.ground is not None else None
         self.resolve_collisions(collisions, events)
-        self._contain(before)
+        if before is not None:
+            self._contain(before)
+        if self.match.check(self) is not None:
+            w = self.match.winner
+            x, z = (self.tanks[w].x, self.tanks[w].z) if w is not None else (0.0, 0.0)
+            events.append(Event(self.steps, self.t, "match_end", -1 if w is None else w, x, z))
         return events
+
+    def protection_left(self, index: int) -> float:
+        """Seconds of spawn protection tank ``index`` has left (0: none; it ends
+        when the tank fires)."""
+        t = self.tanks[index]
+        return max(self.protected_until[index] - self.t, 0.0) if t.alive else 0.0
 
     @property
     def names(self) -> list[str]:
@@ -207,10 +239,13 @@ class World:
     def snapshot(self) -> dict[str, Any]:
         """Everything needed to continue this world exactly (plain data: for network
         peers taking over a session, replays, tests)."""
+        m = self.match
         return {
             "t": self.t, "steps": self.steps, "rng": self.rng.getstate(),
             "tanks": [{f: getattr(t, f) for f in self._TANK_FIELDS} for t in self.tanks],
             "shells": [{f: getattr(s, f) for f in Shell.__slots__} for s in self.shells],
+            "protected_until": list(self.protected_until),
+            "match": {"over": m.over, "reason": m.reason, "ended_at": m.ended_at, "winner": m.winner},
         }
 
     def restore(self, snap: dict[str, Any]) -> None:
@@ -231,6 +266,11 @@ class World:
             for f in Shell.__slots__:
                 setattr(sh, f, d[f])
             self.shells.append(sh)
+        self.protected_until = list(snap.get("protected_until", [0.0] * len(self.tanks)))
+        m = snap.get("match")
+        if m is not None:
+            self.match.over, self.match.reason = m["over"], m["reason"]
+            self.match.ended_at, self.match.winner = m["ended_at"], m["winner"]
 
     def momentum(self) -> tuple[float, float]:
         """Total linear momentum of the live tanks [kg m/s]."""
@@ -309,8 +349,9 @@ class World:
             turn_drag = min(sp.turn_drag, sp.inertia * inv_dt)
             t.torque = sp.turn_torque * r - turn_drag * t.omega
             if want_fire and t.reload <= 0.0:
-                shell = fire(t, self.walls, self.ground)
+                shell = fire(t, self.walls, self.rules, self.rng, self.ground)
                 self.shells.append(shell)
+                self.protected_until[t.index] = -math.inf      # firing ends spawn protection
                 t.reload = sp.fire_interval
                 t.shots += 1
                 events.append(Event(self.steps, self.t, "shot", t.index, t.x, t.z))
@@ -487,6 +528,10 @@ class World:
             if not t.alive:
                 continue
             shooter = self.tanks[s.owner]
+            if self.t < self.protected_until[victim]:
+                hx, hz = s.px + f * (s.x - s.px), s.pz + f * (s.z - s.pz)
+                events.append(Event(self.steps, self.t, "shielded", s.owner, hx, hz, victim, 0.0))
+                continue
             hx = s.px + f * (s.x - s.px)
             hz = s.pz + f * (s.z - s.pz)
             shooter.hits += 1
@@ -506,7 +551,9 @@ class World:
 
     def _respawn(self, t: Tank, events: list[Event]) -> None:
         """Back at a free spawn point (no live tank within both radii + 1 m), chosen with
-        the world's generator; if none is free, the one farthest from the live tanks."""
+        the world's generator; if none is free, the one farthest from the live tanks.
+        With ``rules.hidden_spawns`` the choice is among the free points no live enemy
+        has a line of sight to, if any; else among those seen by the fewest."""
         live = [o for o in self.tanks if o.alive and o is not t]
         free, best, best_d = [], None, -1.0
         for k, (x, z, h) in enumerate(self.spawns):
@@ -517,6 +564,10 @@ class World:
                 free.append(k)
             if d > best_d:
                 best, best_d = k, d
+        if free and self.rules.hidden_spawns:
+            seen = [self._watchers(k, live) for k in free]
+            least = min(seen)
+            free = [k for k, n in zip(free, seen) if n == least]
         k = self.rng.choice(free) if free else best
         x, z, h = self.spawns[k]
         t.place(x, z, h)
@@ -524,6 +575,7 @@ class World:
         t.hp = t.spec.hit_points
         t.alive = True
         t.reload = 0.0
+        self.protected_until[t.index] = self.t + self.rules.spawn_protection
         events.append(Event(self.steps, self.t, "respawn", t.index, x, z))
 
     # ------------------------------------------------------------------ the ground
@@ -666,6 +718,34 @@ class World:
                 return 0.0, dz
         t.vx = t.vz = 0.0
         return 0.0, 0.0
+
+    def _spawn_eye(self, k: int) -> float | None:
+        """Eye height at spawn point ``k`` (None on a flat arena or with no height)."""
+        y = self.spawn_y[k]
+        return None if self.ground is None or y is None else y + EYE
+
+    def _watchers(self, k: int, tanks: Sequence[Tank]) -> int:
+        """How many of ``tanks`` have a line of sight to spawn point ``k``."""
+        x, z, _ = self.spawns[k]
+        y = self._spawn_eye(k)
+        return sum(1 for o in tanks if not self.line_blocked(o.x, o.z, x, z, self.eye(o), y))
+
+    def _hidden_order(self, order: list[int], n: int) -> list[int]:
+        """The first ``n`` spawn points for the tanks, taken from the shuffled ``order``
+        so that each is seen by as few of the ones before it as possible (lines of
+        sight between spawn points; the first of the fewest in ``order``)."""
+        spawns = self.spawns
+
+        def sees(a: int, b: int) -> bool:
+            return not self.line_blocked(spawns[a][0], spawns[a][1], spawns[b][0], spawns[b][1],
+                                         self._spawn_eye(a), self._spawn_eye(b))
+
+        left, taken = list(order), []
+        for _ in range(n):
+            k = min(left, key=lambda c: sum(sees(c, p) for p in taken))
+            left.remove(k)
+            taken.append(k)
+        return taken + left
 
 
 class Collisions:

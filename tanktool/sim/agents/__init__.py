@@ -1,4 +1,5 @@
-"""Computer opponents (issue 7): perception, fuzzy attack, grid navigation and search.
+"""Computer opponents (issue 7): perception, aim and dodging, grid navigation and search;
+the yardstick opponents of issue 19 in ``robots``.
 
     from tanktool.sim.agents import Agent, make_agents
     agents = make_agents(world, "normal")            # one per tank, seeded from the world

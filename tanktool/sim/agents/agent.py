@@ -9,8 +9,15 @@ that returns the command for this think; ``_watch`` plays Watch and Ambush):
   three-node heuristic with memory (``navigation.Wanderer``).
 * **Search** (an enemy was seen or heard, and is not in sight): the quadrant search
   (``navigation.SearchPlan``), A* paths to each quadrant's centre.
-* **Attack** (an enemy in sight and the reaction time passed): the fuzzy controller
-  (``fuzzy.AttackController``) turns, advances or backs off, strafes to dodge, fires.
+* **Attack** (an enemy in sight and the reaction time passed): turn onto the exact
+  intercept (``aim.intercept``; the fuzzy turn rules of ``fuzzy.AttackController``
+  turn the hull), fire when the shot's predicted miss is small (``aim.predicted_miss``),
+  hold the level's fighting distance, strafe at speed, dodge seen shells
+  (``dodge.Evasion``); with ``cover``, back behind the corner it came round while
+  it reloads, and break off a fight it is losing.
+* **Hunt** (``cover`` levels, an enemy seen standing still in the last 90 s): drive
+  to the nearest place that sees it from the stand-off distance, with room to strafe
+  and out of the cone it faced, the gun on it where the way comes into its sight.
 * **Evade** (hit twice within 4 s by an enemy it cannot see): drive to the nearest of
   a few sampled nodes out of the threat's line of sight, or, with no cover near,
   strafe hard.
@@ -42,6 +49,8 @@ between, as a person holds a key)::
     any      --hit repeatedly-->                  Evade --cover reached or 5 s--> Search
     Watch    --watched WATCH_STINT s, part unseen-->  Wander --all seen again--> Watch
     Wander / Watch  --kills above deaths-->       Ambush --not leading any more--> Wander / Watch
+    Attack   --losing, cover-->                   Evade
+    not Attack, not leading --a camp known, cover-->  Hunt --it is not there / forgotten--> Wander
 
 Wander, Watch and Search (not Ambush) also take a heard engine (a moving tank within
 the engine-hearing radius, through walls) as they take a heard shot.
@@ -65,10 +74,14 @@ import random
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ...nav.navgrid import nearest_valid_node
 from ...nav.steering import heading_from_angle
 from ..commands import IDLE, Command
-from .fuzzy import PREDICT, AttackController, FIRE_THRESHOLD
+from . import aim as gun
+from .dodge import Evasion, half_extent_at, visible_shells
+from .driving import Pilot, trim
 from .navigation import (EYE, Coverage, Memory, SearchPlan, Vantages, Wanderer, agent_grid, plan_path, vantages_for,
                          views_for)
 from .perception import Senses, Sighting, wrap
@@ -77,11 +90,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..body import Tank
     from ..world import World
 
-#: corners: braking at this fraction of the engine's deceleration, and up to this much
-#: faster than 3 m/s through a bend gentler than a right angle [m/s]
-CORNER_BRAKE = 0.8
-CORNER_FAST = 6.0
-STATES = ("wander", "watch", "ambush", "search", "attack", "evade")
+STATES = ("wander", "watch", "ambush", "search", "attack", "evade", "hunt")
 #: a vantage point sees at least this fraction of the arena's blocks in one cone
 WATCH_COVER = 0.4
 #: choosing a vantage: its cover less this much per metre of path to it
@@ -89,7 +98,7 @@ WATCH_PER_M = 0.004
 #: watch this long [s] before going to look at what has not been seen for a minute
 WATCH_STINT = 30.0
 #: ... if more than this fraction of the arena's blocks has not been seen for a minute
-STALE = 0.2
+STALE = 0.1
 #: a watching agent sweeps its cone this far either side of the vantage's way [rad],
 #: at this rate [rad/s]
 SWEEP = 0.35
@@ -103,6 +112,23 @@ AMBUSH_AWAY_CAP = 80.0
 #: hit by a tank it cannot see, shot heard in the open: turn to face it, for at most
 #: this long [s] (a half turn takes a light tank about 2.5 s from rest)
 RETURN_FIRE = 3.0
+#: fighting: strafe to a side with at least this much room [m]
+ROOM = 6.0
+#: an enemy slower than this is standing still [m/s]
+STILL = 1.0
+#: an enemy seen again within this long needs no new reaction time [s]
+REACQUIRE = 2.0
+#: cover: where it was in the last TRAIL s [s]; a standing enemy seen in the last KNOWN s is still where it was; within
+#: PREAIM m of it the agent closes in with its gun on it; it goes back to cover while
+#: the reload has more than SCOOT s to go
+TRAIL = 6.0
+KNOWN = 20.0
+PREAIM = 70.0
+SCOOT = 0.4
+#: an enemy seen standing still is remembered there this long [s]; a way into its
+#: sight is driven at most this fast [m/s], gun on it
+CAMP_MEMORY = 90.0
+CAMP_SPEED = 7.0
 
 
 @dataclass(frozen=True)
@@ -116,15 +142,42 @@ class Difficulty:
     hearing_radius: float
     think_hz: float
     engine_radius: float = 0.0
+    #: how much of the intercept lead it takes (0: aims at where the enemy is)
+    lead: float = 1.0
+    #: fires when a shot now would pass within this fraction of the enemy's half width
+    fire_tolerance: float = 0.6
+    #: notices a shell flying at it this long after it comes into view (inf: never dodges)
+    dodge_reaction: float = math.inf
+    #: the distance it fights at when it can choose [m]
+    engage: float = 30.0
+    #: and against an enemy standing still (it cannot dodge; we can, from afar) [m]
+    stand_off: float = 30.0
+    #: aims between where the enemy goes on and where it is if it stops this long after
+    #: the shot (the stop that dodges); 0: the plain intercept [s]
+    hedge: float = 0.0
+    #: waits this long after its gun is loaded before it fires again (a newcomer's
+    #: hesitation) [s]
+    trigger: float = 0.0
+    #: explores for what it has not seen (else: the paper's wander heuristic only)
+    explore: bool = True
+    #: holds vantage points and, leading, hiding places (``Agent(watch=...)`` too)
+    watch: bool = True
+    #: fights like a player who knows cover: closes in on a known enemy with the gun
+    #: on it, goes back behind the corner it came from while reloading, and breaks off
+    #: a fight it is losing
+    cover: bool = False
 
 
 DIFFICULTIES: dict[str, Difficulty] = {
-    "easy": Difficulty("easy", reaction=0.6, aim_noise=math.radians(4.0), vision_range=60.0,
-                       hearing_radius=50.0, think_hz=8.0, engine_radius=25.0),
-    "normal": Difficulty("normal", reaction=0.2, aim_noise=math.radians(1.5), vision_range=90.0,
-                         hearing_radius=80.0, think_hz=15.0, engine_radius=35.0),
-    "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.5), vision_range=130.0,
-                       hearing_radius=120.0, think_hz=20.0, engine_radius=40.0),
+    "easy": Difficulty("easy", reaction=0.8, aim_noise=math.radians(7.0), vision_range=60.0,
+                       hearing_radius=50.0, think_hz=8.0, engine_radius=25.0, lead=0.3, fire_tolerance=1.2,
+                       dodge_reaction=math.inf, engage=25.0, stand_off=25.0, watch=False, trigger=1.2, explore=False),
+    "normal": Difficulty("normal", reaction=0.3, aim_noise=math.radians(1.5), vision_range=90.0,
+                         hearing_radius=80.0, think_hz=15.0, engine_radius=35.0, lead=1.0, fire_tolerance=0.7,
+                         dodge_reaction=0.45, engage=40.0, stand_off=45.0, cover=True),
+    "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.3), vision_range=130.0,
+                       hearing_radius=120.0, think_hz=20.0, engine_radius=40.0, lead=1.0, fire_tolerance=0.5,
+                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True),
 }
 
 
@@ -138,7 +191,7 @@ def difficulty(name: str | Difficulty) -> Difficulty:
         raise ValueError(f"difficulty must be one of {', '.join(DIFFICULTIES)}, got {name!r}") from None
 
 
-class Agent:
+class Agent(Pilot):
     """A computer opponent; call it as a driver: ``agent(world, tank) -> Command``.
 
     Parameters
@@ -173,7 +226,6 @@ class Agent:
         self.goal_gain = 0.0
         self.recheck = 0.0
         self.wanderer: Wanderer | None = None
-        self.controller: AttackController | None = None
         # wander route: world points of nodes, and the walker's node and heading
         self.route: list[tuple[float, float]] = []
         self.walker: tuple[tuple[int, int], str] | None = None
@@ -184,11 +236,23 @@ class Agent:
         self.state_since = 0.0
         self.evade_until = 0.0
         self.evade_cooldown = -math.inf
-        self.threat: tuple[float, float] | None = None
+        self.threat: tuple[float, ...] | None = None
         # attack
         self.target: int | None = None
         self.acquired_at = math.inf
         self.aim_error = rng.gauss(0.0, self.level.aim_noise)
+        self.evasion = Evasion(self.level.dodge_reaction)
+        self.fired_at = -math.inf
+        # cover: enemies' hit points by our count, our hits so far, where it was lately
+        # (t, x, z)
+        self.enemy_hp: dict[int, float] = {}
+        self.own_hits = 0
+        self.trail: list[tuple[float, float, float]] = []
+        # enemies seen standing still: where, when, facing (index -> (x, z, t, heading))
+        self.camps: dict[int, tuple[float, float, float, float]] = {}
+        self.hunt_for: tuple[float, float] | None = None
+        self._room: np.ndarray | None = None
+        self.hunt_replan = -math.inf
         self.dodge = 1.0 if rng.random() < 0.5 else -1.0
         self.dodge_flip = 0.0
         self.hits: list[float] = []
@@ -196,7 +260,7 @@ class Agent:
         self.own_kills = 0
         self.killed_at = -math.inf
         # watching: the vantage table, the spot chosen, the way it faces, the path there
-        self.watches = watch
+        self.watches = watch and self.level.watch
         self.vantages: Vantages | None = None
         self.spot: tuple[float, float] | None = None
         self.spot_face = 0.0
@@ -209,10 +273,7 @@ class Agent:
         self.faced: tuple[object, float] | None = None
         # return fire: the way to face, until when
         self.return_to = (0.0, -math.inf)
-        # stuck recovery
-        self.progress_at = (0.0, math.nan, math.nan)
-        self.reverse_until = -math.inf
-        self.reverse_turn = 1.0
+        Pilot.__init__(self)      # stuck recovery
 
     # ------------------------------------------------------------------ driver
     def __call__(self, world: "World", tank: "Tank") -> Command:
@@ -222,8 +283,21 @@ class Agent:
         if world.t + 1e-12 < self.next_think:
             return self.command
         self.next_think = world.t + self.period
-        self.command = self.think(world, tank)
+        self.command = self._evade_shells(world, tank, self.think(world, tank))
         return self.command
+
+    def _evade_shells(self, world: "World", tank: "Tank", cmd: Command) -> Command:
+        """Dodge a shell seen flying at it (``dodge.Evasion``: noticed after the level's
+        ``dodge_reaction``) when a way out exists: the escape's forward and sideways
+        moves replace the command's, which keeps its turn and its shot."""
+        if not math.isfinite(self.level.dodge_reaction):
+            return cmd
+        esc = self.evasion.command(world, tank, visible_shells(world, tank, self.senses.half_angle,
+                                                               self.senses.vision_range))
+        if esc is None or self.evasion.clearance <= 0.0:
+            return cmd           # nothing to dodge, or no escape: keep fighting
+        top = tank.spec.top_speed
+        return self._drive(world, tank, esc[0] * top, esc[1] * 0.5 * top, cmd.rotate, cmd.fire)
 
     def _reset(self) -> None:
         self.state = "wander"
@@ -233,6 +307,7 @@ class Agent:
         self.spot, self.spot_replan, self.spot_path, self.exploring = None, -math.inf, [], False
         self.return_to = (0.0, -math.inf)
         self.senses.hp = math.inf
+        self.trail = []
         self.reverse_until = -math.inf
         self.next_think = -math.inf
 
@@ -240,7 +315,6 @@ class Agent:
         self.grid = agent_grid(world, self.cell, tank.spec.radius + self.margin)
         self.memory = Memory(self.grid, region=16.0)
         self.wanderer = Wanderer(self.grid, self.memory, self.rng)
-        self.controller = AttackController(tank.spec.shell_speed)
         self.views = views_for(world, self.grid)
         self.coverage = Coverage(self.views, self.senses.half_angle, self.senses.vision_range)
         self.vantages = vantages_for(self.views, self.senses.half_angle, self.senses.vision_range)
@@ -268,19 +342,31 @@ class Agent:
         if self.senses.hit_taken(tank) > 0.0:
             self.hits.append(t)
         self.hits = [h for h in self.hits if t - h < 4.0]
+        self._count_hits(world, tank)
         self._kills(tank, t)
 
+        for o in seen:
+            if math.hypot(o.vx, o.vz) < STILL:
+                self.camps[o.index] = (o.x, o.z, t, o.heading)
+            else:
+                self.camps.pop(o.index, None)
         sight = self._pick_target(seen)
         if sight is not None:
-            fresh = previous is None or previous.index != sight.index or t - previous.t > 1.0
+            fresh = previous is None or previous.index != sight.index or t - previous.t > REACQUIRE
             if self.target != sight.index or fresh:
                 self.acquired_at = t + self.level.reaction
             self.target = sight.index
 
+        self.trail.append((t, tank.x, tank.z))
+        while self.trail and t - self.trail[0][0] > TRAIL:
+            self.trail.pop(0)
         if self.state != "evade" and sight is None and len(self.hits) >= 2 and t >= self.evade_cooldown:
             threat = (sight.x, sight.z, sight.y) if sight else self._estimate(t)
             if threat is not None:
                 self._start_evade(world, tank, threat, t)
+        elif (self.level.cover and sight is not None and self.state == "attack" and t >= self.evade_cooldown
+              and self._losing(world, tank, sight)):
+            self._start_evade(world, tank, (sight.x, sight.z), t)
         if self.state == "evade":
             cmd = self._evade(world, tank, sight)
             if cmd is not None:
@@ -295,6 +381,13 @@ class Agent:
         if sight is not None and t >= self.acquired_at:
             self._enter("attack", t)
             return self._attack(world, tank, sight)
+        if self.level.cover and sight is None and self.state != "attack" and not self._leading(tank):
+            cmd = self._hunt(world, tank)
+            if cmd is not None:
+                self._enter("hunt", t)
+                return self._unstick(world, tank, cmd)
+            if self.state == "hunt":
+                self._enter("wander", t)
         if sight is None and self.state == "attack":
             if t - self.killed_at < 1.0:
                 # it died: it comes back at a spawn point, not where it was
@@ -337,6 +430,8 @@ class Agent:
             if s is not None and t - s.t < 1.0:
                 del self.senses.last_seen[self.target]
                 self.killed_at = t
+            self.enemy_hp.pop(self.target, None)           # it comes back whole
+            self.camps.pop(self.target, None)
 
     def _pick_target(self, seen: list[Sighting]) -> Sighting | None:
         """The current target if still in sight (no dithering), else the nearest."""
@@ -375,7 +470,7 @@ class Agent:
             if not arrived:
                 return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
             self.path = []
-        best = cov.goal(x, z, t, y=tank.y)
+        best = cov.goal(x, z, t, y=tank.y) if self.level.explore else None
         if best is not None:
             cell, gain = best
             gx, gz = self.views.points[cell]
@@ -426,6 +521,17 @@ class Agent:
         if t - self.state_since > 60.0 or self.plan is None:
             return None
         x, z = tank.x, tank.z
+        known = self._known(t)
+        if self.level.cover and known is not None and self.plan.k <= 1 and \
+                math.hypot(known[0] - x, known[1] - z) < PREAIM:
+            # an enemy where it was just seen or heard: close in with the gun on it
+            if not self.path or self.goal != known:
+                self.goal = known
+                self.path = plan_path(self.grid, (x, z, tank.y), known)  # type: ignore[arg-type]
+                self.plan.k = 1
+            trim(self.path, x, z)
+            if self.path and math.hypot(self.path[-1][0] - x, self.path[-1][1] - z) > 4.0:
+                return self._approach(world, tank, self.path, known, 0.5 * tank.spec.top_speed)
         if self.goal is not None and math.hypot(self.goal[0] - x, self.goal[1] - z) < 4.0:
             self.goal, self.path = None, []
         tries = 0
@@ -440,34 +546,190 @@ class Agent:
         trim(self.path, x, z)
         return self._follow(world, tank, self.path, speed=0.9, lookahead=4.0, corner=self._corner(tank))
 
-    # ------------------------------------------------------------------ attack
-    def _attack(self, world: "World", tank: "Tank", s: Sighting) -> Command:
-        ctl = self.controller
+    def _hunt(self, world: "World", tank: "Tank") -> Command | None:
+        """A camping enemy is known: drive to the nearest place (by path) that sees it
+        from ``stand_off`` +- 15 m (the blocks' line-of-sight table), the gun on it where
+        the way comes into its sight.  There and not seeing it: it has gone, forget it.
+        None: no camp known."""
         t = world.t
+        live = [(ct, i) for i, (_, _, ct, _) in self.camps.items() if t - ct <= CAMP_MEMORY]
+        if not live:
+            return None
+        _, idx = max(live)
+        cx, cz, _, face = self.camps[idx]
+        v = self.views
+        x, z = tank.x, tank.z
+        if self.hunt_for != (cx, cz) or t >= self.hunt_replan or not self.path:
+            cb, here = v.cell_at(cx, cz), v.cell_at(x, z, tank.y)  # type: ignore[union-attr]
+            if cb < 0 or here < 0:
+                return None
+            lo, hi = self.level.stand_off - 15.0, min(self.level.stand_off + 15.0, self.senses.vision_range)
+            dist = v.distance[cb]  # type: ignore[union-attr]
+            pd = v.path_distances(here)  # type: ignore[union-attr]
+            sees = v.visible[cb] & np.isfinite(pd)  # type: ignore[union-attr]
+            ok = sees & (dist >= lo) & (dist <= hi)
+            if not ok.any():
+                ok = sees & (dist <= hi)
+            if not ok.any():
+                return None
+            # nearest by path, and a place with room to strafe (ROOM each way) counts
+            # as much nearer as a tank drives in 2 s
+            # and one outside the cone it faced (it does not see us come: first shots
+            # are ours) as much nearer as a tank drives in 4 s
+            roomy = self._block_room() >= ROOM
+            p = v.points  # type: ignore[union-attr]
+            off = np.abs(np.remainder(np.arctan2(p[:, 1] - cz, p[:, 0] - cx) - face + np.pi, 2 * np.pi) - np.pi)
+            unseen = off > self.senses.half_angle + 0.2
+            top = tank.spec.top_speed
+            score = pd - np.where(roomy, 2.0 * top, 0.0) - np.where(unseen, 4.0 * top, 0.0)
+            b = int(np.argmin(np.where(ok, score, np.inf)))
+            gx, gz = (float(c) for c in v.points[b])  # type: ignore[union-attr]
+            self.hunt_for, self.hunt_replan = (cx, cz), t + 5.0
+            self.path = plan_path(self.grid, (x, z, tank.y), (gx, gz, float(v.heights[b])))  # type: ignore[arg-type]
+            if not self.path:
+                return None
+        trim(self.path, x, z)
+        end = self.path[-1]
+        if math.hypot(end[0] - x, end[1] - z) < 3.0:
+            err = abs(wrap(math.atan2(cz - z, cx - x) - tank.heading))
+            if err < 0.3 or t - self.camps[idx][2] > CAMP_MEMORY:
+                del self.camps[idx]            # looking at where it was, and it is not there
+                return None
+            return self._drive(world, tank, 0.0, 0.0, self._turn(tank, wrap(math.atan2(cz - z, cx - x) - tank.heading)))
+        return self._follow(world, tank, self.path, speed=1.0, lookahead=4.0, corner=self._corner(tank))
+
+    def _block_room(self) -> np.ndarray:
+        """Per block of the sight table: the free space around its representative node
+        beyond the grid's clearance [m] (the distance to the nearest invalid node)."""
+        if self._room is None:
+            from scipy.ndimage import distance_transform_edt
+
+            g = self.grid
+            valid = np.asarray(g.layers.valid if g.layers is not None else g.valid, dtype=bool)  # type: ignore[union-attr]
+            if valid.ndim == 3:   # a layered grid: each level's own free space
+                free = np.stack([distance_transform_edt(v) for v in valid]) * g.cell  # type: ignore[union-attr]
+            else:
+                free = distance_transform_edt(valid) * g.cell  # type: ignore[union-attr]
+            self._room = np.array([free[tuple(n)] for n in self.views.nodes])  # type: ignore[union-attr]
+        return self._room
+
+    def _known(self, t: float) -> tuple[float, float] | None:
+        """Where the target was seen (in the last ``KNOWN`` s, standing still, or in the
+        last 3 s, moved on) or a shot was heard (in the last 3 s); None if neither."""
+        s = self.senses.last_seen.get(self.target) if self.target is not None else None
+        if s is not None and t - s.t < (KNOWN if math.hypot(s.vx, s.vz) < STILL else 3.0):
+            dt = min(t - s.t, 2.0)
+            return s.x + s.vx * dt, s.z + s.vz * dt
+        h = self.senses.heard
+        if h is not None and not h.engine and t - h.t < 3.0:
+            return h.x, h.z
+        return None
+
+    # ------------------------------------------------------------------ attack
+    def _losing(self, world: "World", tank: "Tank", s: Sighting) -> bool:
+        """Down to two hits or less and behind the enemy by more than a hit (its hit
+        points counted from ours that hit it, as a player counts them)."""
+        dmg = tank.spec.shell_damage
+        theirs = self.enemy_hp.get(s.index, world.tanks[s.index].spec.hit_points)
+        return tank.hp <= 2.0 * dmg and tank.hp < theirs - dmg
+
+    def _count_hits(self, world: "World", tank: "Tank") -> None:
+        """Our hits since the last think went to the target: its hit points by our count."""
+        if tank.hits > self.own_hits and self.target is not None:
+            e = world.tanks[self.target]
+            left = self.enemy_hp.get(self.target, e.spec.hit_points)
+            self.enemy_hp[self.target] = left - (tank.hits - self.own_hits) * tank.spec.shell_damage
+        self.own_hits = tank.hits
+
+    def _attack(self, world: "World", tank: "Tank", s: Sighting) -> Command:
+        """Turn onto the intercept point, fire when the shot would hit, hold the
+        level's fighting distance, strafe.
+
+        The lead is the exact intercept (``aim.intercept``) of the velocity seen (the
+        level's ``lead`` share of it, relative to our own), off by the aim error drawn
+        after each shot.  The gun fires when a shell leaving at the next chance to fire
+        (the reload left, the hull still turning) would pass within ``fire_tolerance``
+        of the enemy's half width of where it aims -- not at an enemy under spawn
+        protection until that ends before the shell arrives.  It strafes at speed,
+        flipping side every 2.5-5 s and away from walls: a tank that strafes can dodge
+        by stopping (``_evade_shells``)."""
+        lv = self.level
+        t = world.t
+        v = tank.spec.shell_speed
         dx, dz = s.x - tank.x, s.z - tank.z
         d = max(math.hypot(dx, dz), 1e-6)
-        px, pz = -dz / d, dx / d       # the right of the line of sight
-        v_lat = (s.vx - tank.vx) * px + (s.vz - tank.vz) * pz
-        aim = math.atan2(dz, dx) + ctl.lead(v_lat) + self.aim_error  # type: ignore[union-attr]
-        err = wrap(aim - tank.heading)
-        out = ctl(err, tank.omega, d)  # type: ignore[misc]
-        fire = out.fire >= FIRE_THRESHOLD and tank.reload <= self.period
+        tvx = tank.vx + lv.lead * (s.vx - tank.vx)
+        tvz = tank.vz + lv.lead * (s.vz - tank.vz)
+        sol = gun.intercept(tank.x, tank.z, tank.vx, tank.vz, s.x, s.z, tvx, tvz, v)
+        if sol is not None and lv.hedge > 0.0 and sol.time > lv.hedge:
+            # the enemy goes on (at sol.time) or stops (about hedge s after the shot):
+            # aim at the middle, which hits both while they lie within its width (its
+            # own velocity only: ours the shell keeps whatever the enemy does)
+            k = 0.5 * (sol.time + lv.hedge) / sol.time
+            tvx = tank.vx + lv.lead * (k * s.vx - tank.vx)
+            tvz = tank.vz + lv.lead * (k * s.vz - tank.vz)
+            sol = gun.intercept(tank.x, tank.z, tank.vx, tank.vz, s.x, s.z, tvx, tvz, v) or sol
+        heading = sol.heading if sol is not None else math.atan2(dz, dx)
+        err = wrap(heading + self.aim_error - tank.heading)
+        rotate = self._turn(tank, err)
+        fire = False
+        hesitant = lv.trigger > 0.0 and t - self.fired_at < tank.spec.fire_interval + lv.trigger
+        if tank.reload <= self.period and sol is not None and s.protected <= sol.time and not hesitant:
+            delay = max(tank.reload, world.dt)
+            miss = gun.predicted_miss(tank.x, tank.z, tank.vx, tank.vz, tank.heading - self.aim_error, s.x, s.z,
+                                      tvx, tvz, v, delay, tank.omega)
+            e = world.tanks[s.index]
+            fire = miss < lv.fire_tolerance * half_extent_at(e.spec, s.heading, heading)
+            if fire and world.ground is not None:
+                # on relief the hull's pitch aims the gun up or down: hold fire when
+                # the shell would pass over or under the enemy
+                fire = gun.height_miss(world.eye(tank), tank.pitch, v, world.rules.shell_gravity, d,
+                                       s.y, e.spec.height) < HEIGHT_TOLERANCE
         if fire:
-            self.aim_error = self.rng.gauss(0.0, self.level.aim_noise)
-        if t >= self.dodge_flip:
-            self.dodge = -self.dodge
-            self.dodge_flip = t + self.rng.uniform(1.0, 2.5)
+            self.aim_error = self.rng.gauss(0.0, lv.aim_noise)
+            self.fired_at = t
         top = tank.spec.top_speed
-        advance, strafe = out.advance, out.strafe_size
-        lateral = self._dodge_side(world, tank) * strafe * 0.5 * top
-        return self._drive(world, tank, advance * 0.5 * top, lateral, out.rotate, fire)
+        cover = self._cover_behind(world, tank, s) if lv.cover and tank.reload > SCOOT else None
+        if cover is not None:
+            # just fired: back behind the corner while the gun reloads, gun on the enemy
+            cmd = self._approach(world, tank, [cover], (s.x, s.z), 0.5 * top)
+            return Command(cmd.advance, cmd.rotate, cmd.strafe, fire)
+        aligned = max(0.0, 1.0 - abs(err) / 0.6)
+        engage = lv.stand_off if math.hypot(s.vx, s.vz) < STILL else lv.engage
+        forward = max(-0.5 * top, min(0.5 * top, 0.4 * (d - engage))) * aligned
+        side, room = self._strafe_side(world, tank, t)
+        if forward < 0.0 and self._free(world, tank, tank.heading + math.pi, 3.0 * ROOM, (0.0,)) < 2.0 * ROOM:
+            forward = 0.0                       # no backing into a wall or a corner
+        if room < ROOM:
+            forward = 0.5 * top * aligned       # boxed in across the line of fire: out, forwards
+        lateral = side * 0.5 * top * (0.4 + 0.6 * aligned)
+        return self._drive(world, tank, forward, lateral, rotate, fire)
 
-    def _dodge_side(self, world: "World", tank: "Tank") -> float:
-        """The dodge direction, flipped when a wall is near on that side."""
-        angle = tank.heading + self.dodge * math.pi / 2
-        if self._free(world, tank, angle, tank.spec.radius + 6.0, (0.0,)) < tank.spec.radius + 5.0:
+    def _cover_behind(self, world: "World", tank: "Tank", s: Sighting) -> tuple[float, float] | None:
+        """The latest place on our way here (the last ``TRAIL`` s) that the enemy cannot
+        see, if it is 1.5-10 m away: the corner we came round."""
+        for _, x, z in reversed(self.trail):
+            d = math.hypot(x - tank.x, z - tank.z)
+            if d > 10.0:
+                return None
+            if d > 1.5 and world.line_blocked(x, z, s.x, s.z, None, _eye(s.y)):
+                return x, z
+        return None
+
+    def _strafe_side(self, world: "World", tank: "Tank", t: float) -> tuple[float, float]:
+        """The side to strafe to (+1 right, -1 left) and the room [m] there: the same
+        side until a random flip every 4-8 s or until there is less than ``ROOM``
+        that way, then the side with more room."""
+        look = tank.spec.radius + 2.0 * ROOM
+        room = {k: self._free(world, tank, tank.heading + k * math.pi / 2, look, (0.0,)) - tank.spec.radius
+                for k in (1.0, -1.0)}
+        if t >= self.dodge_flip:
+            self.dodge_flip = t + self.rng.uniform(4.0, 8.0)
+            if room[-self.dodge] >= ROOM:
+                self.dodge = -self.dodge
+        if room[self.dodge] < ROOM and room[-self.dodge] > room[self.dodge]:
             self.dodge = -self.dodge
-        return self.dodge
+        return self.dodge, room[self.dodge]
 
     # ------------------------------------------------------------------ watch
     def _watch(self, world: "World", tank: "Tank") -> Command | None:
@@ -508,9 +770,6 @@ class Agent:
                 cell, face = v.safest(here, AMBUSH_PER_M, away, AMBUSH_AWAY, AMBUSH_AWAY_CAP)
             else:
                 cell, face = v.best(here, WATCH_PER_M)
-            if cell < 0:            # off the map (no valid node near): nothing to watch from
-                self.spot = None
-                return None
             spot = tuple(float(c) for c in self.views.points[cell])  # type: ignore[union-attr]
             self.spot_face = face
             if spot != self.spot or not self.spot_path:
@@ -603,149 +862,47 @@ class Agent:
     # ------------------------------------------------------------------ driving
     def _follow(self, world: "World", tank: "Tank", points: list[tuple[float, float]], speed: float,
                 lookahead: float, corner: tuple[float, float] | None = None, stop: bool = False) -> Command:
-        """Pure pursuit of the first point at least ``lookahead`` away (or the last),
-        at up to ``speed`` x top speed, slowing to turn and for ``corner`` (the next
-        waypoint where the path bends); ``stop``: braking to stand at the last point."""
-        if not points:
-            return self._drive(world, tank, 0.0, 0.0, 0.0)
-        x, z = tank.x, tank.z
-        tx, tz = points[-1]
-        for p in points:
-            if math.hypot(p[0] - x, p[1] - z) >= lookahead:
-                tx, tz = p
-                break
-        err = wrap(math.atan2(tz - z, tx - x) - tank.heading)
-        rotate = self._turn(tank, err)
-        top = tank.spec.top_speed
-        # turn first, then drive: full speed only when pointing the right way
-        v = speed * top * max(0.0, 1.0 - abs(err) / 1.2)
-        if corner is not None:
-            # the speed to take the bend at: 3 m/s for a right angle or sharper, more
-            # for a gentler one; braking at CORNER_BRAKE of the engine's deceleration
-            brake = CORNER_BRAKE * tank.spec.engine_force / tank.spec.mass
-            bend = math.pi / 2
-            k = points.index(corner) if corner in points else -1
-            if 0 <= k < len(points) - 1:
-                nx, nz = points[k + 1]
-                bend = abs(wrap(math.atan2(nz - corner[1], nx - corner[0]) - math.atan2(corner[1] - z, corner[0] - x)))
-            vc = 3.0 + CORNER_FAST * max(0.0, 1.0 - bend / (math.pi / 2))
-            v = min(v, vc + math.sqrt(2.0 * brake * math.hypot(corner[0] - x, corner[1] - z)))
-        if stop:
-            # planned at half the corner braking: the speed controller lags the wish
-            brake = 0.5 * CORNER_BRAKE * tank.spec.engine_force / tank.spec.mass
-            v = min(v, math.sqrt(2.0 * brake * math.hypot(points[-1][0] - x, points[-1][1] - z)))
-        return self._drive(world, tank, v, 0.0, rotate)
+        """``Pilot._follow``; but with ``cover``, where the way ahead comes into the sight
+        of a known camping enemy, along it with the gun on that enemy (``_approach``)."""
+        camp = self._camp_ahead(world, tank, points) if self.level.cover and points else None
+        if camp is not None:
+            return self._approach(world, tank, points, camp, min(speed * tank.spec.top_speed, CAMP_SPEED))
+        return super()._follow(world, tank, points, speed, lookahead, corner, stop)
 
-    def _turn(self, tank: "Tank", err: float) -> float:
-        """The turn command for a heading error, read where the gun will point
-        ``PREDICT`` s from now (the fuzzy turn rules)."""
-        return self.controller.turn(err - PREDICT * tank.omega)  # type: ignore[union-attr]
-
-    def _free(self, world: "World", tank: "Tank", angle: float, length: float, offsets: tuple[float, ...]) -> float:
-        """Free distance along ``angle`` from points beside the centre, up to ``length``."""
-        c, s = math.cos(angle), math.sin(angle)
-        best = length
-        for o in offsets:
-            ox, oz = tank.x - s * o, tank.z + c * o
-            hit = world.walls_of(tank).first_hit(ox, oz, ox + c * length, oz + s * length)
-            if hit is not None:
-                best = min(best, hit[0] * length)
+    def _camp_ahead(self, world: "World", tank: "Tank", points: list[tuple[float, float]]
+                    ) -> tuple[float, float] | None:
+        """A camping enemy remembered (``CAMP_MEMORY`` s, within vision range) that sees
+        us here or at the first point of the way at least 6 m ahead."""
+        t, x, z = world.t, tank.x, tank.z
+        ahead = next((p for p in points if math.hypot(p[0] - x, p[1] - z) >= 6.0), points[-1])
+        best, best_d = None, math.inf
+        for cx, cz, ct, _ in self.camps.values():
+            d = math.hypot(cx - x, cz - z)
+            if t - ct > CAMP_MEMORY or d > self.senses.vision_range or d >= best_d:
+                continue
+            if not world.line_blocked(x, z, cx, cz, world.eye(tank)) or not world.line_blocked(ahead[0], ahead[1], cx, cz):
+                best, best_d = (cx, cz), d
         return best
 
-    def _drive(self, world: "World", tank: "Tank", forward: float, lateral: float, rotate: float,
-               fire: bool = False) -> Command:
-        """Commands that reach a wanted forward and sideways speed [m/s] (+ = right).
+    def _on_path(self) -> bool:
+        return bool(self.path or self.route)
 
-        Tracks coast far on their own (the rolling drag is weak), so speed is
-        controlled, braking included, and capped by the walls: the speed from which
-        the tank can still stop, at 60 % of its engine's deceleration, before its
-        centre comes within footprint radius + 1 m of a wall.  Feelers are rays from
-        the centre and beside it, along the way the tank is going.
-        """
-        spec = tank.spec
-        c, s = tank.c, tank.s
-        vf = tank.vx * c + tank.vz * s
-        vr = -tank.vx * s + tank.vz * c
-        bx0, bz0, bx1, bz1 = spec.box
-        half = 0.5 * (bz1 - bz0)
-        length = 0.5 * (bx1 - bx0)
-        if abs(forward) > 0.05:
-            brake = 0.8 * spec.engine_force / spec.mass
-            stop = (bx1 if forward > 0 else -bx0) + 1.0
-            reach = stop + forward * forward / (2.0 * brake) + 1.0
-            angle = tank.heading if forward > 0 else tank.heading + math.pi
-            free = self._free(world, tank, angle, reach, (0.0, half, -half))
-            forward = math.copysign(min(abs(forward), math.sqrt(2.0 * brake * max(free - stop, 0.0))), forward)
-        if abs(lateral) > 0.05:
-            brake = 0.6 * spec.strafe_force / spec.mass
-            stop = spec.radius + 1.0
-            angle = tank.heading + math.copysign(math.pi / 2, lateral)
-            free = self._free(world, tank, angle, stop + 10.0, (0.0, 0.8 * length, -0.8 * length))
-            lateral = math.copysign(min(abs(lateral), math.sqrt(2.0 * brake * max(free - stop, 0.0))), lateral)
-        # a wall closer than the footprint radius + 1.5 m pushes the tank away: turning
-        # in place sweeps the whole footprint circle, and attack moves go anywhere
-        push = spec.radius + 1.5
-        px = pz = 0.0
-        walls = world.walls_of(tank)
-        for k in walls.near(tank.x, tank.z, push):
-            w = walls.walls[k]
-            ax, az, ex, ez, l2, _ = w  # type: ignore[misc]
-            u = min(max(((tank.x - ax) * ex + (tank.z - az) * ez) / l2, 0.0), 1.0)
-            dx, dz = tank.x - (ax + u * ex), tank.z - (az + u * ez)
-            d = math.hypot(dx, dz)
-            if d > 1e-9:
-                px += dx / d * (push - d)
-                pz += dz / d * (push - d)
-        if px or pz:
-            forward += 2.0 * (px * c + pz * s)
-            lateral += 2.0 * (-px * s + pz * c)
-        top = spec.top_speed
-        advance = forward / top + 0.3 * (forward - vf)
-        strafe = lateral / (0.5 * top) + 0.3 * (lateral - vr)
-        return Command(advance=advance, rotate=rotate, strafe=strafe, fire=fire)
+    def _replan(self) -> None:
+        self.route, self.walker, self.path, self.spot_path = [], None, [], []
 
     def _corner(self, tank: "Tank") -> tuple[float, float] | None:
         """The next waypoint of the A* path where it bends (the path's end counts)."""
         return self.path[0] if self.path else None
 
-    def _back_off(self, tank: "Tank") -> Command:
-        return Command(advance=-0.3, rotate=self.reverse_turn)
 
-    def _unstick(self, world: "World", tank: "Tank", cmd: Command) -> Command:
-        """Pushing (or held still on a path) but not moving for a second: reverse and
-        turn for 0.8 s, then replan."""
-        t = world.t
-        if t < self.reverse_until:
-            back = self._free(world, tank, tank.heading + math.pi, 8.0, (0.0,))
-            ahead = self._free(world, tank, tank.heading, 8.0, (0.0,))
-            return self._drive(world, tank, -4.0 if back >= ahead else 4.0, 0.0, self.reverse_turn)
-        t0, x0, z0 = self.progress_at
-        # pushing, or on a path and neither driving nor turning (a wall feeler holding
-        # it still, facing the next waypoint past a corner)
-        pushing = abs(cmd.advance) >= 0.3 or (bool(self.path or self.route) and abs(cmd.rotate) < 0.1
-                                               and abs(tank.omega) < 0.1)
-        if not pushing or not math.isfinite(x0) or math.hypot(tank.x - x0, tank.z - z0) > 0.5:
-            self.progress_at = (t, tank.x, tank.z)
-            return cmd
-        if t - t0 > 1.0:
-            # back out the way there is room for, turning; then plan afresh from here
-            self.reverse_until = t + 0.8
-            self.reverse_turn = 1.0 if self.rng.random() < 0.5 else -1.0
-            self.progress_at = (t + 0.8, math.nan, math.nan)
-            self.route, self.walker, self.path, self.spot_path = [], None, [], []
-            return self._drive(world, tank, -4.0, 0.0, self.reverse_turn)
-        return cmd
+#: a shot on relief may pass this far over or under the enemy's body [m] (its
+#: sphere tree is rounder than the box the test assumes)
+HEIGHT_TOLERANCE = 0.25
 
 
 def _eye(y: float | None) -> float | None:
     """The eye height over a tank standing at ``y`` (None: not known)."""
     return None if y is None else y + EYE
-
-
-def trim(path: list[tuple[float, float]], x: float, z: float, reach: float = 3.0) -> None:
-    """Drop the waypoints of ``path`` already within ``reach`` m of (x, z), keeping the last."""
-    while len(path) > 1 and math.hypot(path[0][0] - x, path[0][1] - z) < reach:
-        path.pop(0)
 
 
 def make_agents(world: "World", level: str | Difficulty = "normal",

@@ -51,7 +51,8 @@ def wrap(a: float) -> float:
 @dataclass(frozen=True)
 class Sighting:
     """One enemy seen at time ``t``: its index, centre and velocity then, distance,
-    which way its hull (and gun) points, and the height it stands at."""
+    which way its hull (and gun) points, the height it stands at and the seconds of
+    spawn protection it has left (a player sees its shield)."""
 
     index: int
     x: float
@@ -62,6 +63,7 @@ class Sighting:
     distance: float
     heading: float = 0.0
     y: float = 0.0
+    protected: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -94,6 +96,12 @@ def can_see(walls, ox: float, oz: float, heading: float, tx: float, tz: float,
     ``walls`` is the world's ``WallSet`` (or anything with ``blocked(ax, az, bx, bz)``).
     """
     return in_cone(ox, oz, heading, tx, tz, half_angle, vision_range) and not walls.blocked(ox, oz, tx, tz)
+
+
+def _protection(world: "World", index: int) -> float:
+    """Seconds of spawn protection tank ``index`` has left (0 in worlds without it)."""
+    left = getattr(world, "protection_left", None)
+    return left(index) if left is not None else 0.0
 
 
 class Senses:
@@ -131,7 +139,7 @@ class Senses:
         for o, seen in zip(cand, world.sees_all(me, cand)):
             if seen:
                 s = Sighting(o.index, o.x, o.z, o.vx, o.vz, world.t, math.hypot(o.x - me.x, o.z - me.z), o.heading,
-                             o.y)
+                             o.y, _protection(world, o.index))
                 self.last_seen[o.index] = s
                 out.append(s)
         out.sort(key=lambda s: (s.distance, s.index))
