@@ -237,3 +237,29 @@ def test_an_agent_grid_falls_back_to_less_clearance():
     bots = make_bots(w)
     for _ in range(600):
         w.step(None, [b(w, t) for b, t in zip(bots, w.tanks)])
+
+
+def test_play_refuses_a_vehicle_too_big_for_the_arena_and_picks_one_that_fits(tmp_path, monkeypatch):
+    """An arena imported too small for the heavy tank records the largest that fits
+    ([vehicles]); play refuses the heavy one by name and, with no --vehicle, takes the
+    one that fits and says so."""
+    out = _import(tmp_path, "corridor")
+    info = load_match_arena(out)
+    assert info.vehicles.get("largest") == "light" and "heavy" in info.vehicles.get("too_big", [])
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(out), "--vehicle", "heavy",
+                                 "--seconds", "1", "--bots", "2"])
+    assert r.exit_code == 2 and "too big for arena" in r.output and "--vehicle light" in r.output, r.output
+    assert "Traceback" not in r.output
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(out), "--seconds", "1", "--bots", "2",
+                                 "--report", str(tmp_path / "r.json")])
+    assert r.exit_code == 0, r.output
+    import json
+
+    assert {t["vehicle"] for t in json.loads((tmp_path / "r.json").read_text())["tanks"]} == {"light"}
+    # a default vehicle too big for it gives way to the largest that fits, with a word
+    from tanktool.sim import match
+
+    monkeypatch.setattr(match, "default_vehicle", lambda: "heavy")
+    said = []
+    assert match.choose_vehicle(info, None, said.append) == "light"
+    assert said and "playing with light" in said[0]

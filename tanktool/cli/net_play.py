@@ -102,7 +102,7 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
     from ..net.peer import Peer, parse_address
     from ..net.protocol import name_bytes
     from ..net.session import NetMatch
-    from ..sim.match import default_arena, default_vehicle, load_match_arena, load_tank_spec
+    from ..sim.match import default_arena, load_match_arena, load_tank_spec
 
     if host is not None and join is not None:
         raise click.UsageError("--host and --join exclude each other")
@@ -126,7 +126,9 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
     if ref is None:
         raise TanktoolError("no arena given and none bundled under arenas/ (use --arena PATH)")
     info = load_match_arena(ref)
-    spec = load_tank_spec(vehicle or default_vehicle())
+    from ..sim.match import choose_vehicle
+
+    spec = load_tank_spec(choose_vehicle(info, vehicle, echo))   # one the arena is built for
     seconds = DEFAULT_NET_SECONDS if seconds is None else seconds
 
     if host is not None:

@@ -130,7 +130,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             return
         run_network(host, join, player_name, password, arena, vehicle, seconds, seed, report_path, echo)
         return
-    from ..sim.match import default_vehicle, format_report, load_match_arena, load_tank_spec, run_match, scoreboard
+    from ..sim.match import (choose_vehicle, default_vehicle, format_report, load_match_arena, load_tank_spec,
+                             run_match, scoreboard)
 
     width, height = _size(size)
     if record_path is not None or replay_path is not None:
@@ -232,7 +233,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             raise TanktoolError(f"{out}: folder {out.parent} does not exist")
 
     info = load_match_arena(_arena_ref(arena))
-    vref = vehicle or default_vehicle()
+    # a replay plays what it recorded; a new match only with a vehicle the arena is built for
+    vref = (vehicle or default_vehicle()) if replay is not None else choose_vehicle(info, vehicle, echo)
     spec = load_tank_spec(vref)
     if vref is None:
         echo("no vehicle bundled yet: using the built-in box tank")

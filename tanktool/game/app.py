@@ -392,7 +392,7 @@ class App:
         play it in the window: your tank is yours, the others come over the network
         (``game.net_session``).  Raises NetError/TanktoolError (the menu shows it)."""
         from ..net.peer import Peer, parse_address
-        from ..sim.match import load_match_arena, load_tank_spec
+        from ..sim.match import choose_vehicle, load_match_arena, load_tank_spec
         from .net_session import NetGameSession
 
         m = self.menu
@@ -400,7 +400,7 @@ class App:
         if self.presenter is None or self.presenter.size != self.size():
             self.open_window()
         info = load_match_arena(m.arena.value)
-        spec = load_tank_spec(m.vehicle.value)
+        spec = load_tank_spec(choose_vehicle(info, m.vehicle.value))   # refuses one too big for the arena
         name = self.player_name or ("host" if mode == "host" else "player")
         if mode == "host":
             peer = Peer.host(parse_address(m.address), name, self.password)

@@ -110,7 +110,7 @@ class GameSession:
                  seed: int = 0, difficulty: str = "normal", player: bool = True,
                  drivers: Sequence[Driver] | None = None, bot: str = "agent", rules: Any = None) -> None:
         from ..errors import TanktoolError
-        from ..sim.match import default_arena, default_vehicle, load_match_arena, load_tank_spec, make_bots
+        from ..sim.match import choose_vehicle, default_arena, load_match_arena, load_tank_spec, make_bots
 
         self._args = dict(arena=arena, vehicle=vehicle, bots=bots, seed=seed, difficulty=difficulty,
                           player=player, drivers=drivers, bot=bot, rules=rules)
@@ -119,8 +119,8 @@ class GameSession:
         self.arena_ref = arena or default_arena()
         if self.arena_ref is None:
             raise TanktoolError("no arena given and none bundled under arenas/")
-        self.vehicle_ref = vehicle or default_vehicle()
         self.info = load_match_arena(self.arena_ref)
+        self.vehicle_ref = choose_vehicle(self.info, vehicle)   # refuses one too big for the arena
         self.spec = load_tank_spec(self.vehicle_ref)
         self.difficulty = difficulty
         n = bots + (1 if player else 0)

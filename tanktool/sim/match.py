@@ -42,6 +42,7 @@ class ArenaInfo:
     path: Path | None
     bounds: np.ndarray | None = None
     ground: Any = None            # sim.ground.Ground, None on a flat arena
+    vehicles: dict[str, Any] = field(default_factory=dict)   # the manifest's [vehicles]: what it was built for
 
 
 @dataclass
@@ -110,8 +111,45 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
     bundle = load_arena(path)
     spawns = np.asarray(bundle.spawns, dtype=np.float64)
     spawns = spawns.reshape(len(spawns), -1) if spawns.size else np.zeros((0, 3))
+    vehicles = bundle.toml.get("vehicles")
     return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path), np.asarray(bundle.bounds, float),
-                     load_ground(bundle))
+                     load_ground(bundle), vehicles if isinstance(vehicles, dict) else {})
+
+
+#: a vehicle may be this much larger than the one an arena was built for [m] (rounding)
+FIT_SLACK = 0.01
+
+
+def choose_vehicle(info: ArenaInfo, requested: str | Path | None,
+                   say: Callable[[str], None] | None = None) -> str | Path | None:
+    """The vehicle to play ``info`` with: ``requested``, or the default one.
+
+    An arena too small for the larger vehicles was built (its spawns, its navigation
+    grid) for the largest one that fits: its manifest's ``[vehicles] radius`` and
+    ``largest``.  A requested vehicle with a larger footprint is refused with a clear
+    error (tanks would not fit its passages and spawns); when none was requested the
+    largest that fits is taken instead of the default, and ``say`` is told."""
+    ref = requested if requested is not None else default_vehicle()
+    limit = info.vehicles.get("radius")
+    if ref is None or not isinstance(limit, (int, float)) or isinstance(limit, bool) or not math.isfinite(limit):
+        return ref
+    from ..formats.vehicle_bundle import load_vehicle
+
+    radius = float(load_vehicle(_bundle_dir(ref, "vehicles", DEFAULT_VEHICLES)).footprint_radius)
+    if radius <= limit + FIT_SLACK:
+        return ref
+    largest = info.vehicles.get("largest")
+    hint = f" (the largest that fits: --vehicle {largest})" if isinstance(largest, str) and largest else ""
+    if requested is not None:
+        raise VehicleError(f"{ref}: footprint radius {radius:.2f} m is too big for arena {info.name}, which was "
+                           f"built for vehicles up to {limit:.2f} m{hint}; or re-import the arena for it")
+    if not (isinstance(largest, str) and largest):
+        raise VehicleError(f"arena {info.name} was built for vehicles up to {limit:.2f} m and the default "
+                           f"vehicle {ref} is {radius:.2f} m: give a smaller one with --vehicle")
+    if say is not None:
+        say(f"arena {info.name} is too small for {ref} (footprint radius {radius:.2f} m > {limit:.2f} m): "
+            f"playing with {largest}")
+    return largest
 
 
 def load_tank_spec(ref: str | Path | None) -> TankSpec:
