@@ -247,7 +247,7 @@ class Agent(Pilot):
         # (t, x, z)
         self.enemy_hp: dict[int, float] = {}
         self.own_hits = 0
-        self.trail: list[tuple[float, float, float]] = []
+        self.trail: list[tuple[float, float, float, float]] = []   # (t, x, z, eye height)
         # enemies seen standing still: where, when, facing (index -> (x, z, t, heading))
         self.camps: dict[int, tuple[float, float, float, float]] = {}
         self.hunt_for: tuple[float, float] | None = None
@@ -357,7 +357,7 @@ class Agent(Pilot):
                 self.acquired_at = t + self.level.reaction
             self.target = sight.index
 
-        self.trail.append((t, tank.x, tank.z))
+        self.trail.append((t, tank.x, tank.z, world.eye(tank)))
         while self.trail and t - self.trail[0][0] > TRAIL:
             self.trail.pop(0)
         if self.state != "evade" and sight is None and len(self.hits) >= 2 and t >= self.evade_cooldown:
@@ -708,11 +708,16 @@ class Agent(Pilot):
     def _cover_behind(self, world: "World", tank: "Tank", s: Sighting) -> tuple[float, float] | None:
         """The latest place on our way here (the last ``TRAIL`` s) that the enemy cannot
         see, if it is 1.5-10 m away: the corner we came round."""
-        for _, x, z in reversed(self.trail):
+        near = []
+        for _, x, z, y in reversed(self.trail):
             d = math.hypot(x - tank.x, z - tank.z)
             if d > 10.0:
-                return None
-            if d > 1.5 and world.line_blocked(x, z, s.x, s.z, None, _eye(s.y)):
+                break
+            if d > 1.5:
+                near.append((x, z, y))
+        # all the lines from the enemy at once (one array lookup on a ground)
+        for (x, z, _), hidden in zip(near, world.blocked_from(s.x, s.z, _eye(s.y), near)):
+            if hidden:
                 return x, z
         return None
 
