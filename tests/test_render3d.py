@@ -191,3 +191,20 @@ def test_far_tanks_drop_their_small_parts():
         assert r._lod(other, r._tank_model_matrix(other, 1.0), eye) is far     # 55 m away: a few dozen pixels
     finally:
         r.release()
+
+
+def test_quality_option_picks_the_preset_for_the_run(tmp_path, monkeypatch):
+    from tanktool.game.app import App
+    from tanktool.game.quality import preset
+
+    # the window's settings page may say "high" with its own shadows; --quality low wins, unsaved
+    cfg = tmp_path / "settings.toml"
+    cfg.write_text('quality = "high"\nshadows = "high"\n')
+    app = App(None, arena="box", bots=1, view="top", size=(320, 180), sound=False, settings_file=cfg, quality="low")
+    assert app.quality == preset("low")
+    assert 'quality = "high"' in cfg.read_text()
+    r = CliRunner().invoke(cli, ["play", "--headless", "--frames", "5", "--screenshot", str(tmp_path / "q.png"),
+                                 "--arena", "box", "--bots", "2", "--size", "160x90", "--quality", "low"])
+    assert r.exit_code == 0 and (tmp_path / "q.png").is_file(), r.output
+    r = CliRunner().invoke(cli, ["play", "--headless", "--quality", "ultra"])
+    assert r.exit_code == 2 and "ultra" in r.output

@@ -87,6 +87,9 @@ def _size(text: str) -> tuple[int, int]:
 @click.option("--replay", "replay_path", type=click.Path(dir_okay=False, path_type=Path), default=None,
               help="Play a recorded match back from this file: the same final state, bit for bit.  In the "
                    "window unless --headless, --report or --picture.")
+@click.option("--quality", type=click.Choice(["low", "medium", "high"]), default=None,
+              help="3D graphics preset for this run (default: the settings page's, medium): low for slow "
+                   "software OpenGL, high for shadows on everything and Phong lighting.")
 @click.option("--time-limit", "time_limit", type=click.FloatRange(0, 86400, min_open=True), default=None,
               metavar="S", help="The match ends after S simulated seconds (its rules: the scoreboard says who won).")
 @click.option("--score-limit", "score_limit", type=click.IntRange(1, 1_000_000), default=None, metavar="K",
@@ -98,7 +101,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
          host: str | None = None, join: str | None = None, player_name: str | None = None,
          password: str | None = None, difficulty: str = "normal", bot_driver: str = "agent",
          record_path: Path | None = None, replay_path: Path | None = None,
-         time_limit: float | None = None, score_limit: int | None = None) -> None:
+         time_limit: float | None = None, score_limit: int | None = None, quality: str | None = None) -> None:
     """Play a match: bots on an arena.
 
     \b
@@ -179,7 +182,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             tape = read_replay(replay_path)
             try:
                 run_window(view=view, size=(width, height), fullscreen=fullscreen, replay=tape,
-                           replay_name=str(replay_path))
+                           replay_name=str(replay_path), quality=quality)
                 return
             except NoDisplay as e:
                 echo(f"no display to show the replay ({e}); playing it back headless instead.")
@@ -192,7 +195,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             raise click.UsageError("--frames needs --screenshot FILE.png")
         shot = take_screenshot(screenshot, view=view, frames=120 if frames is None else frames, arena=arena,
                                vehicle=vehicle, bots=8 if bots is None else bots, seed=seed, size=(width, height),
-                               difficulty=difficulty, bot=bot_driver)
+                               difficulty=difficulty, bot=bot_driver, quality=quality or "medium")
         echo(f"{shot['view']} view after {shot['frames']} frames: {shot['path']}")
         return
     if not headless:
@@ -205,7 +208,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
             saved = run_window(arena=arena, vehicle=vehicle, bots=3 if bots is None else max(bots - 1, 0),
                                seed=seed, view=view, size=(width, height), fullscreen=fullscreen,
                                difficulty=difficulty, bot=bot_driver, record=record_path, seconds=seconds,
-                               **extra)
+                               quality=quality, **extra)
             for line in saved:
                 echo(line)
             if record_path is not None and not saved:

@@ -231,7 +231,8 @@ class App:
                  fullscreen: bool = False, bindings: Bindings | None = None, sound: bool = True,
                  bindings_file: Path | None = None, difficulty: str = "normal", bot: str = "agent",
                  record: Path | None = None, replay: Any = None, replay_name: str = "",
-                 seconds: float | None = None, settings_file: Path | None = None, rules: Any = None) -> None:
+                 seconds: float | None = None, settings_file: Path | None = None, rules: Any = None,
+                 quality: str | None = None) -> None:
         from .quality import load_settings
 
         #: the rules of every local match (``sim.rules.Rules``; None: the default ones)
@@ -240,6 +241,8 @@ class App:
         #: the settings page's choices (quality, resolution, name), read at every start
         self.settings_file = settings_file
         self.settings = load_settings(settings_file)
+        if quality is not None:      # --quality: this run's preset, as it is (saved only from the settings page)
+            self.settings.quality, self.settings.shadows, self.settings.particles = quality, None, None
         if tuple(size) == DEFAULT_SIZE and self.settings.resolution:
             size = tuple(int(v) for v in self.settings.resolution.split("x"))   # --size overrides the saved one
         fullscreen = fullscreen or self.settings.fullscreen
@@ -730,7 +733,7 @@ def run_window(arena: str | None = None, vehicle: str | None = None, bots: int =
                difficulty: str = "normal", bot: str = "agent", record: Path | None = None,
                replay: Any = None, replay_name: str = "", network: tuple[str, str] | None = None,
                name: str | None = None, password: str | None = None,
-               seconds: float | None = None, rules: Any = None) -> list[str]:
+               seconds: float | None = None, rules: Any = None, quality: str | None = None) -> list[str]:
     """Open the window and play until the player quits (``record``: every match is
     recorded, the file holds the last one; ``replay``: show that recording instead of
     the menu; ``network``: ("host" or "join", address) starts that network match at
@@ -742,7 +745,8 @@ def run_window(arena: str | None = None, vehicle: str | None = None, bots: int =
         raise NoDisplay(problem)
     pygame.init()
     app = App(None, arena, vehicle, bots, seed, view, size, fullscreen, difficulty=difficulty, bot=bot,
-              record=record, replay=replay, replay_name=replay_name, seconds=seconds, rules=rules)
+              record=record, replay=replay, replay_name=replay_name, seconds=seconds, rules=rules,
+              quality=quality)
     app.player_name, app.password = name, password
     app.open_window()
     try:
