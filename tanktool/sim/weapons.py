@@ -125,6 +125,11 @@ def _meets_model(shell: Shell, mesh) -> float:
     speed = math.hypot(shell.vx, shell.vz)
     if speed > 0.0 and math.isfinite(shell.reach):
         flight = min(flight, shell.reach / speed + CHORD)   # no further than it is spent
+    if shell.g == 0.0:
+        # a straight flight: one segment, tested at once
+        end = (shell.x + shell.vx * flight, shell.y + shell.vy * flight, shell.z + shell.vz * flight)
+        f = mesh.first_hit((shell.x, shell.y, shell.z), end)
+        return math.inf if f is None else float(f * flight)
     n = int(math.ceil(flight / CHORD))
     t = np.arange(n + 1) * CHORD
     y = shell.y + shell.vy * t - 0.5 * shell.g * t * t
