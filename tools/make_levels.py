@@ -207,8 +207,10 @@ def fort(seed: int = 0) -> list:
     parts += [("ramp", ramp(24, 30, 50, 44, 0.0, top, "+x")), ("ramp", ramp(24, 56, 50, 70, 0.0, top, "+x"))]
     # a sunken road west of the fort, across the whole yard, bridged in the middle
     parts = [p for p in parts if p[0] != "ground"]
-    parts += [("ground", box(0, 0, 12, 100, -0.5, 0)), ("ground", box(19, 0, 100, 100, -0.5, 0)),
+    # (the yard's ground is solid down to the road's bottom: the road's sides are earth)
+    parts += [("ground", box(0, 0, 12, 100, -3.0, 0)), ("ground", box(19, 0, 100, 100, -3.0, 0)),
               ("ground", box(12, 0, 19, 100, -3.0, -2.5)),
+              ("wall", box(12, 0, 19, 1, -3.0, 0)), ("wall", box(12, 99, 19, 100, -3.0, 0)),   # the yard wall's footing
               ("deck", box(12, 44, 19, 56, -0.5, 0))]
     return parts
 
