@@ -425,10 +425,22 @@ def free_space(solid, floor):
     return shapely.union_all(parts)
 
 
-def _ring_walls(ring: np.ndarray) -> np.ndarray:
+def _ring_walls(ring: np.ndarray, tolerance: float = 0.0) -> np.ndarray:
     """(k, 2, 2) walls along a closed ring (last point == first), starting at its
-    lowest-left vertex."""
+    lowest-left vertex.  A vertex closer than ``tolerance`` to the one kept before it is
+    dropped, so no wall is shorter than that and the walls still close up (dropping the
+    short walls themselves would leave gaps)."""
     pts = ring[:-1]
+    if tolerance > 0.0 and len(pts) > 3:
+        keep = [0]
+        for k in range(1, len(pts)):
+            if np.hypot(*(pts[k] - pts[keep[-1]])) >= tolerance:
+                keep.append(k)
+        while len(keep) > 3 and np.hypot(*(pts[keep[-1]] - pts[keep[0]])) < tolerance:
+            keep.pop()
+        if len(keep) < 3:
+            return np.zeros((0, 2, 2))
+        pts = pts[keep]
     start = int(np.lexsort((pts[:, 1], pts[:, 0]))[0])
     pts = np.roll(pts, -start, axis=0)
     return np.stack([pts, np.roll(pts, -1, axis=0)], axis=1)
@@ -441,12 +453,10 @@ def outline_walls(free, tolerance: float) -> np.ndarray:
     out = []
     for poly in shapely.get_parts(free):
         for ring in [poly.exterior, *poly.interiors]:
-            out.append(_ring_walls(np.asarray(ring.coords)))
+            out.append(_ring_walls(np.asarray(ring.coords), tolerance))
     if not out:
         return np.zeros((0, 2, 2))
-    walls = np.concatenate(out)
-    length = np.hypot(*(walls[:, 1] - walls[:, 0]).T)
-    return walls[length >= tolerance]
+    return np.concatenate(out)
 
 
 def thin_walls(chains: list, free, tolerance: float) -> np.ndarray:

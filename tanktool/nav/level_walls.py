@@ -335,6 +335,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
             ledges = ledge_walls(cells, same[level], origin, cell, cells & ~floor)
             if len(ledges):
                 thin = np.concatenate([thin, ledges])
+            thin = _split_crossings(_clip_crossings(thin, outline, R, tolerance), tolerance)
             segs = np.concatenate([outline, thin, thin[:, ::-1]]) if len(thin) else outline
             thin_total += 2 * len(thin)
             out_seg.append(segs)
@@ -353,6 +354,71 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     hi = pts.max(axis=0) + AUX_MARGIN
     walls.aux = aux_rectangle(lo[0], lo[1], hi[0], hi[1])
     return LevelWalls(walls, regions, thin_total, portal_len)
+
+
+#: thin walls cut where they cross the outline end this far inside it [m]
+CLIP_INSET = 0.001
+
+
+def _crossings(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Proper crossings (an X, ends excluded) of the segments of ``a`` with those of
+    ``b``, both (n, 2, 2): (index in a, index in b, parameter along the a segment)."""
+    out_i, out_j, out_t = [], [], []
+    if len(a) and len(b):
+        q, s = b[None, :, 0], (b[:, 1] - b[:, 0])[None]
+        for k0 in range(0, len(a), 512):          # bounded memory on long wall lists
+            aa = a[k0:k0 + 512]
+            p, r = aa[:, None, 0], (aa[:, 1] - aa[:, 0])[:, None]
+            den = r[..., 0] * s[..., 1] - r[..., 1] * s[..., 0]
+            qp = q - p
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = (qp[..., 0] * s[..., 1] - qp[..., 1] * s[..., 0]) / den
+                u = (qp[..., 0] * r[..., 1] - qp[..., 1] * r[..., 0]) / den
+            eps = 1e-6
+            hit = (np.abs(den) > 1e-12) & (t > eps) & (t < 1 - eps) & (u > eps) & (u < 1 - eps)
+            i, j = np.nonzero(hit)
+            out_i.append(i + k0)
+            out_j.append(j)
+            out_t.append(t[i, j])
+    if not out_i:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0)
+    return np.concatenate(out_i), np.concatenate(out_j), np.concatenate(out_t)
+
+
+def _split_crossings(seg: np.ndarray, tolerance: float) -> np.ndarray:
+    """Walls that cross each other (two cuts or a cut and a ledge through the same
+    steps) split at the crossing: they then meet at a point, an X becomes four walls
+    ending there."""
+    i, _, t = _crossings(seg, seg)
+    if len(i) == 0:
+        return seg
+    out = [seg[np.setdiff1d(np.arange(len(seg)), i)]]
+    for k in np.unique(i):
+        ts = np.concatenate([[0.0], np.sort(t[i == k]), [1.0]])
+        a, d = seg[k, 0], seg[k, 1] - seg[k, 0]
+        pts = a + ts[:, None] * d
+        pieces = np.stack([pts[:-1], pts[1:]], axis=1)
+        out.append(pieces[np.hypot(*(pieces[:, 1] - pieces[:, 0]).T) >= tolerance / 2])
+    return np.concatenate(out)
+
+
+def _clip_crossings(thin: np.ndarray, outline: np.ndarray, R, tolerance: float) -> np.ndarray:
+    """Thin walls that cross the region's outline (a fence found by the cut a few cm
+    past where the simplified outline runs) end on it instead: the part inside the
+    region is kept, so the two meet in a T, never an X."""
+    bad = np.zeros(len(thin), dtype=bool)
+    bad[_crossings(thin, outline)[0]] = True
+    if not bad.any():
+        return thin
+    # a millimetre inside: the written coordinates (0.1 mm) stay on this side of it
+    inside = shapely.intersection(shapely.linestrings(thin[bad]),
+                                  shapely.buffer(shapely.set_precision(R, 0.0), -CLIP_INSET, join_style="mitre"))
+    coords, index = shapely.get_coordinates(shapely.get_parts(shapely.line_merge(inside)), return_index=True) \
+        if not shapely.is_empty(inside).all() else (np.zeros((0, 2)), np.zeros(0, dtype=np.int64))
+    same = index[1:] == index[:-1]
+    seg = np.stack([coords[:-1][same], coords[1:][same]], axis=1) if len(coords) > 1 else np.zeros((0, 2, 2))
+    seg = seg[np.hypot(*(seg[:, 1] - seg[:, 0]).T) >= tolerance] if len(seg) else seg
+    return np.concatenate([thin[~bad], seg])
 
 
 def ledge_walls(cells: np.ndarray, same: np.ndarray, origin: np.ndarray, cell: float,
@@ -467,4 +533,17 @@ def _drop_slivers(R, tolerance: float):
     if len(parts) == 0:
         return shapely.Polygon()
     keep = ~shapely.is_empty(shapely.buffer(parts, -2 * tolerance, quad_segs=1))
-    return shapely.union_all(parts[keep]) if keep.any() else shapely.Polygon()
+    if not keep.any():
+        return shapely.Polygon()
+    R = shapely.union_all(parts[keep])
+    # and slivers within a part (a pillar that touches a wall in the model, a few mm
+    # off): an opening by half the tolerance closes them, so the pillar's walls meet
+    # the wall instead of leaving a gap or a crossing
+    # (in floating point: a buffer keeps its input's precision grid, and on that grid a
+    # half-tolerance erosion rounds everything away)
+    half = tolerance / 2
+    opened = shapely.buffer(shapely.buffer(shapely.set_precision(R, 0.0), -half, join_style="mitre"), half,
+                            join_style="mitre")
+    opened = shapely.set_precision(opened, tolerance)
+    # where nothing closed, the region as it was (the same walls in the same order)
+    return R if shapely.equals(opened, R) else opened
