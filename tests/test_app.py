@@ -137,3 +137,20 @@ def test_no_display_is_a_clear_fallback(tmp_path, monkeypatch):
     assert r.exit_code == 0, r.output
     assert "no display to open the game window (SDL_VIDEODRIVER=dummy)" in r.output
     assert pic.is_file()
+
+
+def test_the_rules_end_a_window_match_with_the_winner(make_app):
+    # a score limit of the match's rules (tanktool play --score-limit): the world says the
+    # match is over and who won; the window shows the end screen with it
+    from tanktool.sim.rules import DEFAULT
+
+    app = make_app((480, 320), bots=1, rules=DEFAULT.with_limits(score_limit=1))
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    w = app.session.world
+    assert w.rules.score_limit == 1
+    w.tanks[1].kills = 1                    # bot1 scores: the next step ends the match
+    app.advance(0.05)
+    assert w.match.over and app.state == "over"
+    assert "score limit" in app.over_reason and "bot1 wins" in app.over_reason
+    app.frame(0.016)                        # the end screen draws
