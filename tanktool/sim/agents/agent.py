@@ -114,6 +114,9 @@ AMBUSH_AWAY_CAP = 80.0
 RETURN_FIRE = 3.0
 #: fighting: strafe to a side with at least this much room [m]
 ROOM = 6.0
+#: ... the same side for a random time in this range [s] (a strafe takes about 5 s
+#: to reach full speed)
+FLIP = (4.0, 8.0)
 #: an enemy slower than this is standing still [m/s]
 STILL = 1.0
 #: an enemy seen again within this long needs no new reaction time [s]
@@ -166,18 +169,22 @@ class Difficulty:
     #: on it, goes back behind the corner it came from while reloading, and breaks off
     #: a fight it is losing
     cover: bool = False
+    #: with ``cover``: goes back behind the corner it came round while it reloads
+    #: (False: keeps strafing; under rules where a strafe builds up slowly, a tank
+    #: that shuttles to cover stands still in the enemy's sight half the time)
+    scoot: bool = True
 
 
 DIFFICULTIES: dict[str, Difficulty] = {
-    "easy": Difficulty("easy", reaction=0.8, aim_noise=math.radians(7.0), vision_range=60.0,
-                       hearing_radius=50.0, think_hz=8.0, engine_radius=25.0, lead=0.3, fire_tolerance=1.2,
-                       dodge_reaction=math.inf, engage=25.0, stand_off=25.0, watch=False, trigger=1.2, explore=False),
+    "easy": Difficulty("easy", reaction=1.0, aim_noise=math.radians(9.0), vision_range=60.0,
+                       hearing_radius=80.0, think_hz=8.0, engine_radius=40.0, lead=0.3, fire_tolerance=1.2,
+                       dodge_reaction=math.inf, engage=25.0, stand_off=25.0, watch=False, trigger=1.6),
     "normal": Difficulty("normal", reaction=0.3, aim_noise=math.radians(1.5), vision_range=90.0,
                          hearing_radius=80.0, think_hz=15.0, engine_radius=35.0, lead=1.0, fire_tolerance=0.7,
                          dodge_reaction=0.45, engage=40.0, stand_off=45.0, cover=True),
     "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.3), vision_range=130.0,
                        hearing_radius=120.0, think_hz=20.0, engine_radius=40.0, lead=1.0, fire_tolerance=0.5,
-                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True),
+                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, scoot=False),
 }
 
 
@@ -689,7 +696,7 @@ class Agent(Pilot):
             self.aim_error = self.rng.gauss(0.0, lv.aim_noise)
             self.fired_at = t
         top = tank.spec.top_speed
-        cover = self._cover_behind(world, tank, s) if lv.cover and tank.reload > SCOOT else None
+        cover = self._cover_behind(world, tank, s) if lv.cover and lv.scoot and tank.reload > SCOOT else None
         if cover is not None:
             # just fired: back behind the corner while the gun reloads, gun on the enemy
             cmd = self._approach(world, tank, [cover], (s.x, s.z), 0.5 * top)
@@ -724,7 +731,7 @@ class Agent(Pilot):
         room = {k: self._free(world, tank, tank.heading + k * math.pi / 2, look, (0.0,)) - tank.spec.radius
                 for k in (1.0, -1.0)}
         if t >= self.dodge_flip:
-            self.dodge_flip = t + self.rng.uniform(4.0, 8.0)
+            self.dodge_flip = t + self.rng.uniform(*FLIP)
             if room[-self.dodge] >= ROOM:
                 self.dodge = -self.dodge
         if room[self.dodge] < ROOM and room[-self.dodge] > room[self.dodge]:
