@@ -13,7 +13,7 @@ that returns the command for this think; ``_watch`` plays Watch and Ambush):
   intercept (``aim.intercept``; the fuzzy turn rules of ``fuzzy.AttackController``
   turn the hull), fire when the shot's predicted miss is small (``aim.predicted_miss``),
   hold the level's fighting distance, strafe at speed, dodge seen shells
-  (``dodge.Evasion``); with ``cover``, back behind the corner it came round while
+  (``dodge.Evasion``); with ``cover`` and ``scoot``, back behind the corner it came round while
   it reloads, and break off a fight it is losing.
 * **Hunt** (``cover`` levels, an enemy seen standing still in the last 90 s): drive
   to the nearest place that sees it from the stand-off distance, with room to strafe
@@ -166,12 +166,13 @@ class Difficulty:
     #: holds vantage points and, leading, hiding places (``Agent(watch=...)`` too)
     watch: bool = True
     #: fights like a player who knows cover: closes in on a known enemy with the gun
-    #: on it, goes back behind the corner it came from while reloading, and breaks off
+    #: on it, goes back behind the corner it came from while reloading (``scoot``), and breaks off
     #: a fight it is losing
     cover: bool = False
     #: with ``cover``: goes back behind the corner it came round while it reloads
-    #: (False: keeps strafing; under rules where a strafe builds up slowly, a tank
-    #: that shuttles to cover stands still in the enemy's sight half the time)
+    #: (False: keeps strafing.  A strafe builds up at about 1.5 m/s^2, so a tank that
+    #: shuttles to cover hardly moves across the line of fire: hard's median sideways
+    #: speed in its fights with the camper in the box was 0.5 m/s with it, 1.5 without)
     scoot: bool = True
 
 
@@ -658,7 +659,7 @@ class Agent(Pilot):
         (the reload left, the hull still turning) would pass within ``fire_tolerance``
         of the enemy's half width of where it aims -- not at an enemy under spawn
         protection until that ends before the shell arrives.  It strafes at speed,
-        flipping side every 2.5-5 s and away from walls: a tank that strafes can dodge
+        flipping side every ``FLIP`` s and away from walls: a tank that strafes can dodge
         by stopping (``_evade_shells``)."""
         lv = self.level
         t = world.t
