@@ -36,7 +36,7 @@ target either stands ("still"), strafes at full strength and flips side every 3-
 ``dodge.Evasion`` (noticed 0.25 s after they come into view, the hard agent's
 reaction: "dodging").  Printed: the share of on-target shots that missed, by D.
 
-    python bench/bots.py [--matches N] [--sight-runs M] [--seconds S] [--arenas a,b]
+    python bench/bots.py [--matches N] [--sight-runs M] [--seconds S] [--arenas a,b (default: all bundled)]
                          [--levels easy,normal,hard] [--no-bound] [--dodge-seconds S]
                          [--distances 10,20,...] [--json]
 """
@@ -58,6 +58,7 @@ sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
 
+from tanktool.content import bundled_names  # noqa: E402
 from tanktool.formats.walls_txt import WallList, aux_rectangle  # noqa: E402
 from tanktool.sim.agents import DIFFICULTIES, Agent  # noqa: E402
 from tanktool.sim.agents import aim, dodge  # noqa: E402
@@ -246,7 +247,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="skip the bound (the same duels at normal for an agent told where the enemy is)")
     ap.add_argument("--cap", type=float, default=180.0, help="first-sight runs stop here [s]")
     ap.add_argument("--cpu-steps", type=int, default=3000)
-    ap.add_argument("--arenas", default="box,maze,paper2002")
+    ap.add_argument("--arenas", default=",".join(bundled_names("arenas")),
+                    help="comma-separated (default: every bundled arena)")
     ap.add_argument("--levels", default="easy,normal,hard")
     ap.add_argument("--vehicle", default="light")
     ap.add_argument("--dodge-seconds", type=float, default=90.0,

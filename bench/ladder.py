@@ -12,7 +12,7 @@ over all duels (a Bradley-Terry fit, draws counting half, with one virtual draw 
 pair so that a clean sweep stays finite; the players' mean is 1500) with 90 %
 bootstrap intervals (duels resampled within each pair and arena), and the goals.
 
-    python bench/ladder.py [--duels N] [--json] [--arenas box,maze,paper2002]
+    python bench/ladder.py [--duels N] [--json] [--arenas a,b] (default: every bundled arena)
                            [--players scripted,robot,camper,novice,easy,normal,hard]
                            [--seconds S] [--vehicle light] [--boot B]
 """
@@ -33,6 +33,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from tanktool.content import bundled_names  # noqa: E402
 from tanktool.sim.agents import DIFFICULTIES, Agent  # noqa: E402
 from tanktool.sim.agents.robots import YARDSTICKS  # noqa: E402
 from tanktool.sim.driver import ScriptedDriver  # noqa: E402
@@ -40,7 +41,8 @@ from tanktool.sim.match import load_match_arena, load_tank_spec  # noqa: E402
 from tanktool.sim.world import World  # noqa: E402
 
 PLAYERS = ("scripted", "robot", "camper", "novice", "easy", "normal", "hard")
-ARENAS = ("box", "maze", "paper2002")
+#: every bundled arena (box, fort, hills, maze, paper2002 at the time of writing)
+ARENAS = tuple(bundled_names("arenas"))
 
 
 def make_player(name: str, rng: random.Random):
@@ -103,7 +105,7 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--duels", type=int, default=10, help="duels per pair and arena (default 10)")
     ap.add_argument("--seconds", type=float, default=120.0, help="simulated seconds per duel (default 120)")
-    ap.add_argument("--arenas", default=",".join(ARENAS))
+    ap.add_argument("--arenas", default=",".join(ARENAS), help="comma-separated (default: every bundled arena)")
     ap.add_argument("--players", default=",".join(PLAYERS))
     ap.add_argument("--vehicle", default="light")
     ap.add_argument("--boot", type=int, default=300, help="bootstrap resamples for the Elo intervals")

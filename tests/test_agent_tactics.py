@@ -276,3 +276,27 @@ def test_hit_by_a_tank_it_cannot_see_it_turns_to_face_the_shot():
     a2.next_think = -math.inf
     a2(w2, w2.tanks[0])
     assert a2.return_to[1] == -math.inf
+
+
+def test_only_a_level_that_scoots_goes_back_to_cover_while_reloading(monkeypatch):
+    """Normal shuttles behind the corner it came round while its gun reloads; hard
+    (``scoot`` False) keeps strafing in the fight."""
+    from tanktool.sim.agents.agent import DIFFICULTIES, SCOOT
+
+    assert DIFFICULTIES["normal"].scoot and not DIFFICULTIES["hard"].scoot
+    asked = []
+
+    def corner(self, world, tank, s):
+        asked.append(self.level.name)
+        return tank.x - 5.0, tank.z
+
+    monkeypatch.setattr(Agent, "_cover_behind", corner)
+    for level in ("normal", "hard"):
+        w = box_world([(20.0, 10.0), (50.0, 10.0)])
+        me = w.tanks[0]
+        me.reload = SCOOT + 0.5                      # just fired
+        agent = Agent(random.Random(2), level)
+        s = Sighting(1, 50.0, 10.0, 0.0, 0.0, w.t, 30.0, heading=math.pi)
+        cmd = agent._attack(w, me, s)
+        assert not cmd.fire
+    assert asked == ["normal"]
