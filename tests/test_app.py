@@ -155,7 +155,6 @@ def test_remap_on_an_unwritable_config_folder_says_so_and_goes_on(app, tmp_path,
     assert app.state == "remap" and not app.remap_waiting
     assert app.input.bindings.actions["fire"] == ["joybutton:3"]       # in use until the game ends
     assert "not saved" in app.notice and str(blocker) in app.notice and "\n" not in app.notice, app.notice
-    print(app.notice)
     app.frame(0.016)                       # the remap screen draws the notice
     press(app, pygame.K_ESCAPE)
     assert app.state == "menu"
