@@ -35,6 +35,7 @@ def hall(pillars: int, size: float = 300.0, seed: int = 1):
     import shapely
 
     from tanktool.formats.walls_txt import WallList, aux_rectangle
+    from tanktool.geometry.walls import outline_walls
 
     rng = np.random.default_rng(seed)
     n = max(int(np.ceil(np.sqrt(pillars * 1.3))), 1)
@@ -44,12 +45,7 @@ def hall(pillars: int, size: float = 300.0, seed: int = 1):
     free = shapely.box(0, 0, size, size)
     if pillars:
         free = shapely.difference(free, shapely.union_all(shapely.buffer(shapely.points(centres), 0.8, quad_segs=4)))
-    segs = []
-    for poly in shapely.get_parts(free):
-        for ring in [poly.exterior, *poly.interiors]:
-            xy = shapely.get_coordinates(ring)
-            segs.append(np.stack([xy[:-1], xy[1:]], axis=1))
-    seg = np.concatenate(segs)
+    seg = outline_walls(free, 1e-6)          # free space on their left, as import writes them
     walls = WallList(seg, np.ones(len(seg), np.int8), aux_rectangle(-1, -1, size + 1, size + 1))
     spawns = np.array([[10.0, 10.0, 0.0], [size - 10, size - 10, np.pi]])
     return walls, spawns, free

@@ -876,7 +876,10 @@ def case_file(kind: Kind, seed: int, tmp: Path, seeds: list[bytes]) -> Path:
         if rng.random() < 0.05:
             # a file the manifest names replaced by a link out of the bundle
             victim = rng.choice([p for p in bundle.iterdir() if p.name != kind.suffix])
-            victim.unlink()
+            if victim.is_dir() and not victim.is_symlink():   # the bundle's textures/
+                shutil.rmtree(victim)
+            else:
+                victim.unlink()
             victim.symlink_to(rng.choice(["/etc/passwd", "/dev/zero", "../../../../etc"]))
         return bundle
     f = case / f"case{kind.suffix}"

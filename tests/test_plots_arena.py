@@ -11,6 +11,7 @@ import numpy as np
 import shapely
 
 from tanktool.formats.walls_txt import WallList, aux_rectangle
+from tanktool.geometry.walls import outline_walls
 from tanktool.plots.arena import FREE_COLOUR, fill_region, render_preview
 
 matplotlib.use("Agg", force=False)
@@ -60,12 +61,7 @@ def test_fill_region_leaves_holes_empty_and_fills_an_island_in_a_hole():
 def test_preview_of_a_hall_with_pillars_draws_walls_holes_and_spawns():
     free = shapely.difference(shapely.box(0, 0, 40, 40),
                               shapely.union_all(shapely.buffer(shapely.points([[10, 10], [30, 30], [10, 30]]), 2.0)))
-    segs = []
-    for poly in shapely.get_parts(free):
-        for ring in [poly.exterior, *poly.interiors]:
-            xy = shapely.get_coordinates(ring)
-            segs.append(np.stack([xy[:-1], xy[1:]], axis=1))
-    seg = np.concatenate(segs)
+    seg = outline_walls(free, 1e-6)          # free space on their left, as import writes them
     walls = WallList(seg, np.ones(len(seg), np.int8), aux_rectangle(-1, -1, 41, 41))
     png = render_preview(walls, np.array([[20.0, 20.0, 0.0]]), "hall", free, size_px=400)
     img = _png_pixels(png)
