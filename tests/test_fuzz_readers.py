@@ -407,3 +407,16 @@ def test_an_embedded_4096_image_is_kept_at_2048_in_model_glb(tmp_path):
         off = v.get("byteOffset", 0)
         sizes.append(Image.open(io.BytesIO(binary[off:off + v["byteLength"]])).size)
     assert sizes and all(max(s) <= 2048 for s in sizes), sizes
+
+
+def test_an_npy_header_numpy_cannot_tokenize_is_a_format_error(tmp_path):
+    """Found by the long fuzz (arena-navgrid): a header with an unclosed bracket made
+    numpy's header parser raise tokenize.TokenError, an X001 in check."""
+    from tanktool.nav.navgrid import NavGrid
+
+    p = tmp_path / "navgrid.npz"
+    with zipfile.ZipFile(p, "w") as z:
+        z.writestr("valid.npy", b"\x93NUMPY\x01\x00v\x00{'descr': '|b1', 'fortran_order': False, 'shape': ((1, 2), }"
+                   .ljust(128, b" ")[:127] + b"\n")
+    with pytest.raises(FormatError, match="navgrid.npz: member 'valid.npy' cannot be read"):
+        NavGrid.load(p)
