@@ -443,6 +443,172 @@ def mutate_replay(data: bytes, rng: random.Random, pool: list[bytes] | None = No
     return mutate_bytes(data, rng, pool)
 
 
+# ---------------------------------------------------------------------------- images
+
+def _png_chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+
+def png_bytes(w: int, h: int, rows: int | None = None, colour: int = 2) -> bytes:
+    """A PNG declaring w x h pixels (any size: the header is written by hand) holding
+    ``rows`` rows of pixel data (all of them by default; fewer make a short image)."""
+    channels = {0: 1, 2: 3, 6: 4}[colour]
+    n = h if rows is None else rows
+    data = zlib.compress(b"".join(b"\0" + bytes(channels * w) for _ in range(n)), 9)
+    return (b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, colour, 0, 0, 0))
+            + _png_chunk(b"IDAT", data) + _png_chunk(b"IEND", b""))
+
+
+@functools.lru_cache(maxsize=1)
+def full_size_png() -> bytes:
+    """4096 x 4096 RGBA, every row there (64 MB of pixels in about 70 KB)."""
+    row = b"\0" + bytes(4 * 4096)
+    z = zlib.compressobj(9)
+    data = b"".join(z.compress(row) for _ in range(4096)) + z.flush()
+    return (b"\x89PNG\r\n\x1a\n" + _png_chunk(b"IHDR", struct.pack(">IIBBBBB", 4096, 4096, 8, 6, 0, 0, 0))
+            + _png_chunk(b"IDAT", data) + _png_chunk(b"IEND", b""))
+
+
+@functools.lru_cache(maxsize=1)
+def jpeg_bytes() -> bytes:
+    """A small valid JPEG (PIL's)."""
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.new("RGB", (16, 8), (200, 120, 40)).save(buf, format="JPEG")
+    return buf.getvalue()
+
+
+def jpeg_claiming(w: int, h: int) -> bytes:
+    """The small JPEG with its frame header (SOF0) claiming w x h pixels."""
+    b = bytearray(jpeg_bytes())
+    i = b.find(b"\xff\xc0")
+    b[i + 5:i + 9] = struct.pack(">HH", h & 0xFFFF, w & 0xFFFF)
+    return bytes(b)
+
+
+def image_case(rng: random.Random) -> tuple[bytes, str]:
+    """(image bytes, the mime type a glTF would give them): valid, huge by header,
+    truncated, damaged, of another kind than said."""
+    r = rng.randrange(12)
+    if r == 0:
+        return png_bytes(rng.choice([1, 4, 64]), rng.choice([1, 4, 64]), colour=rng.choice([0, 2, 6])), "image/png"
+    if r == 1:
+        return jpeg_bytes(), "image/jpeg"
+    if r == 2:   # huge by header, little or no pixel data
+        w, h = rng.choice([(4097, 4096), (5000, 5000), (9000, 9000), (65535, 65535), (2 ** 31 - 1, 1), (1, 10 ** 9)])
+        return png_bytes(w, h, rows=rng.choice([0, 1]) if w <= 65535 else 0), "image/png"
+    if r == 3:   # at the limit, all its rows (a 64 MB image from a few KB: a zlib bomb the limit allows)
+        return full_size_png(), "image/png"
+    if r == 4:
+        return jpeg_claiming(*rng.choice([(65500, 65500), (4097, 4097), (0, 0), (9000, 9000)])), "image/jpeg"
+    if r == 5:   # truncated
+        data = png_bytes(64, 64) if rng.random() < 0.5 else jpeg_bytes()
+        return data[:rng.randrange(8, len(data))], "image/png" if data.startswith(b"\x89PNG") else "image/jpeg"
+    if r == 6:   # the wrong mime type for the bytes
+        return rng.choice([(png_bytes(4, 4), "image/jpeg"), (jpeg_bytes(), "image/png"),
+                           (b"GIF89a" + bytes(40), "image/png"), (png_bytes(4, 4), rng.choice(["image/gif", "text/plain", "", 7]))])
+    if r == 7:   # the magic, then garbage
+        return rng.choice([b"\x89PNG\r\n\x1a\n", b"\xff\xd8\xff"]) + bytes(rng.randrange(256) for _ in range(200)), \
+            rng.choice(["image/png", "image/jpeg"])
+    data, mime = image_case(rng) if rng.random() < 0.9 else (png_bytes(8, 8), "image/png")
+    return mutate_bytes(data, rng), mime
+
+
+def textured_box_gltf(image: bytes, mime, view=None, rng: random.Random | None = None) -> tuple[dict, bytes]:
+    """The box of :func:`box_gltf` with texture coordinates and ``image`` embedded as
+    its material's base colour texture (``view``: the image's bufferView index when not
+    the one holding it; ``rng``: sometimes a view that leaves the buffer)."""
+    import trimesh  # noqa: F401  (box_gltf's)
+
+    doc, binary = box_gltf(False)
+    n = doc["accessors"][1]["count"]
+    uv = np.random.default_rng(0).random((n, 2), dtype=np.float32).tobytes()
+    binary += b"\0" * (-len(binary) % 4)
+    doc["bufferViews"].append({"buffer": 0, "byteOffset": len(binary), "byteLength": len(uv)})
+    doc["accessors"].append({"bufferView": len(doc["bufferViews"]) - 1, "componentType": 5126, "count": n,
+                             "type": "VEC2"})
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = len(doc["accessors"]) - 1
+    binary += uv
+    binary += b"\0" * (-len(binary) % 4)
+    img_view = {"buffer": 0, "byteOffset": len(binary), "byteLength": len(image)}
+    if rng is not None and rng.random() < 0.15:
+        img_view[rng.choice(["byteOffset", "byteLength"])] = rng.choice([len(binary) + len(image) + 4, 2 ** 31, -1, 0])
+    doc["bufferViews"].append(img_view)
+    binary += image
+    im = {"bufferView": len(doc["bufferViews"]) - 1 if view is None else view}
+    if mime != "":
+        im["mimeType"] = mime
+    doc["images"] = [im]
+    doc["samplers"] = [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]
+    doc["textures"] = [{"source": 0, "sampler": 0}]
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {"index": 0}
+    doc["buffers"][0]["byteLength"] = len(binary) + (-len(binary) % 4)
+    return doc, binary
+
+
+def mutate_textured_glb(data: bytes, rng: random.Random, pool: list[bytes] | None = None) -> bytes:
+    """A textured box with one of :func:`image_case`'s images, its bufferView index
+    sometimes out of range or of the wrong type; else a structure mutation."""
+    if rng.random() < 0.7:
+        image, mime = image_case(rng)
+        view = None
+        if rng.random() < 0.2:
+            view = rng.choice([-1, 99, 2 ** 40, True, "0", None, 1.5, 0])
+        doc, binary = textured_box_gltf(image, mime, view, rng)
+        return glb_bytes(doc, binary)
+    return mutate_glb(data, rng, pool)
+
+
+def _textured_glb_seeds(_tmp: Path) -> list[bytes]:
+    return [glb_bytes(*textured_box_gltf(png_bytes(8, 8), "image/png")),
+            glb_bytes(*textured_box_gltf(jpeg_bytes(), "image/jpeg"))]
+
+
+#: an .obj with texture coordinates naming a material library (the box with a vt per vertex)
+TEXTURED_OBJ = "mtllib case.mtl\n" + "".join(
+    f"v {x} {y} {z}\n" for x in (0, 4) for y in (0, 1) for z in (0, 4)) + "".join(
+    f"vt {u} {v}\n" for u in (0, 1) for v in (0, 1)) + "usemtl skin\n" + "".join(
+    f"f {a}/{1 + (a % 4)} {b}/{1 + (b % 4)} {c}/{1 + (c % 4)}\n" for a, b, c in (
+        (1, 3, 4), (1, 4, 2), (5, 6, 8), (5, 8, 7), (1, 2, 6), (1, 6, 5),
+        (3, 7, 8), (3, 8, 4), (1, 5, 7), (1, 7, 3), (2, 4, 8), (2, 8, 6)))
+
+
+def textured_obj_companions(folder: Path, rng: random.Random) -> None:
+    """Beside ``folder/case.obj``: a material library whose ``map_Kd`` lines name an
+    image (one of :func:`image_case`'s, or none), with options, under odd names, or
+    leading out of the folder (``..``, /etc/passwd, /dev/zero, a link, a folder)."""
+    image, _ = image_case(rng)
+    name = rng.choice(["skin.png", "SKIN.PNG", "textures/skin.png", "maps\\skin.png", "skin.jpg"])
+    target = folder / name.replace("\\", "/")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    r = rng.random()
+    if r < 0.75:
+        target.write_bytes(image)
+    elif r < 0.82:
+        target.symlink_to(rng.choice(["/dev/zero", "/etc/passwd", "../../../etc/hostname"]))
+    elif r < 0.86:
+        target.mkdir(exist_ok=True)
+    named = rng.choice([name, name, name, "../skin.png", "/etc/passwd", "/dev/zero", "missing.png", "",
+                        "-s 2 2 1 " + name, "-o 0.5 0.5 -clamp on " + name, "-bm", "a" * 5000 + ".png"])
+    lines = ["newmtl skin", "Kd 1 1 1", f"map_Kd {named}"]
+    if rng.random() < 0.3:
+        lines += ["newmtl other", f"map_Kd {name}", "map_Kd " + name]
+    text = "\n".join(lines) + "\n"
+    if rng.random() < 0.3:
+        text = mutate_text(text.encode(), rng).decode("utf-8", "replace")
+    (folder / "case.mtl").write_text(text)
+
+
+def _textured_import(path: Path) -> None:
+    """What import does with a textured model: load it, then the game's model.glb
+    with the textures attached and embedded, the texture files copied."""
+    from tanktool.formats.materials import export_glb
+    from tanktool.formats.models import load_scene
+
+    export_glb(path, load_scene(path), path.parent / "bundle", warn=lambda _m: None)
+
+
 # ---------------------------------------------------------------------------- targets
 
 def _load_scene(path: Path) -> None:
@@ -535,6 +701,7 @@ class Kind:
     target: Callable[[Path], None]
     bundle: Path | None = None     # a bundle the file is put into (as ``suffix``), else a bare file
     share: int = 1                 # relative number of cases in a run
+    companions: Callable[[Path, random.Random], None] | None = None   # more files beside a bare one
 
 
 def _files(*globs: str) -> Callable[[Path], list[bytes]]:
@@ -602,6 +769,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
     Kind("off", ".off", _trimesh_seeds("off"), mutate_text, _load_scene),
     Kind("glb", ".glb", _glb_seeds, mutate_glb, _load_scene, share=4),
     Kind("glb-check", ".glb", _glb_seeds, mutate_glb, _check_triangles, share=3),
+    Kind("glb-images", ".glb", _textured_glb_seeds, mutate_textured_glb, _textured_import, share=3),
+    Kind("obj-textured", ".obj", lambda t: [TEXTURED_OBJ.encode()],
+         lambda d, r, p: mutate_text(d, r, p) if r.random() < 0.3 else d, _textured_import, share=3,
+         companions=textured_obj_companions),
     Kind("gltf", ".gltf", _gltf_seeds, lambda d, r, p: json.dumps(mutate_json_doc(json.loads(d), r)).encode(),
          _load_scene),
     Kind("bzw", ".bzw", _files("tests/data/bzw/*.bzw"), mutate_text, _load_scene, share=2),
@@ -705,11 +876,16 @@ def case_file(kind: Kind, seed: int, tmp: Path, seeds: list[bytes]) -> Path:
         if rng.random() < 0.05:
             # a file the manifest names replaced by a link out of the bundle
             victim = rng.choice([p for p in bundle.iterdir() if p.name != kind.suffix])
-            victim.unlink()
+            if victim.is_dir() and not victim.is_symlink():   # the bundle's textures/
+                shutil.rmtree(victim)
+            else:
+                victim.unlink()
             victim.symlink_to(rng.choice(["/etc/passwd", "/dev/zero", "../../../../etc"]))
         return bundle
     f = case / f"case{kind.suffix}"
     f.write_bytes(data)
+    if kind.companions is not None:
+        kind.companions(case, rng)
     if kind.name == "obj" and rng.random() < 0.3:
         (case / "box.mtl").write_bytes((ROOT / "arenas/box/box.mtl").read_bytes())
     return f

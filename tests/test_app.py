@@ -154,3 +154,25 @@ def test_the_rules_end_a_window_match_with_the_winner(make_app):
     assert w.match.over and app.state == "over"
     assert "score limit" in app.over_reason and "bot1 wins" in app.over_reason
     app.frame(0.016)                        # the end screen draws
+
+
+def test_remap_on_an_unwritable_config_folder_says_so_and_goes_on(app, tmp_path, monkeypatch):
+    """The config folder cannot be made (its parent is a file; tests run as root, so a
+    read-only mode would not stop the write): the new binding holds for this session,
+    the failure is the screen's notice, naming the file, and the game keeps running."""
+    blocker = tmp_path / "not-a-folder"
+    blocker.write_text("a file where the config folder's parent should be\n")
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(blocker / "cfg"))
+    goto(app, "bindings")
+    press(app, pygame.K_RETURN)
+    while app.remap_cursor != 6:           # FIRE
+        press(app, pygame.K_DOWN)
+    press(app, pygame.K_RETURN)
+    app.handle(pygame.event.Event(pygame.JOYBUTTONDOWN, instance_id=0, joy=0, button=3))
+    assert app.state == "remap" and not app.remap_waiting
+    assert app.input.bindings.actions["fire"] == ["joybutton:3"]       # in use until the game ends
+    assert "not saved" in app.notice and str(blocker) in app.notice and "\n" not in app.notice, app.notice
+    app.frame(0.016)                       # the remap screen draws the notice
+    press(app, pygame.K_ESCAPE)
+    assert app.state == "menu"
+    assert blocker.read_text().startswith("a file")       # nothing written over it

@@ -397,3 +397,53 @@ def test_the_sphere_tree_must_hold_the_surface_not_only_the_vertices(tmp_path):
     # the same samples every run
     assert run_check([tank]).diagnostics[0].message == report.diagnostics[0].message
     assert {x.code for x in report.diagnostics} <= {"V202", "V203"}
+
+
+def _block(x0, x1, z0=3.0, z1=6.0):
+    """A solid rectangle, normals outwards (clockwise with Direction +1)."""
+    p = np.array([[x0, z0], [x0, z1], [x1, z1], [x1, z0]], float)
+    return np.stack([p, np.roll(p, -1, axis=0)], axis=1)
+
+
+def test_a_wall_pasted_thousands_of_times_with_tiny_offsets_is_one_a202_per_copy():
+    """Near-duplicates (every end moved by up to a quarter of the tolerance) are copies
+    of the first: one A202 each against it, nothing else (no A205 from slivers between
+    the copies), the same faces as with the wall written once, and no pair of copies
+    examined (the pair search was quadratic: 1,000 copies took seconds)."""
+    from tanktool.check.walls_rules import check_walls
+
+    base = _block(2, 5)
+    once = _room(base, [1] * 4)
+    fs_once = analyse(once)
+    tol = 4 * fs_once.grid
+    rng = np.random.default_rng(3)
+    copies = base[0] + rng.uniform(-tol / 4, tol / 4, (3000, 2, 2))
+    copies[::2] = copies[::2, ::-1]                    # half of them written backwards...
+    dirs = np.ones(3000, np.int8)
+    dirs[::2] = -1                                      # ...with the Direction that keeps the free side
+    walls = _room(np.concatenate([base, copies]), [1] * 4 + dirs.tolist())
+    fs = analyse(walls)
+    out = check_walls(walls, fs, "w.txt")
+    assert {d.code for d in out} == {"A202"}
+    assert sorted(d.line for d in out) == list(range(9, 3009))
+    assert all(d.message == "this wall repeats the wall on line 5" for d in out)
+    assert len(fs.faces) == len(fs_once.faces) and fs.free.tolist() == fs_once.free.tolist()
+    assert len(fs.dangling) == 0
+    assert (fs.front[8:] == fs.front[4]).all() and (fs.back[8:] == fs.back[4]).all()
+
+
+def test_what_is_and_is_not_a_copy():
+    from tanktool.check.walls_rules import pair_rules
+
+    base = _block(2, 5)
+    g = analyse(_room(base, [1] * 4)).grid
+    cases = {
+        "a hair off, parallel, not touching": ([base[0] + [[2 * g, 0], [2 * g, 0]]], [1], ["A202"]),
+        "backwards, the same free side": ([base[0][::-1]], [-1], ["A202"]),
+        "backwards, the other side (two touching solids)": ([base[0][::-1]], [1], []),
+        "a centimetre off, parallel": ([base[0] + [[0.01, 0], [0.01, 0]]], [1], []),
+        "half of it (an overlap)": ([[base[0][0], 0.5 * (base[0][0] + base[0][1])]], [1], ["A203"]),
+    }
+    for what, (segs, dirs, codes) in cases.items():
+        walls = _room(np.concatenate([base, np.array(segs, float)]), [1] * 4 + dirs)
+        assert [d.code for d in pair_rules(walls, g)] == codes, what

@@ -347,3 +347,76 @@ def test_fuzz_every_reader_long(tmp_path):
     assert len(outcomes) >= 20000
     bad = F.failures(outcomes)
     assert not bad, "\n".join(bad[:50]) + "\n" + F.summary(outcomes)
+
+
+# ------------------------------------------------------------------ textures (found by the image generators)
+
+def _textured_obj(folder, mtl: str, vt: str = "vt 0 0\nvt 1 0\nvt 1 1\n") -> "Path":
+    obj = folder / "case.obj"
+    obj.write_text("mtllib case.mtl\nv 0 0 0\nv 4 0 0\nv 4 0 4\n" + vt + "usemtl skin\nf 1/1 2/2 3/3\n")
+    (folder / "case.mtl").write_text(mtl)
+    return obj
+
+
+def _import_textures(obj):
+    from tanktool.formats.materials import export_glb
+    from tanktool.formats.models import load_scene
+
+    said = []
+    data, copied = export_glb(obj, load_scene(obj), obj.parent / "bundle", warn=said.append)
+    return data, copied, said
+
+
+def test_a_texture_name_too_long_for_the_file_system_is_not_found(tmp_path):
+    obj = _textured_obj(tmp_path, "newmtl skin\nmap_Kd " + "a" * 5000 + ".png\n")
+    data, copied, said = _import_textures(obj)        # was OSError: File name too long
+    assert data[:4] == b"glTF" and copied == [] and len(said) == 1 and "not found" in said[0]
+
+
+def test_a_texture_huge_by_its_header_is_refused_before_decoding(tmp_path):
+    (tmp_path / "skin.jpg").write_bytes(F.jpeg_claiming(9000, 9000))   # 632 bytes, 243 MB decoded
+    obj = _textured_obj(tmp_path, "newmtl skin\nmap_Kd skin.jpg\n")
+    data, copied, said = _import_textures(obj)
+    assert copied == [] and len(said) == 1 and "too large (9000 x 9000 pixels" in said[0]
+
+
+def test_texture_coordinates_of_the_wrong_shape_keep_the_colour(tmp_path):
+    (tmp_path / "skin.png").write_bytes(F.png_bytes(8, 8))
+    obj = _textured_obj(tmp_path, "newmtl skin\nKd 1 0 0\nmap_Kd skin.png\n", vt="vt 0\nvt 1\nvt 0.5\n")
+    data, copied, said = _import_textures(obj)        # was IndexError in trimesh's glb export
+    assert data[:4] == b"glTF" and any("texture coordinates of shape" in s for s in said), said
+
+
+def test_an_embedded_4096_image_is_kept_at_2048_in_model_glb(tmp_path):
+    """The sanitiser lets a .glb's images through up to 4096 x 4096; model.glb keeps
+    at most 2048 on a side, as for the image files found beside a model."""
+    import io
+
+    from PIL import Image
+
+    from tanktool.formats.gltf import _split_glb
+
+    glb = tmp_path / "case.glb"
+    glb.write_bytes(F.glb_bytes(*F.textured_box_gltf(F.full_size_png(), "image/png")))
+    data, _, _ = _import_textures(glb)
+    text, binary = _split_glb(data, "model.glb")
+    doc = json.loads(text)
+    sizes = []
+    for im in doc.get("images", []):
+        v = doc["bufferViews"][im["bufferView"]]
+        off = v.get("byteOffset", 0)
+        sizes.append(Image.open(io.BytesIO(binary[off:off + v["byteLength"]])).size)
+    assert sizes and all(max(s) <= 2048 for s in sizes), sizes
+
+
+def test_an_npy_header_numpy_cannot_tokenize_is_a_format_error(tmp_path):
+    """Found by the long fuzz (arena-navgrid): a header with an unclosed bracket made
+    numpy's header parser raise tokenize.TokenError, an X001 in check."""
+    from tanktool.nav.navgrid import NavGrid
+
+    p = tmp_path / "navgrid.npz"
+    with zipfile.ZipFile(p, "w") as z:
+        z.writestr("valid.npy", b"\x93NUMPY\x01\x00v\x00{'descr': '|b1', 'fortran_order': False, 'shape': ((1, 2), }"
+                   .ljust(128, b" ")[:127] + b"\n")
+    with pytest.raises(FormatError, match="navgrid.npz: member 'valid.npy' cannot be read"):
+        NavGrid.load(p)

@@ -134,3 +134,35 @@ def test_the_top_view_shades_a_layered_arena_by_height(tmp_path):
     assert np.abs(roof - HEIGHT_HIGH).sum() < np.abs(roof - HEIGHT_LOW).sum()
     assert np.abs(yard - HEIGHT_LOW).sum() < np.abs(yard - HEIGHT_HIGH).sum()
     pygame.image.save(surf, str(tmp_path / "fort-top.png"))
+
+
+@pytest.mark.parametrize("name, overlay", [("navgrid.npz", "navgrid"), ("quadtree.npz", "quadtree")])
+@pytest.mark.parametrize("damage", ["flip", "truncate", "garbage"])
+def test_a_damaged_overlay_file_is_said_on_the_overlay_not_a_crash(tmp_path, name, overlay, damage):
+    """The overlays read their file when first shown, mid-match: a damaged one (a byte
+    flipped, cut short, garbage) is one line naming the file on the overlay, the game
+    goes on (it was BadZipFile / zlib.error out of the window's loop)."""
+    import shutil
+
+    from tanktool.content import bundled_dir
+
+    box = tmp_path / "box"
+    shutil.copytree(bundled_dir("arenas") / "box", box)
+    pygame.init()
+    s = GameSession(str(box), bots=1, seed=1, player=False)
+    f = box / name
+    data = bytearray(f.read_bytes())
+    if damage == "flip":
+        data[len(data) // 2] ^= 0xFF
+    elif damage == "truncate":
+        del data[len(data) // 2:]
+    else:
+        data[:] = b"PK\x03\x04" + bytes(range(256)) * 8
+    f.write_bytes(bytes(data))
+    view = TopView(s, SIZE)
+    view.toggle(overlay)
+    surf = pygame.Surface(SIZE)
+    view.draw(surf)
+    view.draw(surf)                          # the layer is kept: no second read, no second error
+    msg = view.problems[overlay]
+    assert str(f) in msg and "\n" not in msg

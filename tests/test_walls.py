@@ -259,3 +259,39 @@ def test_random_overlapping_boxes_invariants(seed):
     parts = shapely.get_parts(shapely.difference(shapely.box(1, 1, 59, 59), grounded))
     expect = shapely.union_all([p for p in parts if not shapely.buffer(p, -0.5, quad_segs=2).is_empty])
     assert shapely.area(shapely.symmetric_difference(expect, ex.free)) < 0.006 * shapely.length(expect)
+
+
+# ---------------------------------------------------------------------------
+# malformed meshes from any caller: one clear ArenaError, never an IndexError or a wrong vertex
+
+
+@pytest.mark.parametrize("bad, says", [
+    ("two", "must be triangles"),      # an .obj face `f 1 2`
+    ("flat", "must be triangles"),
+    ("past", "vertex 99, outside 0..7"),
+    ("negative", "vertex -1, outside 0..7"),   # numpy would count it from the end
+    ("fraction", "not whole numbers"),          # astype(int) would truncate it
+])
+@pytest.mark.parametrize("fn", ["extract_walls", "find_floor", "slice_mesh", "floor_region"])
+def test_malformed_faces_are_refused_by_every_entry(bad, says, fn):
+    import trimesh
+
+    from tanktool.errors import ArenaError
+    from tanktool.geometry import walls as W
+
+    box = trimesh.creation.box((10.0, 2.0, 10.0))
+    v, f = np.asarray(box.vertices), np.asarray(box.faces)
+    faces = {"two": f[:, :2], "flat": f.ravel(), "past": np.vstack([f, [[0, 1, 99]]]),
+             "negative": np.vstack([f, [[0, 1, -1]]]), "fraction": f + 0.5}[bad]
+    args = {"extract_walls": (v, faces), "find_floor": (v, faces), "slice_mesh": (v, faces, 0.0, 1e-6),
+            "floor_region": (v, faces, 0.01)}[fn]
+    with pytest.raises(ArenaError, match=says):
+        getattr(W, fn)(*args)
+
+
+def test_triangle_mesh_accepts_whole_float_indices_and_no_faces():
+    from tanktool.geometry.walls import triangle_mesh
+
+    v, f = triangle_mesh([[0, 0, 0], [1, 0, 0], [0, 0, 1]], np.array([[0.0, 1.0, 2.0]]))
+    assert f.dtype == np.int64 and f.tolist() == [[0, 1, 2]] and v.dtype == np.float64
+    assert triangle_mesh(v, [])[1].shape == (0, 3)

@@ -333,6 +333,9 @@ def make_cases() -> None:
     with open(c / "arenas/a/arena.obj", "a") as f:
         f.write("# edited\n")
     expect(c, "B204", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", "sha256")])
+    c = BROKEN / "B205_texture_missing"
+    write_arena(c / "arenas" / "a", toml_edit=lambda d: d["model"].update(textures=["textures/wall.png"]))
+    expect(c, "B205", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", "textures = ")])
 
     # --- what play cannot load although no other rule objects: [walls] is not a table
     c = BROKEN / "B301_walls_not_a_table"

@@ -61,6 +61,7 @@ RULES: dict[str, Rule] = {r.code: r for r in [
     Rule("B202", ERROR, "a derived file is missing", "rebuild the bundle's derived files"),
     Rule("B203", ERROR, "a derived file is stale (its sha256 does not match the manifest)", "rebuild the bundle's derived files"),
     Rule("B204", ERROR, "the source model changed since the bundle was built", "rebuild the bundle from the new source model"),
+    Rule("B205", ERROR, "a texture listed in [model] textures is missing, outside the bundle, not an image or too large", "restore the image (at most 4096 x 4096 pixels) inside the bundle, or rebuild the bundle"),
     Rule("B301", ERROR, "play cannot load the bundle (a value or file it needs is unusable)", "fix the key or file the message names, or rebuild the bundle"),
     # vehicles
     Rule("V101", ERROR, "a hull.txt line cannot be parsed", "write one 'x y z' point per line"),

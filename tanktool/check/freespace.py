@@ -145,6 +145,72 @@ def snap_grid(segments: np.ndarray) -> float:
     return 1e-7 * max(1.0, m)
 
 
+def near_copies(seg: np.ndarray, direction: np.ndarray, live: np.ndarray, tol: float) -> np.ndarray:
+    """For each wall of ``live`` (indices into ``seg`` (n, 2, 2), ``direction`` (n,)),
+    the wall it repeats: the first wall (in file order) of its group of copies, or itself.
+
+    A copy has both ends within ``tol`` of the other's (in either order), lies along
+    it (both ends within ``tol`` of its line) and has the same free side: the A202
+    rule of the pair search; copies of copies are one group.  Checking every pair of
+    walls pasted 1,000 times with tiny offsets is 500,000 pairs; here the walls are
+    first binned by the cells of size ``tol / 2`` holding their two ends (oriented by
+    cell, so a copy written backwards lands in the same bin): the walls of a bin are
+    copies of its first wall by construction.  Only one wall per bin then meets the
+    others, and at most 3^4 bins hold copies of any one wall, so the pairs left are
+    few whatever the number of copies.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    live = np.asarray(live, dtype=np.int64)
+    if len(live) < 2:
+        return live.copy()
+    s = seg[live]
+    cell = np.floor(s / (0.5 * tol))
+    flip = (cell[:, 0, 0] > cell[:, 1, 0]) | ((cell[:, 0, 0] == cell[:, 1, 0]) & (cell[:, 0, 1] > cell[:, 1, 1]))
+    oriented = np.where(flip[:, None, None], s[:, ::-1], s)
+    side = np.where(flip, -direction[live], direction[live]).astype(np.float64)
+    keys = np.column_stack([np.where(flip[:, None, None], cell[:, ::-1], cell).reshape(-1, 4), side])
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    f = first[inverse.reshape(-1)]
+    # same cells: ends within tol/2 per axis, so within tol of the first's line; the
+    # same free side also needs the same way along (a wall shorter than a cell may not)
+    along = np.einsum("ij,ij->i", oriented[:, 1] - oriented[:, 0], oriented[f, 1] - oriented[f, 0]) > 0
+    f = np.where(along, f, np.arange(len(live)))
+    heads = np.flatnonzero(f == np.arange(len(live)))
+    # copies in neighbouring bins: the pair test among the bins' first walls only
+    lines = shapely.linestrings(s[heads])
+    i, j = STRtree(lines).query(lines, predicate="dwithin", distance=tol)
+    keep = i < j
+    a, b = heads[i[keep]], heads[j[keep]]
+    dup = copy_pairs(s[a], s[b], direction[live[a]], direction[live[b]], tol)
+    n = len(live)
+    graph = coo_matrix((np.ones(int(dup.sum()) + n), (np.r_[a[dup], np.arange(n)], np.r_[b[dup], f])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    lowest = np.full(label.max() + 1, n, dtype=np.int64)
+    np.minimum.at(lowest, label, np.arange(n))
+    return live[lowest[label]]
+
+
+def copy_pairs(sa: np.ndarray, sb: np.ndarray, da: np.ndarray, db: np.ndarray, tol: float) -> np.ndarray:
+    """(k,) bool: wall ``sb[k]`` (2, 2) repeats wall ``sa[k]`` (the A202 test): both ends
+    within ``tol`` of the other's in either order, both within ``tol`` of its line, the
+    same free side (normals ``direction * (-dz, dx)`` agreeing)."""
+    P, Q, R, S = sa[:, 0], sa[:, 1], sb[:, 0], sb[:, 1]
+    u, v = Q - P, S - R
+    with np.errstate(all="ignore"):
+        u = u / np.hypot(u[:, 0], u[:, 1])[:, None]
+        v = v / np.hypot(v[:, 0], v[:, 1])[:, None]
+
+        def side(o, t, p):
+            return t[:, 0] * (p[:, 1] - o[:, 1]) - t[:, 1] * (p[:, 0] - o[:, 0])
+
+        collinear = (np.abs(side(P, u, R)) <= tol) & (np.abs(side(P, u, S)) <= tol)
+        same_side = np.einsum("ij,ij->i", u * da[:, None], v * db[:, None]) > 0
+    same_ends = (((np.abs(P - R) <= tol).all(1) & (np.abs(Q - S) <= tol).all(1))
+                 | ((np.abs(P - S) <= tol).all(1) & (np.abs(Q - R) <= tol).all(1)))
+    return collinear & same_ends & same_side
+
 def analyse(walls: WallList) -> FreeSpace:
     """Faces, wall sides, the normals' vote and the dangling wall ends of ``walls``."""
     seg = np.asarray(walls.segments, dtype=np.float64).reshape(-1, 2, 2)
@@ -160,16 +226,20 @@ def analyse(walls: WallList) -> FreeSpace:
         return FreeSpace(walls, [], front, back, np.zeros(0, bool), np.zeros((0, 2)), np.zeros(0, np.int64),
                          g, lines, None)
     lines[live] = shapely.linestrings(snapped[live])
+    # copies of a wall (A202) add nothing to the arrangement but slivers and cost: the
+    # first of each is noded and looked up, the others take its pieces' sides below
+    origin = near_copies(snapped, walls.direction, live, 4.0 * g)
+    reps = live[origin == live]
     # snap-rounding noder: robust against nearly collinear and nearly touching walls
-    noded = shapely.union_all(lines[live], grid_size=g)
+    noded = shapely.union_all(lines[reps], grid_size=g)
     parts = shapely.get_parts(noded)
     faces = list(shapely.get_parts(shapely.polygonize(parts))) if len(parts) else []
     faces = [f for f in faces if f.area > 0]
 
     fs = FreeSpace(walls, faces, front, back, np.zeros(len(faces), bool), np.zeros((0, 2)),
                    np.zeros(0, np.int64), g, lines, noded)
-    fs._wall_tree = STRtree(lines[live])
-    fs._wall_ids = live
+    fs._wall_tree = STRtree(lines[reps])
+    fs._wall_ids = reps
 
     # Sides are sampled per noded piece, not per wall: a long wall split by T
     # junctions borders a different face along each piece, and each piece must vote
@@ -188,13 +258,14 @@ def analyse(walls: WallList) -> FreeSpace:
     # placed exactly at the middle of a wall
     pmid = pa + (0.5 + 1.0 / 128.0) * (pb - pa)
     pi, ti = fs._wall_tree.query(shapely.points(pmid), predicate="dwithin", distance=2.0 * g)
-    w = live[ti]
+    w = reps[ti]
     d = snapped[w, 1] - snapped[w, 0]
     normal = np.stack([-d[:, 1], d[:, 0]], axis=1) / length[w, None] * walls.direction[w, None]
     eps = np.minimum(100.0 * g, 0.05 * pl[pi])
     m = pmid[pi]
     sides = fs.face_of(np.concatenate([m + eps[:, None] * normal, m - eps[:, None] * normal]))
     pf, pbk = sides[: len(pi)], sides[len(pi):]
+    pi, w, pf, pbk = _with_copies(pi, w, pf, pbk, live, origin)
     fs.piece_wall, fs.piece_front, fs.piece_back, fs.piece_length = w, pf, pbk, pl[pi]
     fs.piece_lines = shapely.linestrings(np.stack([pa[pi], pb[pi]], axis=1)) if len(pi) else np.zeros(0, object)
 
@@ -213,24 +284,42 @@ def analyse(walls: WallList) -> FreeSpace:
     first = order[np.r_[True, w[order][1:] != w[order][:-1]]] if len(order) else order
     front[w[first]] = pf[first]
     back[w[first]] = pbk[first]
-    fs.dangling, fs.dangling_wall = _dangling_ends(snapped, live, lines, g)
+    fs.dangling, fs.dangling_wall = _dangling_ends(snapped, live, origin, lines, g)
     return fs
 
 
-def _dangling_ends(snapped: np.ndarray, live: np.ndarray, lines, g: float) -> tuple[np.ndarray, np.ndarray]:
+def _with_copies(pi: np.ndarray, w: np.ndarray, pf: np.ndarray, pb: np.ndarray,
+                 live: np.ndarray, origin: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The (piece, wall, front, back) rows of the first copies repeated for every other
+    copy of the same wall: a copy lies along the same pieces with the same free side."""
+    copies = live[origin != live]
+    if not len(copies) or not len(w):
+        return pi, w, pf, pb
+    of = origin[origin != live]
+    order = np.argsort(of, kind="stable")
+    of, copies = of[order], copies[order]
+    lo = np.searchsorted(of, w, side="left")
+    n = np.searchsorted(of, w, side="right") - lo           # copies of each row's wall
+    rows = np.repeat(np.arange(len(w)), n)
+    # the k-th copy of a row: lo[row] + k
+    k = np.arange(len(rows)) - np.repeat(np.cumsum(n) - n, n)
+    extra = copies[lo[rows] + k]
+    return (np.concatenate([pi, pi[rows]]), np.concatenate([w, extra]),
+            np.concatenate([pf, pf[rows]]), np.concatenate([pb, pb[rows]]))
+
+
+def _dangling_ends(snapped: np.ndarray, live: np.ndarray, origin: np.ndarray, lines,
+                   g: float) -> tuple[np.ndarray, np.ndarray]:
     """Wall ends touching no other wall (neither its ends nor its length).
 
-    Walls with the same two ends are looked up once: both ends of a repeated wall touch
-    its copy, and a wall pasted 2,000 times would otherwise make 8 million end-wall
-    pairs (seconds of work for a 60 KB file)."""
+    Copies of a wall (``origin``: :func:`near_copies`) are looked up once: both ends of
+    a repeated wall touch its copy, and a wall pasted 2,000 times would otherwise make
+    8 million end-wall pairs (seconds of work for a 60 KB file)."""
     ends = np.concatenate([snapped[live, 0], snapped[live, 1]])
     owner = np.concatenate([live, live])
-    a, b = snapped[live, 0], snapped[live, 1]
-    swap = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
-    key = np.where(swap[:, None], np.hstack([b, a]), np.hstack([a, b]))
-    _, first, group, count = np.unique(key, axis=0, return_index=True, return_inverse=True, return_counts=True)
+    first, group, count = np.unique(origin, return_inverse=True, return_counts=True)
     group = group.reshape(-1)
-    tree = STRtree(lines[live[first]])
+    tree = STRtree(lines[first])
     pi, ti = tree.query(shapely.points(ends), predicate="dwithin", distance=2.0 * g)
     other = ti != np.concatenate([group, group])[pi]
     joined = np.zeros(len(ends), dtype=bool)

@@ -205,4 +205,64 @@ def file_rules(man: Manifest, bundle: Path, required_derived: tuple[str, ...]) -
             out.append(diag("B102", mpath, line, f"[derived] {name} must be a sha256 (hex string), got {want!r}"))
         elif sha256_file(f) != want.lower():
             out.append(diag("B203", mpath, line, f"derived file {name!r} is stale: its sha256 does not match"))
+    return out + texture_rules(man, bundle)
+
+
+#: a texture file larger than this is refused unread (a 4096 x 4096 RGBA image is 64 MiB
+#: uncompressed; a PNG or JPEG of it is far smaller)
+MAX_TEXTURE_BYTES = 128 << 20
+
+
+def texture_rules(man: Manifest, bundle: Path) -> list[Diagnostic]:
+    """B205: every texture ``[model] textures`` lists is a file inside the bundle that
+    is an image (by its name and its content), at most the glTF sanitiser's
+    4096 x 4096 pixels (read from its header, never decoded in full)."""
+    model = man.table("model")
+    if model is None or "textures" not in model:
+        return []
+    mpath = str(man.path)
+    line = man.lines.key("model", "textures")
+    names = model["textures"]
+    if not isinstance(names, list) or not all(isinstance(n, str) for n in names):
+        return [diag("B102", mpath, line, f"[model] textures must be a list of file names, got {str(names)[:60]}")]
+    out = []
+    for name in names:
+        problem = _texture_problem(bundle, name)
+        if problem:
+            out.append(diag("B205", mpath, line, f"texture {name[:200]!r} {problem}"))
     return out
+
+
+def _texture_problem(bundle: Path, name: str) -> str:
+    """'' when ``name`` is a usable texture of ``bundle``, else what is wrong with it."""
+    import warnings
+
+    from ..formats.gltf import MAX_IMAGE_PIXELS
+    from ..formats.materials import IMAGE_SUFFIXES
+
+    f = safe_file(bundle, name) if name else None
+    if f is None:
+        return "is outside the bundle (textures are named relative to it, inside it)"
+    if not f.is_file():
+        return "is missing" if not f.exists() else "is not a regular file"
+    if f.suffix.lower() not in IMAGE_SUFFIXES:
+        return f"is not an image file ({', '.join(IMAGE_SUFFIXES)})"
+    size = f.stat().st_size
+    if size > MAX_TEXTURE_BYTES:
+        return f"is too large: {size:,} bytes, more than {MAX_TEXTURE_BYTES:,}"
+    from PIL import Image
+
+    side = int(MAX_IMAGE_PIXELS ** 0.5)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # PIL's DecompressionBombWarning: the size is judged here
+            with Image.open(f) as im:
+                w, h = im.size
+                if w * h > MAX_IMAGE_PIXELS:
+                    return f"is too large: {w} x {h} pixels, more than {side} x {side}"
+                im.verify()  # chunks and checksums, without decoding the pixels
+    except Image.DecompressionBombError as e:
+        return f"is too large: {e}"
+    except Exception as e:  # PIL raises many kinds for a damaged or foreign file
+        return f"is not a readable image ({type(e).__name__}: {str(e)[:120]})"
+    return ""

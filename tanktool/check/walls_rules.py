@@ -12,7 +12,7 @@ from shapely import STRtree
 
 from ..formats.walls_txt import WallList
 from .diagnostics import Diagnostic, diag, fmt_xz
-from .freespace import UNBOUNDED, FreeSpace, gaps
+from .freespace import UNBOUNDED, FreeSpace, gaps, near_copies
 
 
 def _line(walls: WallList, i: int) -> int:
@@ -35,26 +35,25 @@ def pair_rules(walls: WallList, grid: float) -> list[Diagnostic]:
     live = np.flatnonzero(length > 0)
     if len(live) < 2:
         return []
-    # exact repeats (same ends in either order, same free side) are A202 against their
-    # first copy and take no further part: a wall pasted 10,000 times would otherwise
-    # make 10^8 candidate pairs
-    flip = (seg[live, 0, 0] > seg[live, 1, 0]) | ((seg[live, 0, 0] == seg[live, 1, 0]) & (seg[live, 0, 1] > seg[live, 1, 1]))
-    ends = np.where(flip[:, None, None], seg[live, ::-1], seg[live]).reshape(-1, 4)
-    keys = np.column_stack([ends, np.where(flip, -walls.direction[live], walls.direction[live])])
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    origin = live[first[inverse.reshape(-1)]]
+    # copies (both ends within the tolerance, in either order, same free side) are A202
+    # against the first copy of their bin and take no further part: a wall pasted 1,000
+    # times with tiny offsets would otherwise make 500,000 candidate pairs (and as many
+    # diagnostics)
+    tol = 4.0 * grid
+    origin = near_copies(seg, walls.direction, live, tol)
     repeats = [diag("A202", path, _line(walls, k), f"this wall repeats the wall on line {_line(walls, o)}")
-               for k, o in zip(live, origin) if k != o]
-    live = np.unique(origin)
+               for k, o in zip(live.tolist(), origin.tolist()) if k != o]
+    live = live[origin == live]
     if len(live) < 2:
         return repeats
     lines = shapely.linestrings(seg[live])
-    i, j = STRtree(lines).query(lines, predicate="intersects")
+    # within the tolerance, not only touching: a copy moved off its wall by a hair
+    # (parallel, not meeting it) is a copy all the same
+    i, j = STRtree(lines).query(lines, predicate="dwithin", distance=tol)
     keep = i < j
     a, b = live[i[keep]], live[j[keep]]
     if not len(a):
         return repeats
-    tol = 4.0 * grid
     P, Q = seg[a, 0], seg[a, 1]
     R, S = seg[b, 0], seg[b, 1]
     u = d[a] / length[a, None]
@@ -103,10 +102,14 @@ def flipped_normals(fs: FreeSpace, path: str) -> list[Diagnostic]:
     walls = fs.walls
     out = []
     free = np.append(fs.free, False)
-    for k in np.flatnonzero(fs.flipped()):
-        mine = fs.piece_wall == k
-        bad = mine & (fs.piece_front != fs.piece_back) & ~free[fs.piece_front] & free[fs.piece_back]
-        into = fs.piece_front[np.flatnonzero(bad)[0]] if bad.any() else fs.front[k]
+    # the first bad piece of each wall, found in one pass (a scan of every piece per
+    # flipped wall was quadratic on a wall pasted many times)
+    bad = np.flatnonzero((fs.piece_front != fs.piece_back) & ~free[fs.piece_front] & free[fs.piece_back])
+    first_bad = {}
+    for p, k in zip(bad.tolist(), fs.piece_wall[bad].tolist()):
+        first_bad.setdefault(k, p)
+    for k in np.flatnonzero(fs.flipped()).tolist():
+        into = fs.piece_front[first_bad[k]] if k in first_bad else fs.front[k]
         where = "the outside of the arena" if into == UNBOUNDED else "solid material"
         out.append(diag("A205", path, _line(walls, k),
                         f"the normal of this wall points into {where}; free space is behind it"))

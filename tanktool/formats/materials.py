@@ -115,6 +115,13 @@ def find_texture(name: str, model: Path, extra: Sequence[Path] = ()) -> Path | N
     """The image file a model's texture ``name`` stands for, or None.
 
     ``extra`` are more folders to search (the bundle being rebuilt)."""
+    try:
+        return _find_texture(name, model, extra)
+    except (OSError, ValueError):  # a name the file system refuses (too long, a NUL byte): not found
+        return None
+
+
+def _find_texture(name: str, model: Path, extra: Sequence[Path]) -> Path | None:
     name = name.strip().strip('"')
     if not name or name.startswith("data:"):
         return None
@@ -137,14 +144,26 @@ def find_texture(name: str, model: Path, extra: Sequence[Path] = ()) -> Path | N
 
 
 def _check_image(path: Path) -> str:
-    """'' when PIL can read the image at ``path``, else why not."""
+    """'' when PIL can read the image at ``path`` and it is at most MAX_IMAGE_PIXELS by
+    its header, else why not (a 632-byte JPEG claiming 9000 x 9000 pixels decoded to
+    243 MB and took seconds to scale down)."""
+    import warnings
+
+    from .gltf import MAX_IMAGE_PIXELS
+
     try:
         from PIL import Image
 
-        with Image.open(path) as im:
-            im.verify()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # DecompressionBombWarning: the size is judged here
+            with Image.open(path) as im:
+                w, h = im.size
+                if w * h > MAX_IMAGE_PIXELS:
+                    side = int(MAX_IMAGE_PIXELS ** 0.5)
+                    return f"too large ({w} x {h} pixels, more than {side} x {side})"
+                im.verify()
     except Exception as e:  # PIL raises many kinds for a bad image
-        return f"not a readable image ({type(e).__name__}: {e})"
+        return f"not a readable image ({type(e).__name__}: {str(e)[:200]})"
     return ""
 
 
@@ -283,6 +302,13 @@ def load_image(path: Path) -> Any:
     with Image.open(path) as im:
         im.load()
         img = im.convert("RGBA" if ("A" in im.getbands() or "transparency" in im.info) else "RGB")
+    return fit_image(img)
+
+
+def fit_image(img: Any) -> Any:
+    """A PIL image at most MAX_TEXTURE on a side (scaled down, LANCZOS), else itself."""
+    from PIL import Image
+
     if max(img.size) > MAX_TEXTURE:
         k = MAX_TEXTURE / max(img.size)
         img = img.resize((max(int(img.size[0] * k), 1), max(int(img.size[1] * k), 1)), Image.LANCZOS)
@@ -421,5 +447,50 @@ def export_glb(model: str | os.PathLike, scene: Any, dest: Path, extra: Sequence
     ``extra`` are more folders to look for textures in (the bundle being rebuilt)."""
     model = Path(model)
     out, found = textured_scene(model, scene, extra, warn)
+    _drop_bad_uv(model, out, warn or (lambda _m: None))
+    _fit_embedded(out)
     copied = copy_textures(model, found, dest) if found.found else []
     return out.export(file_type="glb"), copied
+
+
+def _fit_embedded(scene: Any) -> None:
+    """Images a .glb/.gltf brought in (up to the sanitiser's 4096 x 4096) scaled to
+    MAX_TEXTURE like the files found beside a model, so model.glb keeps at most 2048
+    on a side (and its export does not encode a 64 MB image)."""
+    for g in scene.geometry.values():
+        mat = getattr(getattr(g, "visual", None), "material", None)
+        for attr in ("baseColorTexture", "image"):
+            img = getattr(mat, attr, None)
+            if img is not None and hasattr(img, "size") and max(img.size) > MAX_TEXTURE:
+                setattr(mat, attr, fit_image(img))
+
+
+def _drop_bad_uv(model: Path, scene: Any, warn: Warn) -> None:
+    """Meshes whose texture coordinates are not one finite (u, v) per vertex (an .obj
+    ``vt`` line with one number gave (n, 1), which trimesh's glb export indexes out of
+    bounds) are drawn in their material's colour instead, with a warning."""
+    import trimesh
+
+    for name, g in scene.geometry.items():
+        vis = getattr(g, "visual", None)
+        if getattr(vis, "kind", None) != "texture":
+            continue
+        uv = getattr(vis, "uv", None)
+        if uv is None:
+            continue
+        uv = np.asarray(uv)
+        with np.errstate(all="ignore"):   # beyond float32 (1e300) is as bad as NaN: inf in the glb
+            ok = uv.ndim == 2 and uv.shape == (len(g.vertices), 2) and uv.dtype.kind == "f" and \
+                bool(np.isfinite(uv.astype(np.float32)).all())
+        if ok:
+            continue
+        mat = getattr(vis, "material", None)
+        rgba = getattr(mat, "baseColorFactor", None)
+        if rgba is None:
+            rgba = getattr(mat, "diffuse", None)
+        rgba = np.asarray(rgba if rgba is not None else (128, 128, 128, 255), dtype=np.float64).reshape(-1)[:4]
+        if rgba.max() <= 1.0:
+            rgba = rgba * 255
+        g.visual = trimesh.visual.ColorVisuals(g, face_colors=np.tile(np.clip(rgba, 0, 255).astype(np.uint8), (len(g.faces), 1)))
+        warn(f"{model}: mesh {name!r}: texture coordinates of shape {uv.shape} for {len(g.vertices)} vertices; "
+             f"drawn in its material's colour")

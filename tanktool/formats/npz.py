@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import io
 import os
+import tokenize
 import zipfile
 import zlib
 
@@ -68,7 +69,7 @@ def read_npz(path: str | os.PathLike, what: str = "an .npz file", limit: int = M
                 arr = np.frombuffer(raw, dtype=dtype).copy()
                 arr = arr.reshape(shape[::-1]).T if fortran else arr.reshape(shape)
         except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, TypeError, SyntaxError,
-                NotImplementedError, RuntimeError) as e:
+                NotImplementedError, RuntimeError, tokenize.TokenError) as e:   # numpy tokenizes the header
             raise FormatError(f"{label}: member {name[:60]!r} cannot be read: {e}") from None
         out[name[:-4]] = arr
     return out

@@ -564,8 +564,12 @@ class App:
                 return
             action = ACTIONS[self.remap_cursor]
             self.input.bindings.remap(action, name)
-            path = save_bindings(self.input.bindings, self.bindings_file)
-            self.notice = f"{action.upper().replace('_', ' ')} = {describe([name])}  (saved to {path})"
+            said = f"{action.upper().replace('_', ' ')} = {describe([name])}"
+            try:
+                path = save_bindings(self.input.bindings, self.bindings_file)
+                self.notice = f"{said}  (saved to {path})"
+            except TanktoolError as e:              # read-only or full config folder: used, not kept
+                self.notice = f"{said}, for this session only: not saved: {e}"
             self.remap_waiting = False
             return
         if event.type == pygame.KEYDOWN:

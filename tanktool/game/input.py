@@ -127,9 +127,12 @@ def load_bindings(path: str | os.PathLike | None = None) -> Bindings:
 
 def save_config(path: Path, doc: dict[str, Any]) -> Path:
     """Write a config file atomically, creating its folder; returns the path."""
-    from ..formats.bundle import write_toml
+    from ..formats.bundle import output_error, write_toml
 
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:  # a parent that is a file, a read-only home: one OutputError naming the file
+        raise output_error(path, e, "cannot make its folder") from None
     write_toml(path, doc)
     return path
 

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import pygame
 
+from ..errors import TanktoolError
 from .hud import Hud, text
 from .session import GameSession, tank_colour
 
@@ -71,6 +72,8 @@ class TopView:
         self.base = self._draw_arena()
         self._quadtree: pygame.Surface | None = None
         self._navgrid: pygame.Surface | None = None
+        #: overlay -> why its file could not be used (shown on the overlay, the game goes on)
+        self.problems: dict[str, str] = {}
         self.hud = Hud(session, size)
 
     def to_px(self, x: float, z: float) -> tuple[float, float]:
@@ -130,11 +133,17 @@ class TopView:
 
         path = self.session.info.path
         qt_file = Path(path) / "quadtree.npz" if path is not None else None
+        tree = None
         if qt_file is not None and qt_file.is_file():
-            tree = WallQuadtree.load(qt_file)
-        else:
+            try:
+                tree = WallQuadtree.load(qt_file)
+            except TanktoolError as e:      # a damaged file: say so, draw one built from the walls
+                self.problems["quadtree"] = f"{e} (showing one built from the walls)"
+        if tree is None:
             tree = WallQuadtree.build(self.session.world.walls.segments, self.session.world.bounds, depth=3)
         surf = pygame.Surface(self.size, pygame.SRCALPHA)
+        if "quadtree" in self.problems:
+            text(surf, self.problems["quadtree"], (self.size[0] // 2, 20), 18, anchor="midtop")
         counts = tree.leaf_counts()
         for leaf, n in zip(tree.leaves.tolist(), counts.tolist()):
             (ax, az), (bx, bz) = tree.box[leaf].tolist()
@@ -154,7 +163,12 @@ class TopView:
             return surf
         from ..nav.navgrid import NavGrid
 
-        grid = NavGrid.load(f)
+        try:
+            grid = NavGrid.load(f)
+        except TanktoolError as e:          # a damaged file: said on the overlay, the match goes on
+            self.problems["navgrid"] = str(e)
+            text(surf, str(e), (self.size[0] // 2, 20), 18, anchor="midtop")
+            return surf
         nz, nx = grid.shape
         valid = grid.layered("valid").any(axis=0)       # on a layered grid: valid on any level
         rgba = np.zeros((nz, nx, 4), np.uint8)

@@ -93,6 +93,41 @@ class WallExtraction:
 
 
 # ---------------------------------------------------------------------------
+# 0. the input
+
+
+def triangle_mesh(vertices: Any, faces: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``vertices`` (n, 3) float64 and ``faces`` (m, 3) int64, checked.
+
+    Every function here indexes vertices by faces: a face of two vertices, an index
+    past the vertices, a negative index (numpy counts it from the end: silently the
+    wrong vertex) or a fractional one (silently truncated) is refused with one clear
+    ArenaError instead of an IndexError deep inside, whoever the caller is.
+    """
+    try:
+        v = np.asarray(vertices, dtype=np.float64)
+        f = np.asarray(faces)
+    except (TypeError, ValueError) as e:
+        raise ArenaError(f"the model's vertices or faces are not numeric arrays ({e})") from None
+    if v.ndim != 2 or v.shape[1] != 3:
+        raise ArenaError(f"the model's vertices must be an (n, 3) array of x y z, got shape {v.shape}")
+    if f.size == 0:
+        return v, np.zeros((0, 3), dtype=np.int64)
+    if f.ndim != 2 or f.shape[1] != 3:
+        raise ArenaError(f"the model's faces must be triangles, an (m, 3) array of vertex indices; got shape {f.shape}")
+    if f.dtype.kind == "f":
+        if not np.isfinite(f).all() or (f != np.round(f)).any():
+            raise ArenaError("the model's faces hold vertex indices that are not whole numbers")
+    elif f.dtype.kind not in "iub":
+        raise ArenaError(f"the model's faces must hold integer vertex indices, got {f.dtype}")
+    lo, hi = f.min(), f.max()
+    if lo < 0 or hi >= len(v):
+        bad = int(lo) if lo < 0 else int(hi)
+        raise ArenaError(f"a face of the model uses vertex {bad}, outside 0..{len(v) - 1} ({len(v)} vertices)")
+    return v, f.astype(np.int64, copy=False)
+
+
+# ---------------------------------------------------------------------------
 # 1. the floor
 
 
@@ -103,6 +138,7 @@ def _upward_faces(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, 
     written out per component: on a million faces this is several times faster
     than gathering (m, 3, 3) triangles and calling ``np.cross``.
     """
+    vertices, faces = triangle_mesh(vertices, faces)
     # contiguous coordinate and index columns gather much faster than (m, 3) rows
     X, Y, Z = (np.ascontiguousarray(vertices[:, k]) for k in range(3))
     f0, f1, f2 = (np.ascontiguousarray(faces[:, k]) for k in range(3))
@@ -199,6 +235,7 @@ def slice_mesh(vertices: np.ndarray, faces: np.ndarray, y: float,
     Each segment is ordered so that its face normal lies on its right-hand side,
     i.e. for outward normals the solid is on the left.
     """
+    vertices, faces = triangle_mesh(vertices, faces)
     d = vertices[:, 1] - y
     above = (d >= 0.0).view(np.uint8)  # on the plane counts as above: shared edges cut identically
     # per-column gathers: several times faster than above[faces].sum(axis=1)
@@ -368,6 +405,7 @@ def floor_region(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
     arrangement; overlapping floor pieces and T-junctions come out right, and no
     polygon per triangle is ever built.
     """
+    vertices, faces = triangle_mesh(vertices, faces)
     g = _merge_positions(vertices, faces)
     # upward faces are clockwise in (x, z); reversing them puts the face on the left
     e = np.stack([g[:, [0, 2]], g[:, [2, 1]], g[:, [1, 0]]], axis=1).reshape(-1, 2)
@@ -506,8 +544,7 @@ def extract_walls(vertices: np.ndarray, faces: np.ndarray, height: float = 1.0, 
         raise ArenaError(f"--height must be a positive number of metres, got {height}")
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise ArenaError(f"--tolerance must be a positive number of metres, got {tolerance}")
-    vertices = np.asarray(vertices, dtype=np.float64)
-    faces = np.asarray(faces, dtype=np.int64)
+    vertices, faces = triangle_mesh(vertices, faces)
     if len(faces) == 0:
         raise ArenaError("the model has no triangles")
     if not np.isfinite(vertices).all():

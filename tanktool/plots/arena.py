@@ -15,6 +15,59 @@ import numpy as np
 from ..formats.walls_txt import WallList
 
 
+#: the free space's fill, the walls, their normals' ticks
+FREE_COLOUR = "#e8efe6"
+WALL_COLOUR = "#202020"
+NORMAL_COLOUR = "#d04020"
+
+
+def fill_region(ax: Any, geom: Any, colour: str, zorder: float = 0) -> None:
+    """Fill a shapely (Multi)Polygon on ``ax`` as one compound path: every part's
+    outline counter-clockwise, its holes clockwise, so the non-zero rule leaves the
+    holes empty (and an island standing in a hole filled).
+
+    One patch whatever the number of parts and holes: a patch per outline and per
+    hole (each pillar of a floor plan is a hole) cost matplotlib seconds on a plan of
+    800 pillars (``bench/preview.py``)."""
+    import shapely
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as MplPath
+    from shapely.geometry.polygon import orient
+
+    if geom is None or geom.is_empty:
+        return
+    polys = [p for p in shapely.get_parts(geom) if p.geom_type == "Polygon" and not p.is_empty]
+    if not polys:
+        return
+    rings = []
+    for poly in (orient(p, 1.0) for p in polys):
+        rings.append(shapely.get_coordinates(poly.exterior))
+        rings.extend(shapely.get_coordinates(h) for h in poly.interiors)
+    verts = np.concatenate(rings)
+    codes = np.full(len(verts), MplPath.LINETO, dtype=MplPath.code_type)
+    start = np.cumsum([0] + [len(r) for r in rings[:-1]])
+    codes[start] = MplPath.MOVETO
+    codes[start + np.array([len(r) for r in rings]) - 1] = MplPath.CLOSEPOLY
+    # add_artist, not add_patch: the limits are set by the caller, and add_patch walks
+    # every segment of the path to update them (a second on 800 pillars)
+    ax.add_artist(PathPatch(MplPath(verts, codes), facecolor=colour, edgecolor="none", lw=0, zorder=zorder))
+
+
+def draw_segments(ax: Any, seg: np.ndarray, colour: str, width: float, zorder: float) -> None:
+    """Stroke segments (n, 2, 2) as one path of n pieces (butt ends, like a
+    LineCollection's); a LineCollection makes a matplotlib Path per segment, which
+    is most of the drawing time on tens of thousands of walls."""
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as MplPath
+
+    seg = np.asarray(seg, dtype=np.float64).reshape(-1, 2, 2)
+    if not len(seg):
+        return
+    codes = np.tile(np.array([MplPath.MOVETO, MplPath.LINETO], dtype=MplPath.code_type), len(seg))
+    ax.add_artist(PathPatch(MplPath(seg.reshape(-1, 2), codes), fill=False, edgecolor=colour, lw=width,
+                            capstyle="butt", joinstyle="miter", zorder=zorder))
+
+
 def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = None,
                    size_px: int = 900) -> bytes:
     """PNG bytes of the arena's top view.
@@ -40,21 +93,14 @@ def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = 
     fig = Figure(figsize=(fig_w, fig_h), dpi=size_px / fig_w)
     ax = fig.add_subplot(1, 1, 1)
     ax.set_aspect("equal")
-    if free is not None and not free.is_empty:
-        import shapely
-
-        for poly in shapely.get_parts(free):
-            ax.fill(*poly.exterior.xy, color="#e8efe6", zorder=0, lw=0)
-            for hole in poly.interiors:
-                ax.fill(*hole.xy, color="white", zorder=0, lw=0)
+    fill_region(ax, free, FREE_COLOUR)
     seg = walls.segments
-    ax.add_collection(LineCollection(seg, colors="#202020", linewidths=1.4, zorder=2))
+    draw_segments(ax, seg, WALL_COLOUR, 1.4, zorder=2)
     if len(seg):
         mid = seg.mean(axis=1)
         tick = 0.012 * max(w, h)
         tips = mid + walls.normals * tick
-        ax.add_collection(LineCollection(np.stack([mid, tips], axis=1), colors="#d04020",
-                                         linewidths=0.8, zorder=3))
+        draw_segments(ax, np.stack([mid, tips], axis=1), NORMAL_COLOUR, 0.8, zorder=3)
     if walls.aux is not None:
         ax.add_collection(LineCollection(walls.aux, colors="#4060c0", linewidths=0.9,
                                          linestyles="dashed", zorder=1))
@@ -137,10 +183,7 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
         ax = fig.add_subplot(rows, cols, lv + 1)
         ax.set_aspect("equal")
         if flat:
-            for poly in shapely_parts(result.walls.free(lv)):
-                ax.fill(*poly.exterior.xy, color="#e8efe6", zorder=0, lw=0)
-                for hole in poly.interiors:
-                    ax.fill(*hole.xy, color="white", zorder=0, lw=0)
+            fill_region(ax, result.walls.free(lv), FREE_COLOUR)
         else:
             img = np.where(exists[lv], height[lv], np.nan)
             image = ax.imshow(img, origin="lower", extent=extent, cmap=cmap, vmin=lo, vmax=max(hi, lo + 1e-6),
@@ -151,12 +194,11 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
                                        low_headroom, unreachable)
         sel = walls.level == lv
         seg = walls.segments[sel]
-        ax.add_collection(LineCollection(seg, colors="#202020", linewidths=1.2, zorder=3))
+        draw_segments(ax, seg, WALL_COLOUR, 1.2, zorder=3)
         if len(seg):
             mid = seg.mean(axis=1)
             tick = 0.012 * max(w, h)
-            ax.add_collection(LineCollection(np.stack([mid, mid + walls.normals[sel] * tick], axis=1),
-                                             colors="#d04020", linewidths=0.7, zorder=3))
+            draw_segments(ax, np.stack([mid, mid + walls.normals[sel] * tick], axis=1), NORMAL_COLOUR, 0.7, zorder=3)
         if walls.aux is not None:
             ax.add_collection(LineCollection(walls.aux, colors="#4060c0", linewidths=0.9, linestyles="dashed",
                                              zorder=1))
@@ -187,12 +229,6 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", metadata={"Software": None})
     return buf.getvalue()
-
-
-def shapely_parts(geom: Any) -> list:
-    import shapely
-
-    return [] if geom is None or geom.is_empty else list(shapely.get_parts(geom))
 
 
 def _spawns_on_level(result: Any, level: int) -> np.ndarray:
