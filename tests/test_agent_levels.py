@@ -14,8 +14,6 @@
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -25,23 +23,10 @@ from tanktool.cli.main import cli
 from tanktool.formats.walls_txt import WallList
 from tanktool.sim.agents.navigation import SearchPlan, agent_grid, plan_path, views_for
 from tanktool.sim.agents.perception import Senses
-from tanktool.sim.commands import Command
 from tanktool.sim.match import load_match_arena, load_tank_spec, make_bots, run_match
 from tanktool.sim.world import World
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tools"))
-import make_levels  # noqa: E402
-
-
-def _import(tmp: Path, name: str) -> Path:
-    src = make_levels.write_obj(make_levels.level(name), tmp / f"{name}.obj")
-    out = tmp / name
-    r = CliRunner().invoke(cli, ["-q", "import-arena", str(src), "-o", str(out)])
-    assert r.exit_code == 0, r.output
-    r = CliRunner().invoke(cli, ["-q", "build-navgrid", str(out)])
-    assert r.exit_code == 0, r.output
-    return out
+from level_helpers import ROOT, import_level  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -188,7 +173,7 @@ def test_matches_on_levels_run_and_fight(name):
 @pytest.fixture(scope="module")
 def degenerate(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("degenerate")
-    return {name: load_match_arena(_import(tmp, name)) for name in ("corridor", "narrow_deck", "islands", "bridge")}
+    return {name: load_match_arena(import_level(tmp, name)) for name in ("corridor", "narrow_deck", "islands", "bridge")}
 
 
 @pytest.mark.parametrize("name", ["corridor", "narrow_deck", "islands", "bridge"])
@@ -243,7 +228,7 @@ def test_play_refuses_a_vehicle_too_big_for_the_arena_and_picks_one_that_fits(tm
     """An arena imported too small for the heavy tank records the largest that fits
     ([vehicles]); play refuses the heavy one by name and, with no --vehicle, takes the
     one that fits and says so."""
-    out = _import(tmp_path, "corridor")
+    out = import_level(tmp_path, "corridor")
     info = load_match_arena(out)
     assert info.vehicles.get("largest") == "light" and "heavy" in info.vehicles.get("too_big", [])
     r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(out), "--vehicle", "heavy",

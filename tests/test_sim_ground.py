@@ -11,22 +11,16 @@ from __future__ import annotations
 
 import math
 import random
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-from click.testing import CliRunner
 
-from tanktool.cli.main import cli
 from tanktool.sim.commands import Command
 from tanktool.sim.match import load_match_arena, load_tank_spec, run_match
 from tanktool.sim.world import World
 from tanktool.sim.weapons import fire
 
-ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "tools"))
-import make_levels  # noqa: E402
+from level_helpers import ROOT, import_level  # noqa: E402
 
 GENERATED = ("rolling_terrain", "bridge", "two_storeys", "ramps_and_decks")
 
@@ -39,13 +33,7 @@ def arenas(tmp_path_factory):
         out[name] = load_match_arena(ROOT / "arenas" / name)
     base = tmp_path_factory.mktemp("levels")
     for name in GENERATED:
-        src = make_levels.write_obj(make_levels.level(name), base / f"{name}.obj")
-        b = base / name
-        r = CliRunner().invoke(cli, ["-q", "import-arena", str(src), "-o", str(b)])
-        assert r.exit_code == 0, r.output
-        r = CliRunner().invoke(cli, ["-q", "build-navgrid", str(b)])
-        assert r.exit_code == 0, r.output
-        out[name] = load_match_arena(b)
+        out[name] = load_match_arena(import_level(base, name))
     for name, info in out.items():
         assert info.ground is not None, name
     return out

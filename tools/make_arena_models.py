@@ -43,6 +43,7 @@ import trimesh
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tools"))
+import make_levels  # noqa: E402
 
 WALL_H = 3.0  # m, well above the 1 m cut
 SLAB = 0.5  # floor slab thickness (m)
@@ -52,13 +53,8 @@ COLOURS = {
     "wall": (0.62, 0.36, 0.27),
     "crate": (0.55, 0.42, 0.22),
     "block": (0.45, 0.47, 0.55),
-    # the generated levels' kinds (tools/make_levels.py)
-    "ground": (0.42, 0.45, 0.38),
-    "grass": (0.38, 0.52, 0.30),
-    "rock": (0.50, 0.48, 0.45),
-    "deck": (0.55, 0.42, 0.22),
-    "ramp": (0.60, 0.55, 0.40),
 }
+COLOURS.update({k: v for k, v in make_levels.COLOURS.items() if k not in COLOURS})   # the generated levels' kinds
 
 #: the 2002 paper's free-space outline, completed (paper units); x right, z up
 PAPER_OUTLINE = [
