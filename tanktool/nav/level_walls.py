@@ -362,27 +362,22 @@ CLIP_INSET = 0.001
 
 def _crossings(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Proper crossings (an X, ends excluded) of the segments of ``a`` with those of
-    ``b``, both (n, 2, 2): (index in a, index in b, parameter along the a segment)."""
-    out_i, out_j, out_t = [], [], []
-    if len(a) and len(b):
-        q, s = b[None, :, 0], (b[:, 1] - b[:, 0])[None]
-        for k0 in range(0, len(a), 512):          # bounded memory on long wall lists
-            aa = a[k0:k0 + 512]
-            p, r = aa[:, None, 0], (aa[:, 1] - aa[:, 0])[:, None]
-            den = r[..., 0] * s[..., 1] - r[..., 1] * s[..., 0]
-            qp = q - p
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t = (qp[..., 0] * s[..., 1] - qp[..., 1] * s[..., 0]) / den
-                u = (qp[..., 0] * r[..., 1] - qp[..., 1] * r[..., 0]) / den
-            eps = 1e-6
-            hit = (np.abs(den) > 1e-12) & (t > eps) & (t < 1 - eps) & (u > eps) & (u < 1 - eps)
-            i, j = np.nonzero(hit)
-            out_i.append(i + k0)
-            out_j.append(j)
-            out_t.append(t[i, j])
-    if not out_i:
+    ``b``, both (n, 2, 2): (index in a, index in b, parameter along the a segment).
+    Candidate pairs come from an STR tree, so the cost follows the crossings found."""
+    if len(a) == 0 or len(b) == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0)
-    return np.concatenate(out_i), np.concatenate(out_j), np.concatenate(out_t)
+    tree = shapely.STRtree(shapely.linestrings(b))
+    i, j = tree.query(shapely.linestrings(a), predicate="intersects")
+    p, r = a[i, 0], a[i, 1] - a[i, 0]
+    q, s = b[j, 0], b[j, 1] - b[j, 0]
+    den = r[:, 0] * s[:, 1] - r[:, 1] * s[:, 0]
+    qp = q - p
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = (qp[:, 0] * s[:, 1] - qp[:, 1] * s[:, 0]) / den
+        u = (qp[:, 0] * r[:, 1] - qp[:, 1] * r[:, 0]) / den
+    eps = 1e-6
+    hit = (np.abs(den) > 1e-12) & (t > eps) & (t < 1 - eps) & (u > eps) & (u < 1 - eps)
+    return i[hit], j[hit], t[hit]
 
 
 def _split_crossings(seg: np.ndarray, tolerance: float) -> np.ndarray:
