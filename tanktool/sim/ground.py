@@ -157,6 +157,10 @@ class MeshIndex:
         return k, float(t[k][hit[k]].min())
 
 
+#: up to this many lines of sight from one point are walked one by one (SolidField.visible_from)
+FEW_LINES = 4
+
+
 class SolidField:
     """The model's solid as voxels (the spans of ``geometry.heightfield`` at ``cs``
     metres across and ``ch`` up, everything below a column's lowest span counted as
@@ -281,6 +285,10 @@ class SolidField:
         q = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         if len(q) == 0:
             return np.zeros(0, dtype=bool)
+        if len(q) <= FEW_LINES:
+            # a few lines: walked one by one, block by block (the same samples), which
+            # skips what passes above the solid and beats the arrays' set-up cost
+            return np.array([not self.blocked(a, tuple(b)) for b in q.tolist()], dtype=bool)
         p = np.asarray(a, dtype=np.float64)
         d = q - p
         k = np.maximum(np.ceil(np.sqrt((d * d).sum(axis=1)) / (0.5 * self.cs)).astype(np.int64), 1)
