@@ -90,17 +90,25 @@ def walled_yard(w: float, d: float, wall_h: float = 3.0, t: float = 1.0, slab: f
             ("wall", box(0, t, t, d - t, 0, wall_h)), ("wall", box(w - t, t, w, d - t, 0, wall_h))]
 
 
+def sine_waves(rng: np.random.Generator, X: np.ndarray, Z: np.ndarray, count: int, k: tuple[float, float],
+               weight_min: float) -> np.ndarray:
+    """A sum of ``count`` seeded waves sin(kx x + a) cos(kz z + b) over the grid X, Z,
+    wave numbers in ``k``, each weighted between ``weight_min`` and 1."""
+    h = np.zeros_like(X)
+    for _ in range(count):
+        kx, kz = rng.uniform(k[0], k[1], 2)
+        ph = rng.uniform(0, 2 * math.pi, 2)
+        h += rng.uniform(weight_min, 1.0) * np.sin(kx * X + ph[0]) * np.cos(kz * Z + ph[1])
+    return h
+
+
 def rolling_terrain(size: float = 90.0, n: int = 52, amp: float = 3.5, seed: int = 1) -> list:
     """Hills and hollows over ``size`` x ``size`` m: ``2 (n - 1)^2`` triangles of a sum of
     seeded sine waves, plus a ridge steeper than a tank climbs."""
     rng = np.random.default_rng(seed)
     xs = np.linspace(0, size, n)
     X, Z = np.meshgrid(xs, xs)
-    h = np.zeros_like(X)
-    for _ in range(5):
-        kx, kz = rng.uniform(0.03, 0.12, 2)
-        ph = rng.uniform(0, 2 * math.pi, 2)
-        h += rng.uniform(0.4, 1.0) * np.sin(kx * X + ph[0]) * np.cos(kz * Z + ph[1])
+    h = sine_waves(rng, X, Z, 5, (0.03, 0.12), 0.4)
     h *= amp / max(np.abs(h).max(), 1e-9)
     # a steep ridge across one corner (about 50 degrees)
     ridge = np.clip(8.0 - np.abs((X - 0.75 * size) + (Z - 0.75 * size)) * 1.2, 0, None)
@@ -167,11 +175,7 @@ def hills(seed: int = 7) -> list:
     size, n = 120.0, 61
     xs = np.linspace(0, size, n)
     X, Z = np.meshgrid(xs, xs)
-    h = np.zeros_like(X)
-    for _ in range(6):
-        kx, kz = rng.uniform(0.025, 0.08, 2)
-        ph = rng.uniform(0, 2 * math.pi, 2)
-        h += rng.uniform(0.5, 1.0) * np.sin(kx * X + ph[0]) * np.cos(kz * Z + ph[1])
+    h = sine_waves(rng, X, Z, 6, (0.025, 0.08), 0.5)
     h = (h - h.min()) / max(h.max() - h.min(), 1e-9) * 6.0  # 0 .. 6 m
     edge = np.minimum.reduce([X, Z, size - X, size - Z])
     e = np.clip(edge / 25.0, 0, 1)

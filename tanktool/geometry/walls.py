@@ -505,7 +505,12 @@ def thin_walls(chains: list, free, tolerance: float) -> np.ndarray:
     inside = shapely.intersection(lines, free)
     # a chain lying on the free space's outline is already a wall there
     inside = shapely.difference(inside, shapely.buffer(shapely.boundary(free), tolerance, cap_style="flat"))
-    parts = shapely.get_parts(shapely.line_merge(shapely.union_all(inside)))
+    return line_segments(shapely.get_parts(shapely.line_merge(shapely.union_all(inside))), tolerance)
+
+
+def line_segments(parts: np.ndarray, tolerance: float) -> np.ndarray:
+    """The (n, 2, 2) segments of the line strings among ``parts`` (other geometries
+    left out), those shorter than ``tolerance`` dropped."""
     parts = parts[shapely.get_type_id(parts) == 1]
     if len(parts) == 0:
         return np.zeros((0, 2, 2))

@@ -408,12 +408,9 @@ def _clip_crossings(thin: np.ndarray, outline: np.ndarray, R, tolerance: float) 
     # a millimetre inside: the written coordinates (0.1 mm) stay on this side of it
     inside = shapely.intersection(shapely.linestrings(thin[bad]),
                                   shapely.buffer(shapely.set_precision(R, 0.0), -CLIP_INSET, join_style="mitre"))
-    coords, index = shapely.get_coordinates(shapely.get_parts(shapely.line_merge(inside)), return_index=True) \
-        if not shapely.is_empty(inside).all() else (np.zeros((0, 2)), np.zeros(0, dtype=np.int64))
-    same = index[1:] == index[:-1]
-    seg = np.stack([coords[:-1][same], coords[1:][same]], axis=1) if len(coords) > 1 else np.zeros((0, 2, 2))
-    seg = seg[np.hypot(*(seg[:, 1] - seg[:, 0]).T) >= tolerance] if len(seg) else seg
-    return np.concatenate([thin[~bad], seg])
+    if shapely.is_empty(inside).all():
+        return thin[~bad]
+    return np.concatenate([thin[~bad], cut.line_segments(shapely.get_parts(shapely.line_merge(inside)), tolerance)])
 
 
 def ledge_walls(cells: np.ndarray, same: np.ndarray, origin: np.ndarray, cell: float,

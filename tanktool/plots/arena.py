@@ -21,6 +21,16 @@ WALL_COLOUR = "#202020"
 NORMAL_COLOUR = "#d04020"
 
 
+
+def _spawn_mark(ax, x: float, z: float, th: float, number: int, arrow: float, back: float, zorder: int) -> None:
+    """A spawn point: a dot, an arrow ``arrow`` long the way it faces, and its number
+    ``back`` arrow lengths behind it."""
+    ax.annotate("", xy=(x + arrow * np.cos(th), z + arrow * np.sin(th)), xytext=(x, z),
+                arrowprops=dict(arrowstyle="-|>", color="#1a7a1a", lw=1.5), zorder=zorder)
+    ax.plot([x], [z], "o", color="#1a7a1a", ms=4, zorder=zorder)
+    ax.text(x - back * arrow * np.cos(th), z - back * arrow * np.sin(th), str(number), color="#1a7a1a",
+            fontsize=8, ha="center", va="center", zorder=zorder + 1)
+
 def fill_region(ax: Any, geom: Any, colour: str, zorder: float = 0) -> None:
     """Fill a shapely (Multi)Polygon on ``ax`` as one compound path: every part's
     outline counter-clockwise, its holes clockwise, so the non-zero rule leaves the
@@ -108,11 +118,7 @@ def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = 
     spawns = spawns.reshape(len(spawns), -1)[:, :3] if spawns.size else np.zeros((0, 3))
     arrow = 0.03 * max(w, h)
     for k, (x, z, th) in enumerate(spawns, start=1):
-        ax.annotate("", xy=(x + arrow * np.cos(th), z + arrow * np.sin(th)), xytext=(x, z),
-                    arrowprops=dict(arrowstyle="-|>", color="#1a7a1a", lw=1.5), zorder=4)
-        ax.plot([x], [z], "o", color="#1a7a1a", ms=4, zorder=4)
-        ax.text(x - 0.4 * arrow * np.cos(th), z - 0.4 * arrow * np.sin(th), str(k), color="#1a7a1a",
-                fontsize=8, ha="center", va="center", zorder=5)
+        _spawn_mark(ax, x, z, th, k, arrow, 0.4, zorder=4)
     pad = 0.03 * max(w, h)
     ax.set_xlim(xmin - pad, xmax + pad)
     ax.set_ylim(zmin - pad, zmax + pad)
@@ -206,11 +212,7 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
         arrow = 0.03 * max(w, h)
         for k in np.flatnonzero(on):
             x, z, th = spawns[k, :3]
-            ax.annotate("", xy=(x + arrow * np.cos(th), z + arrow * np.sin(th)), xytext=(x, z),
-                        arrowprops=dict(arrowstyle="-|>", color="#1a7a1a", lw=1.5), zorder=5)
-            ax.plot([x], [z], "o", color="#1a7a1a", ms=4, zorder=5)
-            ax.text(x - 0.45 * arrow * np.cos(th), z - 0.45 * arrow * np.sin(th), str(k + 1), color="#1a7a1a",
-                    fontsize=8, ha="center", va="center", zorder=6)
+            _spawn_mark(ax, x, z, th, k + 1, arrow, 0.45, zorder=5)
         pad = 0.03 * max(w, h)
         ax.set_xlim(xmin - pad, xmax + pad)
         ax.set_ylim(zmin - pad, zmax + pad)

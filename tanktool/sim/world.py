@@ -606,6 +606,12 @@ class World:
         """World y a tank looks from (and is seen at): its gun's height over its base."""
         return t.y + t.spec.muzzle_local[1]
 
+    def _eye_at(self, x: float, z: float) -> float:
+        """Eye height over the lowest surface at (x, z) of the ground: for a point of
+        sight given without a height."""
+        g = self.ground
+        return g.height(x, z, max(g.locate(x, z), 0)) + EYE
+
     def line_blocked(self, ax: float, az: float, bx: float, bz: float,
                      ay: float | None = None, by: float | None = None) -> bool:
         """Whether a line of sight from (ax, ay, az) to (bx, by, bz) is blocked: by a
@@ -615,37 +621,29 @@ class World:
         g = self.ground
         if g is None or g.mesh is None:
             return self.walls.blocked(ax, az, bx, bz)
-        if ay is None:
-            ay = g.height(ax, az, max(g.locate(ax, az), 0)) + EYE
-        if by is None:
-            by = g.height(bx, bz, max(g.locate(bx, bz), 0)) + EYE
-        return g.solids.blocked((ax, ay, az), (bx, by, bz))
+        a = (ax, self._eye_at(ax, az) if ay is None else ay, az)
+        return g.solids.blocked(a, (bx, self._eye_at(bx, bz) if by is None else by, bz))
 
     def sees(self, a: Tank, b: Tank) -> bool:
         """Whether nothing stands between two tanks' eyes (range and cone aside)."""
         return not self.line_blocked(a.x, a.z, b.x, b.z, self.eye(a), self.eye(b))
 
     def sees_all(self, a: Tank, others: Sequence[Tank]) -> list[bool]:
-        """``sees(a, b)`` for each of ``others``, in one go (on a ground: one array
-        lookup for all the lines)."""
-        g = self.ground
-        if g is None or g.mesh is None or len(others) < 2:
-            return [self.sees(a, b) for b in others]
-        pts = [(b.x, self.eye(b), b.z) for b in others]
-        return g.solids.visible_from((a.x, self.eye(a), a.z), pts).tolist()
+        """``sees(a, b)`` for each of ``others``, in one go (see :meth:`blocked_from`)."""
+        return [not hidden for hidden in
+                self.blocked_from(a.x, a.z, self.eye(a), [(b.x, b.z, self.eye(b)) for b in others])]
 
     def blocked_from(self, ax: float, az: float, ay: float | None,
                      points: Sequence[tuple[float, float, float | None]]) -> Iterable[bool]:
         """``line_blocked`` from (ax, ay, az) to each (x, z, y) of ``points``: on a
-        ground in one go (one array lookup for all the lines; a height left out is eye
-        height over the lowest surface there), on a flat arena one by one as asked for."""
+        ground in one go (``SolidField.visible_from``; a height left out is eye height
+        over the lowest surface there), on a flat arena one by one as asked for."""
         g = self.ground
-        if g is None or g.mesh is None or len(points) < 2:
+        if g is None or g.mesh is None:
             return (self.line_blocked(ax, az, x, z, ay, y) for x, z, y in points)
-        if ay is None:
-            ay = g.height(ax, az, max(g.locate(ax, az), 0)) + EYE
-        pts = [(x, y if y is not None else g.height(x, z, max(g.locate(x, z), 0)) + EYE, z) for x, z, y in points]
-        return (~g.solids.visible_from((ax, ay, az), pts)).tolist()
+        a = (ax, self._eye_at(ax, az) if ay is None else ay, az)
+        pts = [(x, self._eye_at(x, z) if y is None else y, z) for x, z, y in points]
+        return (~g.solids.visible_from(a, pts)).tolist()
 
     def walls_of(self, t: Tank) -> WallSet:
         """The walls a tank can hit: its level's (all walls on a flat arena)."""
