@@ -19,9 +19,9 @@ install: $(STAMP)
 play: $(STAMP)
 	$(BIN)/tanktool play
 
-## test: set up and run the whole test suite (slow soak/fuzz runs excluded)
+## test: set up and run the whole test suite (slow soak/fuzz runs excluded), on every core
 test: $(STAMP)
-	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(BIN)/python -m pytest -q
+	SDL_VIDEODRIVER=dummy SDL_AUDIODRIVER=dummy $(BIN)/python -m pytest -q -n auto --dist loadscope
 
 ## test-slow: only the long soak/fuzz runs
 test-slow: $(STAMP)
