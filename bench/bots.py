@@ -60,10 +60,10 @@ import numpy as np  # noqa: E402
 
 from tanktool.content import bundled_names  # noqa: E402
 from tanktool.formats.walls_txt import WallList, aux_rectangle  # noqa: E402
-from tanktool.sim.agents import DIFFICULTIES, Agent  # noqa: E402
+from tanktool.bots import BotDriver, Perceiver, Senses  # noqa: E402
+from tanktool.sim.agents import DIFFICULTIES, Agent, make_agents  # noqa: E402
 from tanktool.sim.agents import aim, dodge  # noqa: E402
-from tanktool.sim.agents.agent import trim  # noqa: E402
-from tanktool.sim.agents.navigation import plan_path  # noqa: E402
+from tanktool.sim.agents.driving import trim  # noqa: E402
 from tanktool.sim.commands import IDLE, Command  # noqa: E402
 from tanktool.sim.driver import ScriptedDriver  # noqa: E402
 from tanktool.sim.match import load_match_arena, load_tank_spec  # noqa: E402
@@ -78,27 +78,28 @@ def _stuck(tank) -> bool:
 
 
 class Omniscient(Agent):
-    """The bound: our agent, told where the enemy truly is (it cheats).  Unless it is
-    attacking or evading, it drives an A* path to the enemy, planned again every second."""
+    """The bound: our agent, told where the enemy truly is (it cheats: radar).  Unless
+    it is attacking or evading, it drives an A* path to the enemy, planned again every
+    second."""
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
+        self.senses = dataclasses.replace(self.senses, radar=True)
         self.hunt: list[tuple[float, float]] = []
         self.hunt_at = -math.inf
 
-    def think(self, world, tank):
-        cmd = super().think(world, tank)
-        enemy = next(o for o in world.tanks if o is not tank)
-        if not enemy.alive or self.state in ("attack", "evade"):
+    def think(self, view):
+        cmd = super().think(view)
+        if not view.radar or self.state in ("attack", "evade"):
             return cmd
-        if world.t >= self.hunt_at + 1.0:
-            self.hunt_at = world.t
-            self.hunt = plan_path(self.grid, (tank.x, tank.z), (enemy.x, enemy.z))
-        trim(self.hunt, tank.x, tank.z)
+        me, enemy = view.me, view.radar[0]
+        if view.t >= self.hunt_at + 1.0:
+            self.hunt_at = view.t
+            self.hunt = view.map.path((me.x, me.z, me.y), (enemy.x, enemy.z, enemy.y), self.nav.grid)
+        trim(self.hunt, me.x, me.z)
         if not self.hunt:
             return cmd
-        return self._unstick(world, tank, self._follow(world, tank, self.hunt, speed=1.0, lookahead=4.0,
-                                                       corner=self.hunt[0]))
+        return self.unstick(view, self.follow(view, self.hunt, speed=1.0, lookahead=4.0, corner=self.hunt[0]))
 
 
 def duel(arena, spec, seed: int, level: str, seconds: float, agent=Agent) -> dict:
@@ -106,9 +107,9 @@ def duel(arena, spec, seed: int, level: str, seconds: float, agent=Agent) -> dic
     ours = seed % 2
     world = World(arena.walls, [spec, spec], arena.spawns, seed=seed, bounds=arena.bounds)
     drivers: list = [None, None]
-    drivers[ours] = agent(random.Random(world.rng.getrandbits(64)), level)
+    drivers[ours] = BotDriver(agent(level), world.rng.getrandbits(64))
     drivers[1 - ours] = ScriptedDriver(random.Random(world.rng.getrandbits(64)))
-    agent, base = drivers[ours], drivers[1 - ours]
+    agent, base = drivers[ours].bot, drivers[1 - ours]
     every = int(round(SAMPLE / world.dt))
     samples = [0, 0]
     stuck = [0, 0]
@@ -139,10 +140,10 @@ def first_sight(arena, spec, seed: int, level: str | None, cap: float) -> float:
         def seen() -> bool:
             return driver._target(world, me) is enemy
     else:
-        driver = Agent(rng, level)
+        driver = BotDriver(Agent(level), rng.getrandbits(64))
 
         def seen() -> bool:
-            return enemy.index in driver.senses.last_seen
+            return enemy.index in driver.perceiver.memory.last_seen  # type: ignore[union-attr]
     for _ in range(int(round(cap / world.dt))):
         world.step(None, [driver(world, me), IDLE])
         if seen():
@@ -154,7 +155,7 @@ def cpu(arena, spec, kind: str, steps: int) -> float:
     """Mean seconds per simulated step spent by 8 drivers deciding."""
     world = World(arena.walls, [spec] * 8, arena.spawns, seed=1, bounds=arena.bounds)
     if kind == "agent":
-        drivers = [Agent(random.Random(world.rng.getrandbits(64)), "normal") for _ in range(8)]
+        drivers = make_agents(world, "normal")
     else:
         drivers = [ScriptedDriver(random.Random(world.rng.getrandbits(64))) for _ in range(8)]
     tanks = world.tanks
@@ -194,6 +195,7 @@ class Target:
         self.shooter, self.distance, self.mode, self.rng = shooter, distance, mode, rng
         self.side, self.flip = 1.0, 0.0
         self.evasion = dodge.Evasion(reaction)
+        self.eyes: Perceiver | None = None
 
     def __call__(self, world, me) -> Command:
         s = world.tanks[self.shooter]
@@ -208,7 +210,9 @@ class Target:
         if world.t >= self.flip:
             self.side, self.flip = -self.side, world.t + self.rng.uniform(3.0, 6.0)
         if self.mode == "dodging":
-            esc = self.evasion.command(world, me, [sh for sh in world.shells if sh.owner != me.index])
+            if self.eyes is None:           # it sees every shell (the radar of the bot API)
+                self.eyes = Perceiver(world, me.index, Senses(radar=True), 0)
+            esc = self.evasion.command(world.t, self.eyes.state(world, me), self.eyes.shells(world, me))
             if esc is not None:
                 return Command(advance=esc[0], rotate=rotate, strafe=esc[1])
         return Command(advance=advance, rotate=rotate, strafe=self.side)

@@ -1,6 +1,6 @@
 """The difficulty ladder: a round robin of one-on-one duels between the computer
 agents (easy, normal, hard) and yardstick opponents written from issue 19
-(``sim.agents.robots``: a BZFlag-style robot, a camper, a novice) and the scripted
+(``sim.agents.robots``: a BZFlag-style robot, a camper, a duellist, a novice) and the scripted
 baseline (``sim.driver.ScriptedDriver``), on every bundled arena, under the game's
 rules (``sim.rules.DEFAULT``).
 
@@ -13,7 +13,7 @@ pair so that a clean sweep stays finite; the players' mean is 1500) with 90 %
 bootstrap intervals (duels resampled within each pair and arena), and the goals.
 
     python bench/ladder.py [--duels N] [--json] [--arenas a,b] (default: every bundled arena)
-                           [--players scripted,robot,camper,novice,easy,normal,hard]
+                           [--players scripted,robot,camper,duellist,novice,easy,normal,hard]
                            [--seconds S] [--vehicle light] [--boot B]
 """
 
@@ -33,38 +33,36 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from tanktool.bots import BUILTIN, load_bot  # noqa: E402
 from tanktool.content import bundled_names  # noqa: E402
-from tanktool.sim.agents import DIFFICULTIES, Agent  # noqa: E402
-from tanktool.sim.agents.robots import YARDSTICKS  # noqa: E402
 from tanktool.sim.driver import ScriptedDriver  # noqa: E402
 from tanktool.sim.match import load_match_arena, load_tank_spec  # noqa: E402
 from tanktool.sim.world import World  # noqa: E402
 
-PLAYERS = ("scripted", "robot", "camper", "novice", "easy", "normal", "hard")
+PLAYERS = ("scripted", "robot", "camper", "duellist", "novice", "easy", "normal", "hard")
 #: every bundled arena (box, fort, hills, maze, paper2002 at the time of writing)
 ARENAS = tuple(bundled_names("arenas"))
 
 
-def make_player(name: str, rng: random.Random):
-    """A driver for a player of the ladder."""
+def make_player(name: str, seed: int):
+    """A driver for a player of the ladder (a built-in bot, or the scripted baseline)."""
     if name == "scripted":
-        return ScriptedDriver(rng)
-    if name in YARDSTICKS:
-        return YARDSTICKS[name](rng)
-    if name in DIFFICULTIES:
-        return Agent(rng, name)
+        return ScriptedDriver(random.Random(seed))
+    if name in BUILTIN:
+        return load_bot(name).driver(seed)
     raise ValueError(f"unknown player {name!r} (one of {', '.join(PLAYERS)})")
 
 
 def duel(arena, spec, a: str, b: str, seed: int, seconds: float) -> tuple[int, int]:
     """Kills of ``a`` and of ``b`` in one duel (``a`` is tank 0 on even seeds)."""
     first = seed % 2
-    world = World(arena.walls, [spec, spec], arena.spawns, seed=seed, bounds=arena.bounds)
+    world = World(arena.walls, [spec, spec], arena.spawns, seed=seed, bounds=arena.bounds,
+                  ground=arena.ground)
     drivers: list = [None, None]
-    # the generators are drawn in tank order, so a seed gives each side the same stream
-    rngs = [random.Random(world.rng.getrandbits(64)) for _ in range(2)]
-    drivers[first] = make_player(a, rngs[first])
-    drivers[1 - first] = make_player(b, rngs[1 - first])
+    # the seeds are drawn in tank order, so a seed gives each side the same stream
+    seeds = [world.rng.getrandbits(64) for _ in range(2)]
+    drivers[first] = make_player(a, seeds[first])
+    drivers[1 - first] = make_player(b, seeds[1 - first])
     tanks = world.tanks
     for _ in range(int(round(seconds / world.dt))):
         world.step(None, [d(world, t) for d, t in zip(drivers, tanks)])

@@ -9,7 +9,8 @@ import numpy as np
 from sim_fixtures import box_arena
 from tanktool.sim.agents import Agent
 from tanktool.sim.agents.navigation import Coverage, Views, agent_grid, views_for
-from tanktool.sim.agents.perception import Senses
+from bot_helpers import driver, perceiver
+from tanktool.bots import Senses
 from tanktool.sim.body import TankSpec
 from tanktool.sim.world import World
 
@@ -80,13 +81,13 @@ def test_exploration_goal_heads_for_what_was_not_seen():
 def test_wandering_agent_drives_to_unseen_parts_and_sees_more_of_the_arena():
     walls, spawns = box_arena()
     w = World(walls, [TankSpec.box("t")], spawns, seed=1)     # alone
-    agent = Agent(random.Random(4), "normal", watch=False)
+    agent = driver(Agent("normal", watch=False), 4)
     me = w.tanks[0]
     me.place(10.0, 10.0, 0.0)
     for _ in range(int(30.0 / w.dt)):
         w.step(None, [agent(w, me)])
-    assert agent.state == "wander"
-    assert np.isfinite(agent.coverage.seen).mean() > 0.8    # most of the box seen in 30 s
+    assert agent.bot.state == "wander"
+    assert np.isfinite(agent.bot.nav.coverage.seen).mean() > 0.8    # most of the box seen in 30 s
     assert me.wall_bumps <= 1
 
 
@@ -94,6 +95,5 @@ def test_a_sighting_carries_the_enemy_hull_heading():
     w, _ = box()
     w.tanks[0].place(40.0, 10.0, 0.0)
     w.tanks[1].place(55.0, 10.0, 2.0)
-    senses = Senses(math.radians(60), 100.0, 80.0, 0.15, random.Random(0))
-    (s,) = senses.look(w, w.tanks[0])
+    (s,) = perceiver(w, 0, Senses(math.radians(60), 100.0, 80.0)).look(w, w.tanks[0])
     assert s.index == 1 and s.heading == w.tanks[1].heading

@@ -22,7 +22,8 @@ from click.testing import CliRunner
 from tanktool.cli.main import cli
 from tanktool.formats.walls_txt import WallList
 from tanktool.sim.agents.navigation import SearchPlan, agent_grid, plan_path, views_for
-from tanktool.sim.agents.perception import Senses
+from bot_helpers import perceiver, view_of
+from tanktool.bots import Senses
 from tanktool.sim.match import load_match_arena, load_tank_spec, make_bots, run_match
 from tanktool.sim.world import World
 
@@ -80,19 +81,20 @@ def test_a_tank_follows_the_planned_path_onto_the_roof(fort):
     """The waypoints of a layered path, driven by the agent's own follower, bring the
     tank up the ramp to level 1."""
     w = _world(fort, n=1)
-    bot = make_bots(w)[0]
+    drv = make_bots(w)[0]
     t = w.tanks[0]
-    bot(w, t)                                 # sets the agent up
-    bot.path = plan_path(bot.grid, (t.x, t.z, t.y), (70.0, 36.0, 5.0))
+    drv(w, t)                                 # sets the agent up
+    bot = drv.bot
+    bot.path = plan_path(bot.nav.grid, (t.x, t.z, t.y), (70.0, 36.0, 5.0))
     assert bot.path
     for _ in range(120 * 60):
         if not bot.path:
             break
-        from tanktool.sim.agents.agent import trim
+        from tanktool.sim.agents.driving import trim
         trim(bot.path, t.x, t.z)
         if not bot.path:
             break
-        cmd = bot._follow(w, t, bot.path, speed=1.0, lookahead=4.0)
+        cmd = bot.follow(view_of(drv, w), bot.path, speed=1.0, lookahead=4.0)
         w.step(None, [cmd])
     assert t.level == 1 and abs(t.y - 5.0) < 0.2, (t.x, t.z, t.y, t.level)
 
@@ -131,8 +133,7 @@ def test_sight_is_3d_a_hill_hides_a_deck_hides(hills, fort):
     w.stand(b, 5.0)
     assert a.level == 0 and b.level == 1
     assert not w.sees(a, b) and not w.sees(b, a)
-    senses = Senses(math.pi, 200.0, 50.0, 0.1, __import__("random").Random(0))
-    assert senses.look(w, a) == []
+    assert perceiver(w, 0, Senses(math.pi, 160.0, 50.0)).look(w, a) == ()
 
 
 def test_the_sight_map_sees_in_3d(hills):

@@ -6,15 +6,18 @@ import random
 
 import pytest
 
+from bot_helpers import driver, happen, perceiver, view_of
 from sim_fixtures import ROOT, box_world
+from tanktool.bots import Senses
 from tanktool.sim.agents import Agent
-from tanktool.sim.agents.agent import RETURN_FIRE, STALE, SWEEP, WATCH_COVER, WATCH_STINT
+from tanktool.sim.agents.agent import GUARDS
+from tanktool.sim.agents.combat import RETURN_FIRE
+from tanktool.sim.agents.explore import STALE, SWEEP, WATCH_COVER, WATCH_STINT
 from tanktool.sim.agents.navigation import vantages_for
-from tanktool.sim.agents.perception import Sighting, can_see
+from tanktool.sim.agents.perception import ENGINE_FULL, ENGINE_QUIET, Percept, Sighting, can_see
+from tanktool.sim.commands import IDLE
 from tanktool.sim.match import load_match_arena, load_tank_spec
 from tanktool.sim.world import World
-from tanktool.sim.agents.perception import ENGINE_FULL, ENGINE_QUIET, Senses
-from tanktool.sim.commands import IDLE
 
 
 # ------------------------------------------------------------------ hearing engines
@@ -23,49 +26,49 @@ def test_an_engine_is_heard_through_a_wall_within_the_radius_and_not_beyond():
     w = box_world([(50.0, 35.0), (70.0, 35.0), (110.0, 35.0)])
     me, near, far = w.tanks
     assert w.walls.blocked(me.x, me.z, near.x, near.z)
-    senses = Senses(math.radians(60), 90.0, 80.0, 0.15, random.Random(2), engine_radius=35.0)
+    eyes = perceiver(w, 0, Senses(math.radians(60), 90.0, 80.0, engine_radius=35.0), seed=2)
     # standing still: not heard
-    assert senses.listen_engines(w, me) is None
+    assert eyes.listen_engines(w, me) == ()
     # moving fast: heard through the wall, roughly where it is
     near.vx = ENGINE_FULL
-    heard = senses.listen_engines(w, me)
-    assert heard is not None and heard.engine
+    view = eyes.view(w, random.Random(0))
+    assert len(view.engines) == 1 and view.engines[0].engine
+    heard = view.engines[0]
     assert math.hypot(heard.x - near.x, heard.z - near.z) < 4 * 0.15 * 20.0
-    assert senses.heard is heard                       # remembered as the last thing heard
+    assert view.memory.heard is heard                  # remembered as the last thing heard
     # only the far one moving: 60 m is beyond the 35 m radius
     near.vx, far.vx = 0.0, ENGINE_FULL
-    assert senses.listen_engines(w, me) is None
+    assert eyes.listen_engines(w, me) == ()
     # a dead tank makes no noise
     near.vx, near.alive = ENGINE_FULL, False
-    assert senses.listen_engines(w, me) is None
-    # no engine hearing at all with radius 0 (the default)
+    assert eyes.listen_engines(w, me) == ()
+    # no engine hearing at all with radius 0
     near.alive = True
-    assert Senses(math.radians(60), 90.0, 80.0, 0.15, random.Random(2)).listen_engines(w, me) is None
+    assert perceiver(w, 0, Senses(engine_radius=0.0)).listen_engines(w, me) == ()
 
 
 def test_a_faster_engine_is_heard_farther():
     w = box_world([(20.0, 20.0), (50.0, 20.0)])
     me, o = w.tanks
-    senses = Senses(math.radians(60), 90.0, 80.0, 0.15, random.Random(4), engine_radius=40.0)
+    eyes = perceiver(w, 0, Senses(math.radians(60), 90.0, 80.0, engine_radius=40.0), seed=4)
     o.vx = ENGINE_QUIET + 0.1                 # crawling: heard over about half the radius
-    assert senses.listen_engines(w, me) is None           # 30 m
+    assert eyes.listen_engines(w, me) == ()               # 30 m
     o.place(35.0, 20.0, 0.0)
     o.vx = ENGINE_QUIET + 0.1
-    assert senses.listen_engines(w, me) is not None       # 15 m
+    assert eyes.listen_engines(w, me) != ()               # 15 m
     o.place(50.0, 20.0, 0.0)
     o.vx = ENGINE_FULL                                    # full speed: 30 m < 40 m
-    assert senses.listen_engines(w, me) is not None
+    assert eyes.listen_engines(w, me) != ()
 
 
 def test_an_agent_goes_towards_an_engine_it_hears():
     w = box_world([(50.0, 35.0), (75.0, 35.0)], headings=[math.pi, 0.0])
-    agent = Agent(random.Random(1), "normal")
+    agent = driver(Agent("normal"), 1)
     me, o = w.tanks
     o.vx = ENGINE_FULL
     agent(w, me)
-    assert agent.state == "search"
-    assert agent.plan is not None
-    gx, gz = agent.plan.goals[0]
+    assert agent.bot.state == "search"
+    gx, gz = agent.bot.machine.states["search"].plan.goals[0]
     assert math.hypot(gx - o.x, gz - o.z) < 15.0
 
 
@@ -81,7 +84,7 @@ def alone(name, seed):
     w = bundled(name, 2)
     me, enemy = w.tanks
     enemy.alive, enemy.respawn_at = False, math.inf
-    return w, me, enemy, Agent(random.Random(seed), "normal")
+    return w, me, enemy, driver(Agent("normal"), seed)
 
 
 def drive(w, agent, me, seconds):
@@ -90,15 +93,16 @@ def drive(w, agent, me, seconds):
 
 
 def set_up(w):
-    agent = Agent(random.Random(0), "normal")
-    agent._setup(w, w.tanks[0])
-    return agent
+    """An agent (its driver made it look once: its map is set up) and its driver."""
+    drv = driver(Agent("normal"), 0)
+    drv(w, w.tanks[0])
+    return drv.bot, drv
 
 
 def test_vantage_cover_counts_the_blocks_in_the_cone_and_in_sight():
     w = bundled("paper2002")
-    agent = set_up(w)
-    views, v = agent.views, agent.vantages
+    agent, _ = set_up(w)
+    views, v = agent.nav.views, agent.nav.vantages
     assert v is vantages_for(views, agent.senses.half_angle, agent.senses.vision_range)    # cached
     rng = random.Random(1)
     for _ in range(20):
@@ -114,7 +118,7 @@ def test_vantage_cover_counts_the_blocks_in_the_cone_and_in_sight():
 
 
 def test_open_arenas_have_a_vantage_and_the_maze_has_none():
-    box, maze = set_up(bundled("box")), set_up(bundled("maze"))
+    box, maze = set_up(bundled("box"))[0].nav, set_up(bundled("maze"))[0].nav
     assert box.vantages.top >= 0.7 > WATCH_COVER > maze.vantages.top
     # in the open box the best place is a corner, facing along the diagonal
     b, face = box.vantages.best(box.views.cell_at(30.0, 30.0), 0.0)
@@ -130,8 +134,8 @@ def test_alone_in_the_box_an_agent_holds_a_vantage_and_sweeps_its_cone():
         w.step(None, [agent(w, me), IDLE])
         if w.t > 12.0:
             headings.append(me.heading)
-            assert agent.state == "watch"
-    gx, gz = agent.spot
+            assert agent.bot.state == "watch"
+    gx, gz = agent.bot.machine.states["watch"].spot
     assert math.hypot(me.x - gx, me.z - gz) < 3.0 and me.wall_bumps == 0
     swing = max(headings) - min(headings)
     assert 0.4 < swing < 2 * SWEEP + 0.4                  # it sweeps, about the vantage's way
@@ -140,11 +144,15 @@ def test_alone_in_the_box_an_agent_holds_a_vantage_and_sweeps_its_cone():
 def test_an_enemy_coming_into_the_watched_box_is_seen_and_attacked():
     w, me, enemy, agent = alone("box", 2)
     drive(w, agent, me, 15.0)
-    assert agent.state == "watch"
+    assert agent.bot.state == "watch"
     # the enemy appears far off, in the watched way (the cone less the sweep)
     cone = agent.senses.half_angle - 0.35
+    face = agent.bot.machine.states["watch"].face
+    # ... in plain sight from anywhere near by (it moves while it fights)
+    near = [(me.x + dx, me.z + dz) for dx in (-4.0, 0.0, 4.0) for dz in (-4.0, 0.0, 4.0)]
     far = [(math.hypot(x - me.x, z - me.z), x, z) for x in range(10, 56, 2) for z in range(10, 56, 2)
-           if can_see(w.walls, me.x, me.z, agent.spot_face, x, z, cone, 90.0)]
+           if can_see(w.walls, me.x, me.z, face, x, z, cone, 90.0)
+           and not any(w.walls.blocked(nx, nz, x, z) for nx, nz in near)]
     d, ex, ez = max(far)
     assert d > 40.0
     enemy.place(ex, ez, 0.0)
@@ -152,51 +160,65 @@ def test_an_enemy_coming_into_the_watched_box_is_seen_and_attacked():
     shots, states = me.shots, set()
     for k in range(int(4.0 / w.dt)):
         w.step(None, [agent(w, me), IDLE])
-        states.add(agent.state)
+        states.add(agent.bot.state)
     assert "attack" in states and me.shots > shots and enemy.hp < enemy.spec.hit_points
 
 
 def test_the_watch_gives_way_to_exploring_what_has_gone_unseen():
     w = bundled("paper2002")
-    agent = set_up(w)
-    me = w.tanks[0]
-    agent.state, agent.state_since = "watch", 0.0
-    agent.coverage.seen[:] = 0.0               # all seen at t=0
+    agent, drv = set_up(w)
+    watch = agent.machine.states["watch"]
+    agent.machine.state, agent.machine.since = watch, 0.0
+    cov = agent.nav.coverage
+    cov.seen[:] = 0.0                          # all seen at t=0
+
+    def update():
+        view = view_of(drv, w)
+        return watch.update(agent, view, agent.memory.digest(view, agent.level)), view
+
     w.t = WATCH_STINT + 1.0                   # nothing stale yet: watch on
-    assert agent.coverage.stale_fraction(w.t) == 0.0 and agent._watch(w, me) is not None
+    assert cov.stale_fraction(w.t) == 0.0 and update()[0] is not None
     w.t = 61.0                                 # all stale: explore, until seen again
-    assert agent.coverage.stale_fraction(w.t) > STALE
-    assert agent._watch(w, me) is None and agent.exploring
-    agent.coverage.seen[:] = w.t
-    assert agent._watch(w, me) is not None and not agent.exploring
+    assert cov.stale_fraction(w.t) > STALE
+    cmd, view = update()
+    assert cmd is None and agent.exploring
+    assert not GUARDS["vantage"](agent, view, None)        # no watching while it is stale
+    cov.seen[:] = w.t
+    assert GUARDS["vantage"](agent, view, None) and not agent.exploring
 
 
 # ------------------------------------------------------------------ after a kill
 def test_after_a_kill_it_forgets_the_dead_enemy_and_does_not_search_for_it():
-    w = box_world([(50.0, 35.0), (55.0, 70.0)])
+    w = box_world([(50.0, 35.0), (55.0, 70.0), (100.0, 80.0)])
     me = w.tanks[0]
-    agent = Agent(random.Random(0), "normal")
-    agent(w, me)
-    agent.target, agent.state = 1, "attack"
-    agent.senses.last_seen[1] = Sighting(1, 55.0, 70.0, 0.0, 0.0, w.t, 35.0)
+    drv = driver(Agent("normal"), 0)
+    drv(w, me)
+    agent = drv.bot
+    agent.memory.target = 1
+    agent.machine.state = agent.machine.states["attack"]
+    drv.perceiver.memory.last_seen[1] = Sighting(1, 55.0, 70.0, 0.0, 0.0, w.t, 35.0)
     me.kills = 1
     w.tanks[1].alive = False
-    agent.next_think = -math.inf
-    agent(w, me)
-    assert 1 not in agent.senses.last_seen and agent.killed_at == w.t
+    happen(w, ("kill", 0, 1))
+    drv.next_think = -math.inf
+    drv(w, me)
+    assert 1 not in agent.memory.last_seen and agent.memory.killed_at == w.t
     assert agent.state == "ambush"                 # 1 kill, 0 deaths: it leads
-    # a kill it did not see happen (its target seen long ago) changes nothing
-    agent.senses.last_seen[1] = Sighting(1, 55.0, 70.0, 0.0, 0.0, w.t - 5.0, 35.0)
-    me.kills = 2
-    agent._kills(me, w.t)
-    assert 1 in agent.senses.last_seen
+    # a kill in the kill feed (tank 2 killed tank 1) forgets it too: it respawns
+    # elsewhere; but it was not our kill
+    drv.perceiver.memory.last_seen[1] = Sighting(1, 55.0, 70.0, 0.0, 0.0, w.t, 35.0)
+    killed_at = agent.memory.killed_at
+    happen(w, ("kill", 2, 1), dt=1.0)
+    drv.next_think = -math.inf
+    drv(w, me)
+    assert 1 not in agent.memory.last_seen and agent.memory.killed_at == killed_at
 
 
 # ------------------------------------------------------------------ ambush while leading
 def test_safety_is_the_share_of_the_blocks_seeing_a_block_that_its_cone_sees():
     w = bundled("maze")
-    agent = set_up(w)
-    views, v = agent.views, agent.vantages
+    agent, _ = set_up(w)
+    views, v = agent.nav.views, agent.nav.vantages
     half, rng_ = agent.senses.half_angle, agent.senses.vision_range
     rng = random.Random(3)
     for _ in range(15):
@@ -218,85 +240,90 @@ def test_safety_is_the_share_of_the_blocks_seeing_a_block_that_its_cone_sees():
 
 
 def test_a_leading_agent_ambushes_from_a_safe_place_even_in_the_maze():
-    w, me, enemy, agent = alone("maze", 4)
-    drive(w, agent, me, 5.0)
+    w, me, enemy, drv = alone("maze", 4)
+    agent = drv.bot
+    drive(w, drv, me, 5.0)
     assert agent.state == "wander"             # no vantage in the maze, and not leading
     me.kills = 1                               # now it leads (1 kill, 0 deaths)
-    drive(w, agent, me, 25.0)
+    drive(w, drv, me, 25.0)
+    ambush = agent.machine.states["ambush"]
+    views = agent.nav.views
     assert agent.state == "ambush" and me.wall_bumps == 0
-    spot = agent.views.cell_at(*agent.spot)
-    assert agent.vantages.safety[spot] >= 0.9
-    assert math.hypot(me.x - agent.spot[0], me.z - agent.spot[1]) < 3.0
+    spot = views.cell_at(*ambush.spot)
+    assert agent.nav.vantages.safety[spot] >= 0.9
+    assert math.hypot(me.x - ambush.spot[0], me.z - ambush.spot[1]) < 3.0
     # an engine heard: it does not go looking, it moves away from the noise and turns
     # to face the way the noise would come in
-    here = agent.views.cell_at(me.x, me.z)
-    ex, ez = next((float(x), float(z)) for x, z in agent.views.points
+    here = views.cell_at(me.x, me.z)
+    ex, ez = next((float(x), float(z)) for x, z in views.points
                   if 12.0 < math.hypot(x - me.x, z - me.z) < 20.0
                   and w.walls.blocked(me.x, me.z, float(x), float(z)))
     enemy.place(ex, ez, 0.0)
     enemy.alive, enemy.vx = True, 8.0
-    heard_block = agent.views.cell_at(ex, ez)
-    agent.spot_chosen = -math.inf
+    heard_block = views.cell_at(ex, ez)
+    ambush.chosen = -math.inf
     for k in range(int(1.0 / w.dt)):
         enemy.vx, enemy.vz = 8.0, 0.0
-        w.step(None, [agent(w, me), IDLE])
+        w.step(None, [drv(w, me), IDLE])
         assert agent.state == "ambush"
-    assert agent.faced is not None
-    far = agent.views.path_distances(heard_block)
-    assert far[agent.views.cell_at(*agent.spot)] >= min(far[here], 80.0)
+    assert ambush.faced is not None
+    far = views.path_distances(heard_block)
+    assert far[views.cell_at(*ambush.spot)] >= min(far[here], 80.0)
 
 
 def test_hit_by_a_tank_it_cannot_see_it_turns_to_face_the_shot():
     # the shooter 30 m behind, in the open: heard, not seen
     w = box_world([(75.0, 82.0), (45.0, 82.0)], headings=[0.0, 0.0])
     me, shooter = w.tanks
-    agent = Agent(random.Random(7), "normal", watch=False)
-    agent(w, me)
-    assert 1 not in agent.senses.last_seen
-    w.t += 0.1
+    drv = driver(Agent("normal", watch=False), 7)
+    drv(w, me)
+    assert 1 not in drv.perceiver.memory.last_seen
     me.hp -= 25.0
-    shooter.shots += 1
-    agent.next_think = -math.inf
-    agent(w, me)
-    face, until = agent.return_to
-    assert until == pytest.approx(w.t + RETURN_FIRE)
-    assert abs(math.remainder(face - math.pi, 2 * math.pi)) < 0.3
+    happen(w, ("shot", 1, -1), ("hit", 1, 0, 25.0), dt=0.1)
+    drv.next_think = -math.inf
+    drv(w, me)
+    back = drv.bot.machine.states["return_fire"]
+    assert drv.bot.state == "return_fire"
+    assert back.until == pytest.approx(w.t + RETURN_FIRE)
+    assert abs(math.remainder(back.face - math.pi, 2 * math.pi)) < 0.3
     states = set()
     for k in range(int(RETURN_FIRE / w.dt)):
-        w.step(None, [agent(w, me), IDLE])
-        states.add(agent.state)
-    assert "attack" in states and 1 in agent.senses.last_seen
+        w.step(None, [drv(w, me), IDLE])
+        states.add(drv.bot.state)
+    assert "attack" in states and 1 in drv.perceiver.memory.last_seen
     # a shot heard from behind a wall is not returned
     w2 = box_world([(70.0, 35.0), (45.0, 35.0)], headings=[0.0, 0.0])
-    a2 = Agent(random.Random(7), "normal", watch=False)
-    a2(w2, w2.tanks[0])
-    w2.t += 0.1
+    d2 = driver(Agent("normal", watch=False), 7)
+    d2(w2, w2.tanks[0])
     w2.tanks[0].hp -= 25.0
-    w2.tanks[1].shots += 1
-    a2.next_think = -math.inf
-    a2(w2, w2.tanks[0])
-    assert a2.return_to[1] == -math.inf
+    happen(w2, ("shot", 1, -1), ("hit", 1, 0, 25.0), dt=0.1)
+    d2.next_think = -math.inf
+    d2(w2, w2.tanks[0])
+    assert d2.bot.state != "return_fire"
 
 
 def test_only_a_level_that_scoots_goes_back_to_cover_while_reloading(monkeypatch):
     """Normal shuttles behind the corner it came round while its gun reloads; hard
     (``scoot`` False) keeps strafing in the fight."""
-    from tanktool.sim.agents.agent import DIFFICULTIES, SCOOT
+    from tanktool.sim.agents import combat
+    from tanktool.sim.agents.difficulty import DIFFICULTIES
 
     assert DIFFICULTIES["normal"].scoot and not DIFFICULTIES["hard"].scoot
     asked = []
 
-    def corner(self, world, tank, s):
-        asked.append(self.level.name)
-        return tank.x - 5.0, tank.z
+    def corner(agent, view, s):
+        asked.append(agent.level.name)
+        return view.me.x - 5.0, view.me.z
 
-    monkeypatch.setattr(Agent, "_cover_behind", corner)
+    monkeypatch.setattr(combat, "cover_behind", corner)
     for level in ("normal", "hard"):
         w = box_world([(20.0, 10.0), (50.0, 10.0)])
         me = w.tanks[0]
-        me.reload = SCOOT + 0.5                      # just fired
-        agent = Agent(random.Random(2), level)
+        drv = driver(Agent(level), 2)
+        drv(w, me)
+        me.reload = combat.SCOOT + 0.5                      # just fired
         s = Sighting(1, 50.0, 10.0, 0.0, 0.0, w.t, 30.0, heading=math.pi)
-        cmd = agent._attack(w, me, s)
+        p = Percept(w.t, s, True, None, None, False, (), False, False)
+        cmd = drv.bot.machine.states["attack"].update(drv.bot, view_of(drv, w), p)
         assert not cmd.fire
     assert asked == ["normal"]

@@ -9,6 +9,8 @@ import random
 import numpy as np
 import pytest
 
+from bot_helpers import perceiver, state_of
+from tanktool.bots import Senses
 from tanktool.formats.walls_txt import WallList, aux_rectangle
 from tanktool.sim.agents import aim, dodge
 from tanktool.sim.commands import Command
@@ -60,7 +62,7 @@ def test_the_course_prediction_is_the_worlds_motion():
         for _ in range(120):                         # get moving: forward and right
             w.step(None, [Command(advance=1.0, strafe=1.0)])
         t.omega = 0.0
-        path = dodge.course(t, advance, strafe, 1.0, step=w.dt)
+        path = dodge.course(state_of(w, 0), advance, strafe, 1.0, step=w.dt)
         for _ in range(120):
             w.step(None, [Command(advance=advance, strafe=strafe)])
             t.omega = 0.0
@@ -77,6 +79,7 @@ def _shoot_at_strafer(evade: bool, distance: float, seed: int = 0, still: bool =
               rules=rules, bounds=[[0, 0], [400, 400]])
     g, target = w.tanks
     ev = dodge.Evasion(0.25)
+    eyes = perceiver(w, 1, Senses(math.radians(60), 200.0))
     shots = hits = 0
     side = 1.0
     while w.t < 30.0:
@@ -96,7 +99,7 @@ def _shoot_at_strafer(evade: bool, distance: float, seed: int = 0, still: bool =
         cmd = Command(advance=max(-1.0, min(1.0, 0.5 * (want - vf))),
                       rotate=max(-1.0, min(1.0, 3.0 * face - 0.5 * target.omega)), strafe=0.0 if still else side)
         if evade:
-            esc = ev.command(w, target, dodge.visible_shells(w, target, math.radians(60), 200.0))
+            esc = ev.command(w.t, eyes.state(w, target), eyes.shells(w, target))
             if esc is not None:
                 cmd = Command(advance=esc[0], rotate=cmd.rotate, strafe=esc[1])
         for e in w.step(None, [gun, cmd]):
@@ -126,16 +129,21 @@ def test_threats_and_visible_shells():
     c.place(150.0, 300.0, -math.pi / 2)
     w.step(None, [Command(fire=True), Command(), Command()])
     shell = w.shells[0]
-    assert dodge.visible_shells(w, b, math.radians(60), 200.0) == []          # the wall is in the way
-    assert dodge.visible_shells(w, a, math.radians(60), 200.0) == []          # its own
-    assert dodge.threats(w, c) == []                                           # not flying at c
+    assert perceiver(w, 1).shells(w, b) == ()                                  # the wall is in the way
+    assert perceiver(w, 0).shells(w, a) == ()                                  # its own
+    seen_by_c = perceiver(w, 2).shells(w, c)
+    assert len(seen_by_c) == 1 and dodge.threats(state_of(w, 2), seen_by_c) == []     # not flying at c
     # without the wall the shell flies at b: a threat arriving in about 100/40 s
     w2 = World(field(), [spec, spec], [(50, 200, 0.0), (150, 200, math.pi)], seed=0,
                rules=dataclasses.replace(DEFAULT, spread=0.0, spawn_protection=0.0))
     w2.tanks[0].place(50.0, 200.0, 0.0)
     w2.tanks[1].place(130.0, 200.0, math.pi)
     w2.step(None, [Command(fire=True), Command()])
-    th = dodge.threats(w2, w2.tanks[1])
+    seen = perceiver(w2, 1).shells(w2, w2.tanks[1])
+    th = dodge.threats(state_of(w2, 1), seen)
     assert len(th) == 1 and th[0].arrives == pytest.approx(80.0 / 40.0, abs=0.2) and th[0].miss < 0
-    assert dodge.visible_shells(w2, w2.tanks[1], math.radians(60), 200.0) == [w2.shells[0]]
+    assert [(s.x, s.z, s.owner) for s in seen] == [(w2.shells[0].x, w2.shells[0].z, 0)]
     assert shell.owner == 0
+    # a shell keeps its key while it flies (the step it was fired in), in any process
+    w2.step(None, [Command(), Command()])
+    assert perceiver(w2, 1).shells(w2, w2.tanks[1])[0].key == seen[0].key == (0, 1)

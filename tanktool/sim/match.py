@@ -258,7 +258,21 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
         "steps_per_second": round(steps / wall, 1) if wall > 0 else None,
         "realtime_factor": round(steps * dt / wall, 2) if wall > 0 else None,
     }
+    bot_report(report, drivers, world)
     return MatchResult(report, world, arena, trails)
+
+
+def bot_report(report: dict[str, Any], drivers: list, world: World) -> None:
+    """Bots' failures (deterministic: ``bot_errors`` per tank, when any failed) and
+    their time per call (``timing.bots``: calls over the budget; it depends on the
+    machine, so it never changes what happens)."""
+    stats = [(t.name, getattr(d, "stats", None)) for d, t in zip(drivers, world.tanks)]
+    errors = {name: st.errors for name, st in stats if st is not None and st.errors}
+    if errors:
+        report["bot_errors"] = errors
+    timing = {name: st.timing() for name, st in stats if st is not None}
+    if timing:
+        report["timing"]["bots"] = timing
 
 
 def make_report(world: World, arena: str, vehicle: str, seed: int, events: list) -> dict[str, Any]:

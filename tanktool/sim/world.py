@@ -185,6 +185,8 @@ class World:
         self.t = 0.0
         self.steps = 0
         self.iterations_used = 0          # resolution passes in the last step (for tests/bench)
+        #: the events of the last step (what drivers perceive from: ``sim.bots``)
+        self.events: list[Event] = []
         self._reach = [_sphere_reach(s) for s in specs]
 
     # ------------------------------------------------------------------ public
@@ -194,8 +196,10 @@ class World:
         if len(commands) > len(self.tanks):
             raise ValueError(f"{len(commands)} commands for {len(self.tanks)} tanks")
         if self.match.over:
+            self.events = []
             return []
         events: list[Event] = []
+        self.events = events
         self.steps += 1
         self.t += dt
         self._step_dt = dt

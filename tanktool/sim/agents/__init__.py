@@ -1,11 +1,13 @@
-"""Computer opponents (issue 7): perception, aim and dodging, grid navigation and search;
-the yardstick opponents of issue 19 in ``robots``.
+"""Computer opponents (issues 7, 28): bots on the bot API (``sim.bots``) with
+perception digested each think, a state machine whose transitions are data, aim and
+dodging, grid navigation and search; the yardstick opponents in ``robots``.
 
     from tanktool.sim.agents import Agent, make_agents
-    agents = make_agents(world, "normal")            # one per tank, seeded from the world
-    commands = [a(world, t) for a, t in zip(agents, world.tanks)]
+    drivers = make_agents(world, "normal")            # one per tank, seeded from the world
+    commands = [d(world, t) for d, t in zip(drivers, world.tanks)]
 """
 
-from .agent import DIFFICULTIES, STATES, Agent, Difficulty, difficulty, make_agents
+from .agent import STATES, TRANSITIONS, Agent, make_agents
+from .difficulty import DIFFICULTIES, Difficulty, difficulty
 
-__all__ = ["Agent", "DIFFICULTIES", "Difficulty", "STATES", "difficulty", "make_agents"]
+__all__ = ["Agent", "DIFFICULTIES", "Difficulty", "STATES", "TRANSITIONS", "difficulty", "make_agents"]

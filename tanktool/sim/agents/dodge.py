@@ -12,21 +12,20 @@ full left / none / full right, that keeps the shell farthest outside the hull
 hit).  Stopping a strafe is usually the best dodge: the grip stops a 7 m/s strafe in
 about 0.15 s, and the shooter led the old velocity.
 
-Used by the agents (``sim.agents.agent``) and the yardstick robot
-(``sim.agents.robots``); measured by ``bench/bots.py`` (the share of on-target
-shots a dodging tank avoids, by distance).
+Used by the agents (``sim.agents``) and the yardsticks (``sim.agents.robots``) on
+what their view shows (``sim.bots``: the tank's own state, the shells it sees as
+values named by a stable key); measured by ``bench/bots.py`` (the share of
+on-target shots a dodging tank avoids, by distance).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Iterable, Sequence
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..body import Tank, TankSpec
-    from ..weapons import Shell
-    from ..world import World
+    from ..bots import ShellSeen, TankState, Vehicle
 
 #: prediction step [s]
 STEP = 1.0 / 60.0
@@ -45,17 +44,17 @@ class Threat:
     """A shell that will hit if nothing changes: when it arrives [s from now] and by
     how much it would miss (negative: inside the hull) on the present course."""
 
-    shell: "Shell"
+    shell: "ShellSeen"
     arrives: float
     miss: float
 
 
-def half_extent(tank: "Tank", direction: float) -> float:
+def half_extent(tank: "TankState", direction: float) -> float:
     """Half the width of the tank's footprint box seen along ``direction`` [rad]."""
-    return half_extent_at(tank.spec, tank.heading, direction)
+    return half_extent_at(tank.vehicle, tank.heading, direction)
 
 
-def half_extent_at(spec: "TankSpec", heading: float, direction: float) -> float:
+def half_extent_at(spec: "Vehicle", heading: float, direction: float) -> float:
     """Half the width, seen along ``direction``, of the footprint box of a tank of
     ``spec`` facing ``heading`` [rad]."""
     bx0, bz0, bx1, bz1 = spec.box
@@ -63,11 +62,11 @@ def half_extent_at(spec: "TankSpec", heading: float, direction: float) -> float:
     return 0.5 * (bx1 - bx0) * abs(math.sin(a)) + 0.5 * (bz1 - bz0) * abs(math.cos(a))
 
 
-def course(tank: "Tank", advance: float, strafe: float, duration: float,
+def course(tank: "TankState", advance: float, strafe: float, duration: float,
            step: float = STEP) -> list[tuple[float, float, float]]:
     """(t, x, z) of the tank's centre every ``step`` s for ``duration`` s while it holds
     ``advance`` and ``strafe`` with its heading held (the world's force laws)."""
-    sp = tank.spec
+    sp = tank.vehicle
     c, s = math.cos(tank.heading), math.sin(tank.heading)
     vf = tank.vx * c + tank.vz * s
     vr = -tank.vx * s + tank.vz * c
@@ -97,7 +96,7 @@ def course(tank: "Tank", advance: float, strafe: float, duration: float,
     return out
 
 
-def clearance(tank: "Tank", shell: "Shell", path: Sequence[tuple[float, float, float]]) -> float:
+def clearance(tank: "TankState", shell: "ShellSeen", path: Sequence[tuple[float, float, float]]) -> float:
     """How far the shell passes outside the footprint (negative: it hits) if the tank
     follows ``path``: the least distance between the shell and the tank's centre over
     the path, less the footprint's half extent across the shell's line."""
@@ -115,7 +114,7 @@ def clearance(tank: "Tank", shell: "Shell", path: Sequence[tuple[float, float, f
     return best - ext
 
 
-def arrival(tank: "Tank", shell: "Shell") -> tuple[float, float]:
+def arrival(tank: "TankState", shell: "ShellSeen") -> tuple[float, float]:
     """(time of closest approach from now [s], distance then [m]) of ``shell`` to the
     tank's centre, both moving as they move now."""
     rx, rz = shell.x - tank.x, shell.z - tank.z
@@ -129,15 +128,15 @@ def arrival(tank: "Tank", shell: "Shell") -> tuple[float, float]:
     return t, math.hypot(rx + vx * t, rz + vz * t)
 
 
-def threats(world: "World", tank: "Tank", shells: Iterable["Shell"] | None = None,
-            horizon: float = HORIZON, margin: float = 0.5) -> list[Threat]:
-    """The enemy shells (``shells``, default all in flight) that pass within the
-    footprint + ``margin`` of the tank in the next ``horizon`` s if it holds its
+def threats(tank: "TankState", shells: Iterable["ShellSeen"], horizon: float = HORIZON,
+            margin: float = 0.5) -> list[Threat]:
+    """The shells among ``shells`` (the enemies' shells it knows of) that pass within
+    the footprint + ``margin`` of the tank in the next ``horizon`` s if it holds its
     present velocity, soonest first."""
     out = []
-    reach = tank.spec.radius + margin
-    for sh in world.shells if shells is None else shells:
-        if sh.owner == tank.index or not sh.alive:
+    reach = tank.vehicle.radius + margin
+    for sh in shells:
+        if sh.owner == tank.index:
             continue
         t, d = arrival(tank, sh)
         if not (0.0 < t <= horizon) or d > reach:
@@ -149,7 +148,7 @@ def threats(world: "World", tank: "Tank", shells: Iterable["Shell"] | None = Non
     return out
 
 
-def escape(tank: "Tank", shells: Sequence["Shell"], escapes: Sequence[tuple[float, float]] = ESCAPES,
+def escape(tank: "TankState", shells: Sequence["ShellSeen"], escapes: Sequence[tuple[float, float]] = ESCAPES,
            ) -> tuple[tuple[float, float], float]:
     """The (advance, strafe) that keeps the nearest of ``shells`` farthest outside the
     hull, and that clearance [m] (the worst over the shells).  Ties go to the earlier
@@ -181,53 +180,43 @@ def escape(tank: "Tank", shells: Sequence["Shell"], escapes: Sequence[tuple[floa
     return best, best_c
 
 
-def visible_shells(world: "World", tank: "Tank", half_angle: float, vision_range: float) -> list["Shell"]:
-    """The enemy shells in the tank's vision cone, within range and in line of sight
-    (what a player sees flying at them)."""
-    out = []
-    for sh in world.shells:
-        if sh.owner == tank.index or not sh.alive:
-            continue
-        dx, dz = sh.x - tank.x, sh.z - tank.z
-        d2 = dx * dx + dz * dz
-        if d2 > vision_range * vision_range:
-            continue
-        if d2 > 1e-12 and abs(math.remainder(math.atan2(dz, dx) - tank.heading, 2.0 * math.pi)) > half_angle:
-            continue
-        if world.line_blocked(tank.x, tank.z, sh.x, sh.z, world.eye(tank), sh.y):
-            continue
-        out.append(sh)
-    return out
+def moved(shell: "ShellSeen", dt: float) -> "ShellSeen":
+    """Where a shell (flying straight) is ``dt`` s later."""
+    return replace(shell, x=shell.x + shell.vx * dt, y=shell.y + shell.vy * dt, z=shell.z + shell.vz * dt)
 
 
 class Evasion:
-    """Dodging over time: a shell is noticed ``reaction`` s after it is first seen
-    (``visible`` shells passed to :meth:`command`); a noticed shell that would hit is
-    dodged with :func:`escape`, and the tank stays committed to dodging it until it
-    has passed (or is gone), so that it does not steer back into its path."""
+    """Dodging over time: a shell is noticed ``reaction`` s after it comes into view
+    (``visible`` shells passed to :meth:`command`, known by their ``key``); a noticed
+    shell that would hit is dodged with :func:`escape`, and the tank stays committed
+    to dodging it until it has passed (out of sight, where it is now is worked out
+    from where it was seen), so that it does not steer back into its path."""
 
     def __init__(self, reaction: float = 0.25, margin: float = 0.5) -> None:
         self.reaction = reaction
         self.margin = margin
-        self.first_seen: dict[int, float] = {}
-        self.committed: dict[int, "Shell"] = {}
+        self.first_seen: dict[tuple[int, int], float] = {}
+        self.committed: dict[tuple[int, int], tuple["ShellSeen", float]] = {}
         self.clearance = math.inf
 
-    def command(self, world: "World", tank: "Tank", visible: Sequence["Shell"]) -> tuple[float, float] | None:
-        """(advance, strafe) to dodge with now, or None: nothing to dodge."""
-        t = world.t
-        live = {id(s): s for s in world.shells if s.alive}
-        self.first_seen = {k: v for k, v in self.first_seen.items() if k in live}
-        self.committed = {k: s for k, s in self.committed.items() if k in live and arrival(tank, s)[0] > -0.05}
-        for s in visible:
-            self.first_seen.setdefault(id(s), t)
-        noticed = [live[k] for k, t0 in self.first_seen.items() if t - t0 >= self.reaction - 1e-9]
-        danger = {id(th.shell): th.shell for th in threats(world, tank, noticed, margin=self.margin)}
-        danger.update(self.committed)
+    def command(self, t: float, tank: "TankState", visible: Sequence["ShellSeen"]) -> tuple[float, float] | None:
+        """(advance, strafe) to dodge with at time ``t``, or None: nothing to dodge."""
+        vis = {s.key: s for s in visible}
+        self.first_seen = {k: t0 for k, t0 in self.first_seen.items() if k in vis}
+        for k in vis:
+            self.first_seen.setdefault(k, t)
+        committed = {}
+        for k, (s, ts) in self.committed.items():
+            now = vis.get(k) or moved(s, t - ts)
+            if arrival(tank, now)[0] > -0.05:
+                committed[k] = now
+        noticed = [vis[k] for k, t0 in self.first_seen.items() if t - t0 >= self.reaction - 1e-9]
+        danger = {th.shell.key: th.shell for th in threats(tank, noticed, margin=self.margin)}
+        danger.update(committed)
         if not danger:
-            self.clearance = math.inf
+            self.committed, self.clearance = {}, math.inf
             return None
         (a, s), c = escape(tank, list(danger.values()))
-        self.committed = danger
+        self.committed = {k: (sh, t) for k, sh in danger.items()}
         self.clearance = c
         return a, s

@@ -1,0 +1,350 @@
+"""The agent's states for fighting: Attack, Evade, Hunt, ReturnFire.
+
+* **Attack** (an enemy in sight and the reaction time over): turn onto the exact
+  intercept (``aim.intercept``; the fuzzy turn rules of ``fuzzy.AttackController``
+  turn the hull), fire when the shot's predicted miss is small
+  (``aim.predicted_miss``), hold the level's fighting distance, strafe at speed;
+  with ``cover`` and ``scoot``, back behind the corner it came round while it reloads.
+* **Evade** (hit twice within 4 s by an enemy it cannot see, or losing a fight):
+  drive to the nearest of a few sampled nodes out of the threat's line of sight, or,
+  with no cover near, strafe hard.  Done in cover or after ``EVADE_TIME`` s.
+* **Hunt** (``cover`` levels, an enemy seen standing still in the last
+  ``CAMP_MEMORY`` s): drive to the nearest place that sees it from the stand-off
+  distance, with room to strafe and out of the cone it faced, the gun on it where the
+  way comes into its sight.  Done when it is not there.
+* **ReturnFire** (hit by a tank it cannot see whose shot it heard from a place in its
+  line of sight): turn on the spot to face there, until facing it or for at most
+  ``RETURN_FIRE`` s; then it searches from there.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..commands import Command
+from . import aim as gun
+from .dodge import half_extent_at
+from .driving import trim
+from .machine import State
+from .perception import Sighting, wrap
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..bots import View
+    from .agent import Agent
+    from .perception import Percept
+
+#: hit by a tank it cannot see, shot heard in the open: turn to face it, for at most
+#: this long [s] (a half turn takes a light tank about 2.5 s from rest)
+RETURN_FIRE = 3.0
+#: fighting: strafe to a side with at least this much room [m]
+ROOM = 6.0
+#: ... the same side for a random time in this range [s] (a strafe takes about 5 s
+#: to reach full speed)
+FLIP = (4.0, 8.0)
+#: an enemy slower than this is standing still [m/s]
+STILL = 1.0
+#: it goes back to cover while the reload has more than SCOOT s to go [s]
+SCOOT = 0.4
+#: an enemy seen standing still is remembered there this long [s]; a way into its
+#: sight is driven at most this fast [m/s], gun on it
+CAMP_MEMORY = 90.0
+CAMP_SPEED = 7.0
+#: evading lasts at most this long [s]; then no new evasion for EVADE_COOLDOWN s
+EVADE_TIME = 5.0
+EVADE_COOLDOWN = 8.0
+#: a shot on relief may pass this far over or under the enemy's body [m] (its
+#: sphere tree is rounder than the box the test assumes)
+HEIGHT_TOLERANCE = 0.25
+
+
+def _eye(y: float | None) -> float | None:
+    """The eye height over a tank standing at ``y`` (None: not known)."""
+    from .navigation import EYE
+
+    return None if y is None else y + EYE
+
+
+class Attack(State["Agent"]):
+    """Fight the enemy in sight (see the module docstring)."""
+
+    name = "attack"
+
+    def __init__(self) -> None:
+        self.side = 1.0
+        self.flip_at = 0.0
+
+    def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
+        """Turn onto the intercept point, fire when the shot would hit, hold the level's
+        fighting distance, strafe at speed, flipping side every ``FLIP`` s and away from
+        walls: a tank that strafes can dodge by stopping (``Agent.evade_shells``)."""
+        s = p.sight
+        if s is None:
+            return None
+        lv, me = agent.level, view.me
+        rotate, fire, err = aim_and_fire(agent, view, s)
+        top = me.vehicle.top_speed
+        cover = cover_behind(agent, view, s) if lv.cover and lv.scoot and me.reload > SCOOT else None
+        if cover is not None:
+            # just fired: back behind the corner while the gun reloads, gun on the enemy
+            cmd = agent.approach(view, [cover], (s.x, s.z), 0.5 * top)
+            return Command(cmd.advance, cmd.rotate, cmd.strafe, fire)
+        d = max(math.hypot(s.x - me.x, s.z - me.z), 1e-6)
+        aligned = max(0.0, 1.0 - abs(err) / 0.6)
+        engage = lv.stand_off if math.hypot(s.vx, s.vz) < STILL else lv.engage
+        forward = max(-0.5 * top, min(0.5 * top, 0.4 * (d - engage))) * aligned
+        side, room = self.strafe_side(agent, view)
+        if forward < 0.0 and agent.free(view, me.heading + math.pi, 3.0 * ROOM, (0.0,)) < 2.0 * ROOM:
+            forward = 0.0                       # no backing into a wall or a corner
+        if room < ROOM:
+            forward = 0.5 * top * aligned       # boxed in across the line of fire: out, forwards
+        lateral = side * 0.5 * top * (0.4 + 0.6 * aligned)
+        return agent.drive(view, forward, lateral, rotate, fire)
+
+    def strafe_side(self, agent: "Agent", view: "View") -> tuple[float, float]:
+        """The side to strafe to (+1 right, -1 left) and the room [m] there: the same
+        side until a random flip every 4-8 s or until there is less than ``ROOM``
+        that way, then the side with more room."""
+        me = view.me
+        look = me.vehicle.radius + 2.0 * ROOM
+        room = {k: agent.free(view, me.heading + k * math.pi / 2, look, (0.0,)) - me.vehicle.radius
+                for k in (1.0, -1.0)}
+        if view.t >= self.flip_at:
+            self.flip_at = view.t + agent.rng.uniform(*FLIP)
+            if room[-self.side] >= ROOM:
+                self.side = -self.side
+        if room[self.side] < ROOM and room[-self.side] > room[self.side]:
+            self.side = -self.side
+        return self.side, room[self.side]
+
+
+def aim_and_fire(agent: "Agent", view: "View", s: Sighting) -> tuple[float, bool, float]:
+    """(turn command, fire, heading error) against a sighting.
+
+    The lead is the exact intercept (``aim.intercept``) of the velocity seen (the
+    level's ``lead`` share of it, relative to our own), off by the aim error drawn
+    after each shot; with ``hedge``, aimed between where the enemy goes on and where
+    it is if it stops ``hedge`` s after the shot (the stop that dodges).  The gun fires
+    when a shell leaving at the next chance to fire (the reload left, the hull still
+    turning) would pass within ``fire_tolerance`` of the enemy's half width of where it
+    aims -- not at an enemy under spawn protection until that ends before the shell
+    arrives, and on relief not when the shell would pass over or under it."""
+    lv, me, t = agent.level, view.me, view.t
+    v = me.vehicle.shell_speed
+    dx, dz = s.x - me.x, s.z - me.z
+    d = max(math.hypot(dx, dz), 1e-6)
+    tvx = me.vx + lv.lead * (s.vx - me.vx)
+    tvz = me.vz + lv.lead * (s.vz - me.vz)
+    sol = gun.intercept(me.x, me.z, me.vx, me.vz, s.x, s.z, tvx, tvz, v)
+    if sol is not None and lv.hedge > 0.0 and sol.time > lv.hedge:
+        # the enemy goes on (at sol.time) or stops (about hedge s after the shot): aim
+        # at the middle, which hits both while they lie within its width (its own
+        # velocity only: ours the shell keeps whatever the enemy does)
+        k = 0.5 * (sol.time + lv.hedge) / sol.time
+        tvx = me.vx + lv.lead * (k * s.vx - me.vx)
+        tvz = me.vz + lv.lead * (k * s.vz - me.vz)
+        sol = gun.intercept(me.x, me.z, me.vx, me.vz, s.x, s.z, tvx, tvz, v) or sol
+    heading = sol.heading if sol is not None else math.atan2(dz, dx)
+    err = wrap(heading + agent.aim_error - me.heading)
+    rotate = agent.turn(me, err)
+    fire = False
+    hesitant = lv.trigger > 0.0 and t - agent.fired_at < me.vehicle.fire_interval + lv.trigger
+    if me.reload <= agent.period and sol is not None and s.protected <= sol.time and not hesitant:
+        delay = max(me.reload, view.dt)
+        miss = gun.predicted_miss(me.x, me.z, me.vx, me.vz, me.heading - agent.aim_error, s.x, s.z,
+                                  tvx, tvz, v, delay, me.omega)
+        ev = s.vehicle if s.vehicle is not None else me.vehicle
+        fire = miss < lv.fire_tolerance * half_extent_at(ev, s.heading, heading)
+        if fire and view.map.relief:
+            # on relief the hull's pitch aims the gun up or down: hold fire when the
+            # shell would pass over or under the enemy
+            fire = gun.height_miss(me.eye, me.pitch, v, view.rules.shell_gravity, d, s.y,
+                                   ev.height) < HEIGHT_TOLERANCE
+    if fire:
+        agent.aim_error = agent.rng.gauss(0.0, lv.aim_noise)
+        agent.fired_at = t
+    return rotate, fire, err
+
+
+def cover_behind(agent: "Agent", view: "View", s: Sighting) -> tuple[float, float] | None:
+    """The latest place on our way here (the last ``memory.TRAIL`` s) that the enemy
+    cannot see, if it is 1.5-10 m away: the corner we came round."""
+    me = view.me
+    near = []
+    for _, x, z, y in reversed(agent.memory.trail):
+        d = math.hypot(x - me.x, z - me.z)
+        if d > 10.0:
+            break
+        if d > 1.5:
+            near.append((x, z, y))
+    # all the lines from the enemy at once (one array lookup on a ground)
+    for (x, z, _), hidden in zip(near, view.map.blocked_from(s.x, s.z, _eye(s.y), near)):
+        if hidden:
+            return x, z
+    return None
+
+
+class Evade(State["Agent"]):
+    """Get out of a threat's sight (see the module docstring); hands the threat on."""
+
+    name = "evade"
+
+    def __init__(self) -> None:
+        self.until = 0.0
+
+    def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
+        """``arg``: the threat, (x, z) or (x, z, height)."""
+        me = view.me
+        self.handoff = arg
+        self.until = view.t + EVADE_TIME
+        agent.path = []
+        cover = self._cover(agent, view, arg)
+        if cover is not None:
+            agent.path = view.map.path((me.x, me.z, me.y), cover, agent.nav.grid)
+
+    def exit(self, agent: "Agent", view: "View") -> None:
+        agent.memory.evade_cooldown = view.t + EVADE_COOLDOWN
+
+    def _cover(self, agent: "Agent", view: "View", threat: tuple[float, ...]) -> tuple[float, float] | None:
+        """The nearest of a few sampled nodes 5-25 m away that the threat (x, z and
+        maybe its height) cannot see."""
+        grid, me = agent.nav.grid, view.me
+        i, j = grid.node_of(me.x, me.z)
+        r = int(25.0 / grid.cell)
+        i0, j0 = max(i - r, 0), max(j - r, 0)
+        a, b = grid.valid[i0:i + r + 1, j0:j + r + 1].nonzero()
+        if len(a) == 0:
+            return None
+        best, best_d = None, math.inf
+        eye = _eye(threat[2] if len(threat) > 2 else None)
+        for _ in range(24):
+            m = agent.rng.randrange(len(a))
+            cx, cz = grid.centre(int(a[m]) + i0, int(b[m]) + j0)
+            d = math.hypot(cx - me.x, cz - me.z)
+            if 5.0 <= d < best_d and view.map.line_blocked(threat[0], threat[1], cx, cz, eye):
+                best, best_d = (cx, cz), d
+        return best
+
+    def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
+        me = view.me
+        if view.t >= self.until:
+            return None
+        trim(agent.path, me.x, me.z)
+        if agent.path:
+            if math.hypot(agent.path[-1][0] - me.x, agent.path[-1][1] - me.z) < 3.0:
+                return None
+            return agent.follow(view, agent.path, speed=1.0, lookahead=4.0, corner=agent.corner())
+        # no cover near: strafe hard across the threat's line, gun on it when seen
+        if p.sight is not None:
+            rotate, fire, _ = aim_and_fire(agent, view, p.sight)
+            side = agent.machine.states["attack"].side  # type: ignore[attr-defined]
+            return agent.drive(view, 0.0, side * 0.5 * me.vehicle.top_speed, rotate, fire)
+        return agent.follow(view, [], speed=0.0, lookahead=4.0)
+
+
+class ReturnFire(State["Agent"]):
+    """Turn to face a shot that hit it from out of sight; hands its place on."""
+
+    name = "return_fire"
+
+    def __init__(self) -> None:
+        self.face, self.until = 0.0, -math.inf
+
+    def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
+        """``arg``: the heard shot (``Heard``)."""
+        me = view.me
+        self.face = math.atan2(arg.z - me.z, arg.x - me.x)
+        self.until = view.t + RETURN_FIRE
+        self.handoff = (arg.x, arg.z, arg.y)
+
+    def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
+        me = view.me
+        err = wrap(self.face - me.heading)
+        if view.t >= self.until or abs(err) < 0.15:
+            return None
+        return agent.drive(view, 0.0, 0.0, agent.turn(me, err))
+
+
+class Hunt(State["Agent"]):
+    """Go for an enemy seen camping (see the module docstring)."""
+
+    name = "hunt"
+
+    def __init__(self) -> None:
+        self.camp: tuple[float, float] | None = None
+        self.replan = -math.inf
+        self._room: np.ndarray | None = None
+
+    def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
+        self.camp, self.replan = None, -math.inf
+
+    def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
+        """To the nearest place (by path) that sees the camp from ``stand_off`` +- 15 m
+        (the blocks' line-of-sight table), the gun on it where the way comes into its
+        sight.  There and not seeing it: it has gone, forget it.  None: no camp."""
+        t, me, mem = view.t, view.me, agent.memory
+        idx = agent.camp_known(t)
+        if idx is None:
+            return None
+        cx, cz, seen_t, face = mem.camps[idx]
+        if self.camp != (cx, cz) or t >= self.replan or not agent.path:
+            if not self._plan(agent, view, (cx, cz), face):
+                del mem.camps[idx]             # nowhere to see it from: give it up
+                return None
+        trim(agent.path, me.x, me.z)
+        end = agent.path[-1]
+        if math.hypot(end[0] - me.x, end[1] - me.z) < 3.0:
+            err = wrap(math.atan2(cz - me.z, cx - me.x) - me.heading)
+            if abs(err) < 0.3:
+                del mem.camps[idx]            # looking at where it was, and it is not there
+                return None
+            return agent.drive(view, 0.0, 0.0, agent.turn(me, err))
+        return agent.follow(view, agent.path, speed=1.0, lookahead=4.0, corner=agent.corner())
+
+    def _plan(self, agent: "Agent", view: "View", camp: tuple[float, float], face: float) -> bool:
+        """A path to the best place to see ``camp`` from (facing ``face``)."""
+        v, me, lv = agent.nav.views, view.me, agent.level
+        cx, cz = camp
+        cb, here = v.cell_at(cx, cz), v.cell_at(me.x, me.z, me.y)
+        if cb < 0 or here < 0:
+            return False
+        lo, hi = lv.stand_off - 15.0, min(lv.stand_off + 15.0, agent.senses.vision_range)
+        dist = v.distance[cb]
+        pd = v.path_distances(here)
+        sees = v.visible[cb] & np.isfinite(pd)
+        ok = sees & (dist >= lo) & (dist <= hi)
+        if not ok.any():
+            ok = sees & (dist <= hi)
+        if not ok.any():
+            return False
+        # nearest by path; a place with room to strafe (ROOM each way) counts as much
+        # nearer as a tank drives in 2 s, and one outside the cone it faced (it does not
+        # see us come: first shots are ours) as much nearer as a tank drives in 4 s
+        roomy = self._block_room(agent) >= ROOM
+        pts = v.points
+        off = np.abs(np.remainder(np.arctan2(pts[:, 1] - cz, pts[:, 0] - cx) - face + np.pi, 2 * np.pi) - np.pi)
+        unseen = off > agent.senses.half_angle + 0.2
+        top = me.vehicle.top_speed
+        score = pd - np.where(roomy, 2.0 * top, 0.0) - np.where(unseen, 4.0 * top, 0.0)
+        b = int(np.argmin(np.where(ok, score, np.inf)))
+        self.camp, self.replan = camp, view.t + 5.0
+        agent.path = view.map.path((me.x, me.z, me.y), (float(pts[b][0]), float(pts[b][1]), float(v.heights[b])),
+                                   agent.nav.grid)
+        return bool(agent.path)
+
+    def _block_room(self, agent: "Agent") -> np.ndarray:
+        """Per block of the sight table: the free space around its representative node
+        beyond the grid's clearance [m] (the distance to the nearest invalid node)."""
+        if self._room is None:
+            from scipy.ndimage import distance_transform_edt
+
+            g = agent.nav.grid
+            valid = np.asarray(g.layers.valid if g.layers is not None else g.valid, dtype=bool)
+            if valid.ndim == 3:   # a layered grid: each level's own free space
+                free = np.stack([distance_transform_edt(m) for m in valid]) * g.cell
+            else:
+                free = distance_transform_edt(valid) * g.cell
+            self._room = np.array([free[tuple(n)] for n in agent.nav.views.nodes])
+        return self._room

@@ -1,0 +1,81 @@
+"""How good an agent is: the difficulty levels (easy, normal, hard).
+
+A level sets what the agent perceives (vision range, hearing radius, engine hearing:
+its ``Senses``), how fast it reacts and thinks, how well it aims and dodges, and how
+it fights (distance, cover, hedging against a dodge).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ..bots import Senses
+
+@dataclass(frozen=True)
+class Difficulty:
+    """How good an agent is.  Times in seconds, angles in radians, distances in metres."""
+
+    name: str
+    reaction: float
+    aim_noise: float
+    vision_range: float
+    hearing_radius: float
+    think_hz: float
+    engine_radius: float = 0.0
+    #: how much of the intercept lead it takes (0: aims at where the enemy is)
+    lead: float = 1.0
+    #: fires when a shot now would pass within this fraction of the enemy's half width
+    fire_tolerance: float = 0.6
+    #: notices a shell flying at it this long after it comes into view (inf: never dodges)
+    dodge_reaction: float = math.inf
+    #: the distance it fights at when it can choose [m]
+    engage: float = 30.0
+    #: and against an enemy standing still (it cannot dodge; we can, from afar) [m]
+    stand_off: float = 30.0
+    #: aims between where the enemy goes on and where it is if it stops this long after
+    #: the shot (the stop that dodges); 0: the plain intercept [s]
+    hedge: float = 0.0
+    #: waits this long after its gun is loaded before it fires again (a newcomer's
+    #: hesitation) [s]
+    trigger: float = 0.0
+    #: explores for what it has not seen (else: the paper's wander heuristic only)
+    explore: bool = True
+    #: holds vantage points and, leading, hiding places (``Agent(watch=...)`` too)
+    watch: bool = True
+    #: fights like a player who knows cover: closes in on a known enemy with the gun
+    #: on it, goes back behind the corner it came from while reloading (``scoot``), and breaks off
+    #: a fight it is losing
+    cover: bool = False
+    #: with ``cover``: goes back behind the corner it came round while it reloads
+    #: (False: keeps strafing.  A strafe builds up at about 1.5 m/s^2, so a tank that
+    #: shuttles to cover hardly moves across the line of fire: hard's median sideways
+    #: speed in its fights with the camper in the box was 0.5 m/s with it, 1.5 without)
+    scoot: bool = True
+
+    def senses(self, half_angle: float = math.radians(60.0)) -> Senses:
+        """What an agent of this level perceives."""
+        return Senses(half_angle, self.vision_range, self.hearing_radius, self.engine_radius)
+
+
+DIFFICULTIES: dict[str, Difficulty] = {
+    "easy": Difficulty("easy", reaction=1.0, aim_noise=math.radians(9.0), vision_range=60.0,
+                       hearing_radius=80.0, think_hz=8.0, engine_radius=40.0, lead=0.3, fire_tolerance=1.2,
+                       dodge_reaction=math.inf, engage=25.0, stand_off=25.0, watch=False, trigger=1.6),
+    "normal": Difficulty("normal", reaction=0.3, aim_noise=math.radians(1.5), vision_range=90.0,
+                         hearing_radius=80.0, think_hz=15.0, engine_radius=35.0, lead=1.0, fire_tolerance=0.7,
+                         dodge_reaction=0.45, engage=40.0, stand_off=45.0, cover=True),
+    "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.3), vision_range=130.0,
+                       hearing_radius=120.0, think_hz=20.0, engine_radius=40.0, lead=1.0, fire_tolerance=0.5,
+                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, scoot=False),
+}
+
+
+def difficulty(name: str | Difficulty) -> Difficulty:
+    """A difficulty by name (easy, normal, hard)."""
+    if isinstance(name, Difficulty):
+        return name
+    try:
+        return DIFFICULTIES[name]
+    except KeyError:
+        raise ValueError(f"difficulty must be one of {', '.join(DIFFICULTIES)}, got {name!r}") from None
