@@ -22,6 +22,7 @@ import numpy as np
 from . import __version__
 from .errors import ArenaError
 from .formats.walls_txt import WallList
+from .formats.limits import MAX_COORDINATE
 
 #: defaults of the [navgrid] table until build-navgrid rewrites it
 NAVGRID_DEFAULTS = {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
@@ -76,6 +77,18 @@ def _table(doc: dict[str, Any], key: str, manifest: Path) -> dict[str, Any]:
     return t
 
 
+def _within_limits(spawns: np.ndarray, manifest: Path) -> None:
+    """Refuse a spawn point whose coordinate is finite but absurd (±1e308 overflowed
+    the grid's index arithmetic in check and play): name the spawn and the field."""
+    far = np.abs(spawns[:, [0, 1] + ([3] if spawns.shape[1] == 4 else [])]) > MAX_COORDINATE
+    headings = np.abs(spawns[:, 2]) > 1e3  # radians; a larger turn is a mistake
+    bad = np.flatnonzero(far.any(axis=1) | headings)
+    if len(bad):
+        k = int(bad[0])
+        raise ArenaError(f"{manifest}: spawns[{k}] = {spawns[k].tolist()}: a coordinate beyond "
+                         f"{MAX_COORDINATE:g} m from the origin or a heading beyond 1000 rad (the limits of an arena)")
+
+
 def load_arena(path: str | os.PathLike) -> ArenaBundle:
     """Read an arena bundle folder (or its ``arena.toml``) the way ``play`` uses it.
 
@@ -117,6 +130,7 @@ def load_arena(path: str | os.PathLike) -> ArenaBundle:
         raise ArenaError(f"{manifest}: 'spawns' must be a list of at most {MAX_SPAWNS} [x, z, heading] or "
                          f"[x, z, heading, y] lists of finite numbers, all of one length")
     spawns = np.array(raw, dtype=np.float64).reshape(-1, width)
+    _within_limits(spawns, manifest)
     raw_bounds = doc.get("bounds")
     if raw_bounds is None:
         bounds = walls.bounds
@@ -125,6 +139,9 @@ def load_arena(path: str | os.PathLike) -> ArenaBundle:
                 or not all(isinstance(c, list) and len(c) == 2 and all(_finite(v) for v in c) for c in raw_bounds)):
             raise ArenaError(f"{manifest}: 'bounds' must be [[xmin, zmin], [xmax, zmax]] of finite numbers")
         bounds = np.array(raw_bounds, dtype=np.float64)
+        if np.abs(bounds).max() > MAX_COORDINATE:
+            raise ArenaError(f"{manifest}: 'bounds' {raw_bounds} lie beyond {MAX_COORDINATE:g} m from the origin "
+                             f"(the limit of an arena coordinate)")
         if not (bounds[1] > bounds[0]).all():
             raise ArenaError(f"{manifest}: 'bounds' must have xmin < xmax and zmin < zmax")
     floor_y = doc.get("floor_y", 0.0)

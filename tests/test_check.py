@@ -273,7 +273,7 @@ def test_spawns_keep_their_manifest_index_when_one_is_malformed(tmp_path):
     head, rest = text.split("spawns = [\n", 1)
     toml.write_text(head + 'spawns = [\n    "not a spawn",\n' + rest)
     codes = sorted((d.code, d.message.split(" at ")[0]) for d in run_check([arena]).diagnostics)
-    assert codes == [("A302", "spawn 9"), ("B102", "spawn 0 must be [x, z, heading_rad] or [x, z, heading_rad, y] with finite numbers, got 'not a spawn'")]
+    assert codes == [("A302", "spawn 9"), ("B102", "spawn 0 must be [x, z, heading_rad] or [x, z, heading_rad, y] with finite numbers (coordinates within 1e+06 m of the origin), got 'not a spawn'")]
 
 
 def test_a_spawn_behind_a_narrow_door_is_unreachable(tmp_path):

@@ -197,3 +197,40 @@ def test_game_session_replays_to_the_recorded_state_and_screenshots(box, tmp_pat
     assert f"top view of {tape} at frame 180 of 180: {shot}" in res.output and shot.stat().st_size > 1000
     res = run(cli, ["play", "--replay", str(tape), "--headless", "--screenshot", str(shot), "--frames", "181"])
     assert res.exit_code == 2 and "the recording has 180 frames" in res.output
+
+
+def _with_header(data: bytes, head: dict) -> bytes:
+    hlen = struct.unpack_from("<I", data, 5)[0]
+    h = json.dumps(head).encode()
+    return data[:5] + struct.pack("<I", len(h)) + h + data[9 + hlen:]
+
+
+def test_every_required_header_field_is_checked_at_read(recorded, tmp_path):
+    """A header without 'seconds' was read and then killed play with a KeyError (issue 26)."""
+    from tanktool.sim.replay import HEADER_FIELDS
+
+    _, replay = recorded
+    data = encode(replay)
+    hlen = struct.unpack_from("<I", data, 5)[0]
+    for key in HEADER_FIELDS:
+        head = json.loads(data[9:9 + hlen])
+        del head[key]
+        _bad(_with_header(data, head), tmp_path, f"lacks {key}")
+
+
+def test_cli_replay_without_seconds_is_one_error_line(recorded, tmp_path):
+    from click.testing import CliRunner
+
+    from tanktool.cli.main import cli
+
+    _, replay = recorded
+    data = encode(replay)
+    hlen = struct.unpack_from("<I", data, 5)[0]
+    head = json.loads(data[9:9 + hlen])
+    del head["seconds"]
+    tape = tmp_path / "noseconds.ttr"
+    tape.write_bytes(_with_header(data, head))
+    res = CliRunner().invoke(cli, ["play", "--replay", str(tape)])
+    assert res.exit_code == 2, res.output
+    assert "noseconds.ttr: byte 9: replay header lacks seconds" in res.output
+    assert "internal error" not in res.output and "Traceback" not in res.output

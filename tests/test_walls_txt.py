@@ -58,6 +58,7 @@ def test_last_four_not_rectangle_means_no_aux():
     ("0 0 1 1\n", ":1:", "expected 5 fields"),
     ("0 0 1 1 1\n0 0 a 1 1\n", ":2:", "expected numbers"),
     ("0 0 1 nan 1\n", ":1:", "finite"),
+    ("0 0 1 1 1\n0 0 -1e308 1 1\n", ":2:", "within 1e+06 m"),
     ("0 0 1 1 2\n", ":1:", "Direction must be +1 or -1"),
     ("0 0 1 1 x\n", ":1:", "Direction must be +1 or -1"),
     ("0 0 1 1 1\n# auxiliary\n0 0 1 0 1\n", "", "expected 4 auxiliary walls"),

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 import shapely
 
+from ..formats.limits import MAX_COORDINATE
 from ..formats.walls_txt import WallList
 from ..geometry.hull import min_width
 from .diagnostics import Diagnostic, diag, fmt_xz
@@ -98,11 +99,12 @@ def _spawns(man: Manifest, out: list[Diagnostic]) -> tuple[np.ndarray, list[int]
     rows, keep, ids = [], [], []
     for i, s in enumerate(raw):
         ok = (isinstance(s, list) and len(s) in (3, 4)
-              and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in s))
+              and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in s)
+              and all(abs(v) <= (1e3 if k == 2 else MAX_COORDINATE) for k, v in enumerate(s)))
         if not ok:
             out.append(diag("B102", str(man.path), lines[i],
-                            f"spawn {i} must be [x, z, heading_rad] or [x, z, heading_rad, y] with finite numbers, "
-                            f"got {s!r}"))
+                            f"spawn {i} must be [x, z, heading_rad] or [x, z, heading_rad, y] with finite numbers "
+                            f"(coordinates within {MAX_COORDINATE:g} m of the origin), got {s!r:.80}"))
             continue
         rows.append([float(v) for v in s] + ([math.nan] if len(s) == 3 else []))
         keep.append(lines[i])

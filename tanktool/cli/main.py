@@ -43,6 +43,22 @@ class UserError(click.ClickException):
         click.echo(f"error: {' '.join(self.format_message().split())}", err=True)
 
 
+class OneLineUsageError(click.UsageError):
+    """click's usage error (a bad option value, an unknown option or command) in the
+    same one-line form as every other error: ``error: <what> (see `<command> --help`)``,
+    exit status 2.  click's own form is four lines (usage, hint, blank, message)."""
+
+    def show(self, file=None) -> None:
+        where = f" (see `{self.ctx.command_path} --help`)" if self.ctx is not None else ""
+        click.echo(f"error: {' '.join(self.format_message().split())}{where}", err=True)
+
+
+def _one_line(e: click.UsageError) -> OneLineUsageError:
+    one = OneLineUsageError(e.format_message(), e.ctx)
+    one.exit_code = e.exit_code
+    return one
+
+
 def _set_output(ctx: click.Context, verbose: int, quiet: bool) -> None:
     """Record -v/-q in the root context's dict (where :func:`is_quiet` and the error
     handler look) and set the logging level from them."""
@@ -82,9 +98,21 @@ def _add_output_options(cmd: click.Command) -> click.Command:
 
 
 class LazyGroup(click.Group):
+    def make_context(self, info_name, args, parent=None, **extra) -> click.Context:
+        try:  # the group's own options (``tanktool --bogus``)
+            return super().make_context(info_name, args, parent=parent, **extra)
+        except OneLineUsageError:
+            raise
+        except click.UsageError as e:
+            raise _one_line(e) from e
+
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
+        except OneLineUsageError:
+            raise
+        except click.UsageError as e:  # a sub-command's options, or no such command
+            raise _one_line(e) from e
         except TanktoolError as e:
             if ctx.obj and ctx.obj.get("verbose"):
                 traceback.print_exc()

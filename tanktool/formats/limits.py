@@ -32,6 +32,10 @@ MERGE_OBJECTS = 64
 #: a model's extent after --scale, metres: beyond these it is a unit mistake
 MAX_EXTENT = 1.0e5
 MIN_EXTENT = 1.0e-3
+#: one coordinate of a wall, a spawn or the bounds of an arena, metres from the
+#: origin: a plan may sit far from its origin, but not so far that a grid index
+#: (coordinate / cell) overflows or a float loses the centimetres
+MAX_COORDINATE = 1.0e6
 #: the arrays of one .npz file (navgrid, quadtree), decompressed
 MAX_NPZ_BYTES = 1024 * MiB
 #: a bundle file hashed or copied by the tools

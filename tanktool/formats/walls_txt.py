@@ -30,6 +30,7 @@ import numpy as np
 
 from ..errors import FormatError
 from .bundle import atomic_write_text, read_input_text
+from .limits import MAX_COORDINATE
 
 AUX_MARKER = "# auxiliary"
 LEVEL_MARKER = "# level"
@@ -189,6 +190,9 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
             raise FormatError(f"{path}:{lineno}: expected numbers, got {' '.join(body[:4])!r}") from None
         if not all(math.isfinite(v) for v in vals):
             raise FormatError(f"{path}:{lineno}: coordinates must be finite, got {' '.join(body[:4])}")
+        if max(abs(v) for v in vals) > MAX_COORDINATE:
+            raise FormatError(f"{path}:{lineno}: coordinates must lie within {MAX_COORDINATE:g} m of the origin, "
+                              f"got {' '.join(body[:4])}")
         try:
             d = float(body[4])
         except ValueError:

@@ -257,6 +257,8 @@ MAX_BOTS = 64
 MAX_INFLATION = 64
 MAX_REPLAY_BYTES = 256 << 20
 DT_RANGE = (1e-4, 1.0)
+#: the header fields every replay has (match_header writes them; playback reads them)
+HEADER_FIELDS = ("bots", "steps", "seconds", "seed", "dt", "integrator", "rng_state", "changes", "final_state")
 #: keys of ``options`` that run_match takes, and the values each may have
 _OPTION_VALUES = {"bot": ("agent", "scripted"), "difficulty": ("easy", "normal", "hard")}
 #: the match end's options: (exclusive low, high, whole number), as ``play`` accepts them
@@ -289,7 +291,7 @@ def check_header(header: dict[str, Any], where: str) -> None:
     steps = header["steps"]
     if not (_is_int(steps) and 1 <= steps and steps * dt <= MAX_SECONDS):
         raise bad("steps", f"must be a count of steps of at most {MAX_SECONDS:g} s of simulated time")
-    seconds = header.get("seconds", steps * dt)
+    seconds = header["seconds"]  # play reads it: required (decode checks it is there)
     if not (_is_number(seconds) and 0 < seconds <= MAX_SECONDS and int(round(seconds / dt)) == steps):
         raise bad("seconds", f"must be {steps} steps x dt {dt:g} s")
     if not (_is_int(header["seed"]) and abs(header["seed"]) < 2 ** 64):
@@ -364,8 +366,7 @@ def decode(data: bytes, path: str | os.PathLike = "<replay>") -> Replay:
         raise FormatError(f"{path}: byte {start}: replay header must be a JSON object")
     if nesting_depth(header) > MAX_DEPTH:
         raise FormatError(f"{path}: byte {start}: replay header is nested deeper than {MAX_DEPTH} levels")
-    need = ("bots", "steps", "seed", "dt", "integrator", "rng_state", "changes", "final_state")
-    missing = [k for k in need if k not in header]
+    missing = [k for k in HEADER_FIELDS if k not in header]
     if missing:
         raise FormatError(f"{path}: byte {start}: replay header lacks {', '.join(missing)}")
     check_header(header, f"{path}: byte {start}")
@@ -506,7 +507,7 @@ def play_replay(replay: Replay, arena: "ArenaInfo", spec: "TankSpec",
                             f"(its walls, spawns or bounds differ)")
     if h.get("vehicle_sha256") and spec_fingerprint(spec) != h["vehicle_sha256"]:
         raise TanktoolError(f"vehicle {spec.name!r} is not the one the replay was recorded with")
-    seconds = float(h.get("seconds", int(h["steps"]) * float(h["dt"])))
+    seconds = float(h["seconds"])
     dt = float(h["dt"])
     if int(round(seconds / dt)) != int(h["steps"]) or not math.isfinite(seconds):
         raise TanktoolError(f"replay header: seconds {seconds} and dt {dt} do not give {h['steps']} steps")

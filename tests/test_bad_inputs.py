@@ -1,0 +1,97 @@
+"""Issue 26: every wrong input gets one clear ``error:`` line naming the file and the
+place, exit status 2, never a traceback nor an internal error."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from tanktool.cli.main import cli
+from tanktool.errors import TanktoolError
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(*args: str):
+    return CliRunner().invoke(cli, list(args), prog_name="tanktool")
+
+
+def one_error_line(res, *needles: str) -> str:
+    """The result is exit 2 with exactly one ``error:`` line holding every needle."""
+    assert res.exit_code == 2, res.output
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    errors = [ln for ln in lines if ln.startswith("error: ")]
+    assert len(errors) == 1, res.output
+    assert "Traceback" not in res.output and "internal error" not in res.output, res.output
+    assert "Usage:" not in res.output, res.output
+    for n in needles:
+        assert n in errors[0], errors[0]
+    return errors[0]
+
+
+@pytest.fixture
+def box_copy(tmp_path) -> Path:
+    target = tmp_path / "box"
+    shutil.copytree(ROOT / "arenas" / "box", target)
+    return target
+
+
+# ----------------------------------------------------------------- coordinates beyond the limits
+
+@pytest.mark.parametrize("value", ["1e308", "-1e308"])
+def test_a_far_spawn_is_refused_at_load_naming_the_spawn(box_copy, value):
+    from tanktool.arena import load_arena
+
+    toml = box_copy / "arena.toml"
+    toml.write_text(toml.read_text().replace("[6.142, 6.142, 0.785398]", f"[{value}, 6.142, 0.785398]"))
+    with pytest.raises(TanktoolError, match=r"arena.toml: spawns\[1\] .*beyond 1e\+06 m"):
+        load_arena(box_copy)
+    one_error_line(run("play", "--headless", "--arena", str(box_copy), "--seconds", "1"), "arena.toml: spawns[1]")
+    res = run("check", str(box_copy))
+    assert "X001" not in res.output and "internal error" not in res.output, res.output
+    assert "B102" in res.output and "spawn 1 must be" in res.output, res.output
+
+
+def test_far_bounds_are_refused(box_copy):
+    from tanktool.arena import load_arena
+
+    toml = box_copy / "arena.toml"
+    toml.write_text(toml.read_text().replace("[60.0, 60.0]", "[1e308, 60.0]"))
+    with pytest.raises(TanktoolError, match="arena.toml: 'bounds'.*beyond"):
+        load_arena(box_copy)
+
+
+def test_a_far_wall_is_refused_with_its_line(box_copy):
+    walls = box_copy / "walls.txt"
+    lines = walls.read_text().splitlines()
+    k = next(i for i, ln in enumerate(lines) if ln.strip() and not ln.startswith("#"))
+    lines[k] = "0 0 1e308 0 1"
+    walls.write_text("\n".join(lines) + "\n")
+    one_error_line(run("play", "--headless", "--arena", str(box_copy), "--seconds", "1"),
+                   f"walls.txt:{k + 1}:", "within 1e+06 m")
+
+
+# ----------------------------------------------------------------- usage errors: the README's promise
+
+def test_readme_promises_one_error_line():
+    text = (ROOT / "README.md").read_text()
+    assert "one `error:` line" in text
+
+
+@pytest.mark.parametrize("args, needle", [
+    (["play", "--headless", "--size", "abc"], "--size"),
+    (["play", "--headless", "--bots", "0"], "--bots"),
+    (["play", "--frames", "1", "--screenshot", "DIR"], "--screenshot"),
+    (["play", "--no-such-option"], "--no-such-option"),
+    (["no-such-command"], "no-such-command"),
+    (["--bogus"], "--bogus"),
+])
+def test_usage_errors_are_one_error_line(args, needle, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "DIR").mkdir()
+    line = one_error_line(run(*args), needle)
+    assert re.search(r"see `tanktool( play)? --help`", line), line
