@@ -88,7 +88,8 @@ def test_encode_decode_round_trip_keeps_every_bit():
             (7, 0, Command(1.0, 0.0, 0.1 + 0.2, True)), (9, 1, Command(-1.0, 1e-300, -0.5))]
     for step, tank, c in cmds:
         rec.record(step, tank, c)
-    replay = rec.replay({"bots": 2, "steps": 10, "seed": 3, "dt": 0.01, "integrator": "euler", "final_state": "x"})
+    replay = rec.replay({"bots": 2, "steps": 10, "seconds": 0.1, "seed": 3, "dt": 0.01, "integrator": "euler",
+                         "final_state": "x"})
     # -0.0 -> 0.0 is a change (different bits); an identical command is not
     assert len(replay) == 3 and list(replay.steps) == [0, 0, 7]
     back = decode(encode(replay))
