@@ -9,7 +9,7 @@ STAMP  := $(VENV)/.installed
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[test,bench]'
+	$(BIN)/python -m pip install --quiet -e '.[test,bench,rl,cluster]'
 	touch $(STAMP)
 	@echo "installed in $(VENV)/: run $(BIN)/tanktool, or 'source $(BIN)/activate' to put tanktool on the PATH"
 

@@ -28,6 +28,7 @@ COMMANDS = {
     "build-navgrid": ("tanktool.cli.build_navgrid", "build_navgrid", "Build an arena's wall quadtree and AI navigation grid, and plot them."),
     "check": ("tanktool.cli.check", "check", "Validate arena and vehicle bundles like a linter."),
     "play": ("tanktool.cli.play", "play", "Play a match (window, or --headless for scripted matches)."),
+    "tournament": ("tanktool.cli.tournament", "tournament", "Play bots against each other: round robin, Elo, replays; local cores or Ray."),
 }
 
 

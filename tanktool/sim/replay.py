@@ -180,6 +180,12 @@ class _RecordingDriver:
         self.recorder.record(world.steps, self.index, IDLE if cmd is None else cmd)
         return cmd
 
+    @property
+    def stats(self) -> Any:
+        """The wrapped bot's ``BotStats`` (None for other drivers): a recorded match
+        reports its bots' failures and timing as an unrecorded one does."""
+        return getattr(self.inner, "stats", None)
+
 
 @dataclass
 class Recorder:
