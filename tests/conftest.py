@@ -34,9 +34,11 @@ def make_app(tmp_path, monkeypatch):
     pygame.font.init()
     apps = []
 
-    def make(size=(320, 240), **kw):
+    from app_helpers import match_config
+
+    def make(size=(320, 240), settings_file=None, **kw):
         presenter = Presenter(size, fullscreen=False, want_gl=False)
-        a = App(presenter, arena="box", view="top", size=size, sound=False, **kw)
+        a = App(presenter, match_config(size=size, **kw), settings_file=settings_file)
         apps.append(a)
         return a
 

@@ -4,7 +4,7 @@ menu, remap screen, fixed-timestep play, pause, restart, quit; and the fallback 
 
 import pygame
 import pytest
-from app_helpers import goto, key, press
+from app_helpers import goto, key, match_config, press
 from click.testing import CliRunner
 
 from tanktool.cli.main import cli
@@ -112,18 +112,18 @@ def test_remap_screen_saves_and_survives_restart(app, tmp_path):
     goto(app, "bindings")
     press(app, pygame.K_RETURN)
     assert app.state == "remap"
-    while app.remap_cursor != 6:           # FIRE
+    while app.remap.cursor != 6:           # FIRE
         press(app, pygame.K_DOWN)
     press(app, pygame.K_RETURN)
-    assert app.remap_waiting
+    assert app.remap.waiting
     app.frame(0.016)                       # "press the button for FIRE"
     app.handle(pygame.event.Event(pygame.JOYBUTTONDOWN, instance_id=0, joy=0, button=2))
-    assert not app.remap_waiting and "FIRE" in app.notice
+    assert not app.remap.waiting and "FIRE" in app.notice
     assert load_bindings().actions["fire"] == ["joybutton:2"]
     press(app, pygame.K_ESCAPE)
     assert app.state == "menu"
     # a new App (a restart of the game) reads the saved bindings
-    again = App(app.presenter, arena="box", bots=1, view="top", size=(480, 320), sound=False)
+    again = App(app.presenter, match_config(bots=1, size=(480, 320)))
     assert again.input.bindings.actions["fire"] == ["joybutton:2"]
 
 
@@ -131,7 +131,7 @@ def test_no_display_is_a_clear_fallback(tmp_path, monkeypatch):
     monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
     assert display_problem() == "SDL_VIDEODRIVER=dummy"
     with pytest.raises(NoDisplay):
-        run_window()
+        run_window(match_config())
     pic = tmp_path / "m.png"
     r = CliRunner().invoke(cli, ["play", "--arena", "box", "--seconds", "1", "--picture", str(pic)])
     assert r.exit_code == 0, r.output
@@ -165,11 +165,11 @@ def test_remap_on_an_unwritable_config_folder_says_so_and_goes_on(app, tmp_path,
     monkeypatch.setenv("XDG_CONFIG_HOME", str(blocker / "cfg"))
     goto(app, "bindings")
     press(app, pygame.K_RETURN)
-    while app.remap_cursor != 6:           # FIRE
+    while app.remap.cursor != 6:           # FIRE
         press(app, pygame.K_DOWN)
     press(app, pygame.K_RETURN)
     app.handle(pygame.event.Event(pygame.JOYBUTTONDOWN, instance_id=0, joy=0, button=3))
-    assert app.state == "remap" and not app.remap_waiting
+    assert app.state == "remap" and not app.remap.waiting
     assert app.input.bindings.actions["fire"] == ["joybutton:3"]       # in use until the game ends
     assert "not saved" in app.notice and str(blocker) in app.notice and "\n" not in app.notice, app.notice
     app.frame(0.016)                       # the remap screen draws the notice

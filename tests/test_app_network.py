@@ -22,11 +22,11 @@ DEADLINE = 60.0
 def type_address(app, text):
     goto(app, "address")
     press(app, pygame.K_RETURN)              # Enter: type into the field
-    assert app.editing and app.menu.address == ""
+    assert app.menu.editing and app.menu.address == ""
     for ch in text:
         press(app, pygame.K_UNKNOWN, ch)
     press(app, pygame.K_RETURN)
-    assert not app.editing and app.menu.address == text
+    assert not app.menu.editing and app.menu.address == text
 
 
 @pytest.fixture
@@ -179,12 +179,12 @@ def test_menu_password_field_is_masked_and_used(app):
 
     goto(app, "password")
     press(app, pygame.K_RETURN)
-    assert app.editing and app.field == "password"
+    assert app.menu.editing and app.menu.field == "password"
     for ch in "S3cr et!":                      # any printable character, upper case too
         press(app, pygame.K_UNKNOWN, ch)
     press(app, pygame.K_BACKSPACE)
     press(app, pygame.K_RETURN)
-    assert not app.editing and app.menu.password == "S3cr et" and app.password == "S3cr et"
+    assert not app.menu.editing and app.menu.password == "S3cr et" and app.password == "S3cr et"
     app.frame(0.016)                           # drawn as stars (never the text)
     goto(app, "network")
     press(app, pygame.K_RIGHT)                 # host

@@ -140,7 +140,7 @@ def test_replay_in_the_window(window, tmp_path):
     press(app, pygame.K_p)
     press(app, pygame.K_F1)
     press(app, pygame.K_TAB)
-    assert app.session.focus() == 1 and "bot1" in app.notice
+    assert app.session.focus() == 1 and "bot1" in app.match_notice
     drive(app, [((), 400)])                    # past the end: it stops there
     assert app.replay_done and "bit for bit" in app.notice
     assert app.session.world.steps == tape.header["steps"] and repr(app.session.world.snapshot()) == final

@@ -6,7 +6,7 @@ import ctypes.util
 import numpy as np
 import pygame
 import pytest
-from app_helpers import goto, press
+from app_helpers import goto, match_config, press
 
 from tanktool.game.quality import load_settings
 
@@ -17,7 +17,7 @@ def mouse(kind, pos, button=1):
 
 def centre_of(app, item):
     i = app.menu.ITEMS.index(item)
-    return dict(app.menu_hits)[i]
+    return dict(app.menu.hits)[i]
 
 
 def test_mouse_points_clicks_and_turns(make_app):
@@ -42,14 +42,14 @@ def test_name_field_typed_and_saved(make_app):
     app = make_app((480, 320), bots=1)
     goto(app, "name")
     press(app, pygame.K_RETURN)
-    assert app.editing and app.field == "name"
+    assert app.menu.editing and app.menu.field == "name"
     for ch in "al ice!":                              # a space and "!" are not name characters
         press(app, pygame.K_a, uni=ch)
     app.frame(0.016)
     press(app, pygame.K_RETURN)
-    assert not app.editing and app.menu.name == "alice" and app.player_name == "alice"
+    assert not app.menu.editing and app.menu.name == "alice" and app.player_name == "alice"
     assert load_settings().name == "alice"            # remembered for the next start
-    again = type(app)(app.presenter, arena="box", bots=1, view="top", size=(480, 320), sound=False)
+    again = type(app)(app.presenter, match_config(bots=1, size=(480, 320)))
     assert again.player_name == "alice"
 
 
@@ -68,10 +68,10 @@ def test_settings_page_changes_quality_and_saves(make_app):
     assert saved.quality == "high" and saved.shadows == "off"
     app.frame(0.016)
     # the mouse on the settings page: "back"
-    app.handle(mouse(pygame.MOUSEBUTTONDOWN, dict(app.menu_hits)[5].center))
+    app.handle(mouse(pygame.MOUSEBUTTONDOWN, dict(app.menu.hits)[5].center))
     assert app.state == "menu"
     # a later start reads them
-    again = type(app)(app.presenter, arena="box", bots=1, view="top", size=(480, 320), sound=False)
+    again = type(app)(app.presenter, match_config(bots=1, size=(480, 320)))
     assert again.quality.shadows == "off" and again.quality.particles == "high"
 
 
@@ -91,9 +91,9 @@ def test_previews_are_rendered_and_clickable(make_app):
     app = make_app((800, 450), bots=1)
     app.frame(0.016)                                  # the first frame shows the menu at once
     app.frame(0.016)                                  # the next renders the previews
-    kinds = [k for k, _ in app.preview_hits]
+    kinds = [k for k, _ in app.menu.preview_hits]
     assert kinds == ["arenas", "vehicles"]
-    rect = dict(app.preview_hits)["arenas"]
+    rect = dict(app.menu.preview_hits)["arenas"]
     pix = pygame.surfarray.array3d(app.presenter.canvas.subsurface(rect)).astype(int)
     assert pix.std() > 15                              # a picture, not a card
     before = app.menu.arena.value

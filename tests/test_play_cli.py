@@ -112,3 +112,24 @@ def test_seconds_is_never_silently_ignored(tmp_path, monkeypatch):
     assert r.exit_code == 0, r.output
     assert "warning: --seconds 5 ignored: a replay lasts as long as its recording" in r.output
     assert "120 steps" in r.output and "bit for bit" in r.output
+
+
+def test_the_window_gets_one_match_config(tmp_path, monkeypatch):
+    """``play`` builds one MatchConfig for the window: --bots counts your tank too, the
+    limits become the match's rules, the recording and the view go in it whole."""
+    import tanktool.game.app as app_mod
+
+    seen = []
+    monkeypatch.setattr(app_mod, "run_window", lambda config: seen.append(config) or [])
+    rec = tmp_path / "m.ttr"
+    r = CliRunner().invoke(cli, ["play", "--arena", "box", "--bots", "3", "--difficulty", "easy", "--seed", "7",
+                                 "--time-limit", "30", "--score-limit", "5", "--record", str(rec),
+                                 "--size", "800x600", "--view", "top", "--quality", "low"])
+    assert r.exit_code == 0, r.output
+    (cfg,) = seen
+    assert (cfg.arena, cfg.seed, cfg.seconds) == ("box", 7, None)
+    assert (cfg.opponents.count, cfg.opponents.difficulty, cfg.opponents.driver) == (2, "easy", "agent")
+    assert (cfg.rules.time_limit, cfg.rules.score_limit) == (30.0, 5)
+    assert (cfg.view.mode, cfg.view.size, cfg.view.quality) == ("top", (800, 600), "low")
+    assert cfg.recording.record == rec and cfg.network is None
+    assert "nothing recorded" in r.output

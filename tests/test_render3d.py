@@ -200,7 +200,9 @@ def test_quality_option_picks_the_preset_for_the_run(tmp_path, monkeypatch):
     # the window's settings page may say "high" with its own shadows; --quality low wins, unsaved
     cfg = tmp_path / "settings.toml"
     cfg.write_text('quality = "high"\nshadows = "high"\n')
-    app = App(None, arena="box", bots=1, view="top", size=(320, 180), sound=False, settings_file=cfg, quality="low")
+    from app_helpers import match_config
+
+    app = App(None, match_config(bots=1, size=(320, 180), quality="low"), settings_file=cfg)
     assert app.quality == preset("low")
     assert 'quality = "high"' in cfg.read_text()
     r = CliRunner().invoke(cli, ["play", "--headless", "--frames", "5", "--screenshot", str(tmp_path / "q.png"),

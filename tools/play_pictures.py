@@ -61,14 +61,16 @@ def menu_shots(only: list[str] | None) -> None:
     import pygame
 
     from tanktool.game.app import App, Presenter
+    from tanktool.game.config import MatchConfig, Opponents, ViewConfig
     from tanktool.game.hud import save_png
 
     with tempfile.TemporaryDirectory() as cfg:
         os.environ["XDG_CONFIG_HOME"] = cfg           # the default settings, not the user's
         pygame.display.init()
         pygame.font.init()
-        app = App(Presenter(SIZE, False, want_gl=False), arena="maze", vehicle="heavy", bots=5, view="3d",
-                  size=SIZE, sound=False)
+        app = App(Presenter(SIZE, False, want_gl=False),
+                  MatchConfig(arena="maze", vehicle="heavy", opponents=Opponents(5), view=ViewConfig("3d", SIZE),
+                              sound=False))
         app.frame(0.0)
         app.frame(0.0)                                 # the previews are made on the second frame
         if not only or "play-menu" in only:

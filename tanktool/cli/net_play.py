@@ -72,6 +72,7 @@ def run_network_window(host: str | None, join: str | None, player_name: str | No
     computer opponents the host runs, as with --headless).  Returns False when there is
     no display (the caller then plays it headless)."""
     from ..game.app import NoDisplay, run_window
+    from ..game.config import MatchConfig, NetworkConfig, Opponents, ViewConfig
 
     if host is not None and join is not None:
         raise click.UsageError("--host and --join exclude each other")
@@ -82,8 +83,9 @@ def run_network_window(host: str | None, join: str | None, player_name: str | No
         raise click.UsageError(f"--bots {bots}: a session holds 8 tanks, the host's own included (at most 7 bots)")
     network = ("host", host) if host is not None else ("join", join)
     try:
-        lines = run_window(arena=arena, vehicle=vehicle, bots=bots, seed=seed, view=view, size=size,
-                           fullscreen=fullscreen, network=network, name=player_name, password=password)  # type: ignore[arg-type]
+        lines = run_window(MatchConfig(arena=arena, vehicle=vehicle, opponents=Opponents(count=bots), seed=seed,
+                                       view=ViewConfig(view, size, fullscreen),
+                                       network=NetworkConfig(*network, player_name, password)))  # type: ignore[arg-type]
     except NoDisplay as e:
         echo(f"no display to open the game window ({e}); the network match runs headless, "
              "the scripted bot driving your tank.")

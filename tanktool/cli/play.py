@@ -23,7 +23,9 @@ with; network matches have none yet (refused).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -31,6 +33,9 @@ from ..errors import ArenaError, TanktoolError
 from .main import echo
 from .net_play import network_options
 from .options import progress
+
+if TYPE_CHECKING:
+    from ..game.config import MatchConfig
 
 
 def _arena_ref(arena: str | None) -> str:
@@ -115,126 +120,195 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --arena maze --record mine.ttr      (the window; the file holds the last match)
       tanktool play --replay mine.ttr                   (watch it in the window)
     """
-    limits = time_limit is not None or score_limit is not None
+    opts = _Options(headless, arena, vehicle, bots, seconds, seed, integrator, report_path, picture, view, frames,
+                    screenshot, _size(size), fullscreen, difficulty, bot_driver, record_path, replay_path,
+                    time_limit, score_limit, quality)
     if host is not None or join is not None:
-        from .net_play import resolve_password, run_network, run_network_window
-
-        if limits:
-            raise click.UsageError("--time-limit/--score-limit: network matches have no match end yet")
-        if record_path is not None or replay_path is not None:
-            raise click.UsageError("network matches are not recorded: --record/--replay go without --host/--join")
-        password = resolve_password(password)      # '-': typed at a prompt, once for both paths below
-
-        if not headless and seconds is not None and _window_possible():
-            click.echo("warning: --seconds is ignored in a network match in the window (it lasts until you "
-                       "quit); use --headless for a timed network match", err=True)
-        if not headless and run_network_window(host, join, player_name, password, arena, vehicle, bots, seed,
-                                               view, _size(size), fullscreen, echo):
-            return
-        run_network(host, join, player_name, password, arena, vehicle, seconds, seed, report_path, echo)
+        _play_network(opts, host, join, player_name, password)
         return
+    if record_path is not None or replay_path is not None:
+        if _replay_setup(opts):
+            return
+    if opts.headless and (frames is not None or screenshot is not None):
+        _screenshot(opts)
+        return
+    if not opts.headless:
+        if _play_window(opts, window_config(opts)):
+            return
+        opts.bots = 4 if opts.bots is None else opts.bots
+        opts.seconds = 20.0 if opts.seconds is None else opts.seconds
+    _play_headless(opts)
+
+
+@dataclass
+class _Options:
+    """``play``'s options as given (the window's part becomes a MatchConfig)."""
+
+    headless: bool
+    arena: str | None
+    vehicle: str | None
+    bots: int | None
+    seconds: float | None
+    seed: int
+    integrator: str
+    report_path: Path | None
+    picture: Path | None
+    view: str
+    frames: int | None
+    screenshot: Path | None
+    size: tuple[int, int]
+    fullscreen: bool
+    difficulty: str
+    bot_driver: str
+    record_path: Path | None
+    replay_path: Path | None
+    time_limit: float | None
+    score_limit: int | None
+    quality: str | None
+
+    @property
+    def limits(self) -> bool:
+        return self.time_limit is not None or self.score_limit is not None
+
+
+def window_config(o: _Options, replay: Any = None) -> "MatchConfig":
+    """The one match configuration the game window gets from ``play``'s options
+    (``--bots`` counts every tank, yours too: the window gets that many less one)."""
+    from ..game.config import MatchConfig, Opponents, Recording, ViewConfig
+    from ..sim.match import match_rules
+
+    rules = match_rules(None, o.time_limit, o.score_limit) if o.limits else None
+    return MatchConfig(arena=o.arena, vehicle=o.vehicle,
+                       opponents=Opponents(3 if o.bots is None else max(o.bots - 1, 0), o.difficulty, o.bot_driver),
+                       seed=o.seed, rules=rules, seconds=o.seconds,
+                       view=ViewConfig(o.view, o.size, o.fullscreen, o.quality),
+                       recording=Recording(record=o.record_path, replay=replay,
+                                           replay_name=str(o.replay_path or "")))
+
+
+def _play_network(o: _Options, host: str | None, join: str | None, player_name: str | None,
+                  password: str | None) -> None:
+    from .net_play import resolve_password, run_network, run_network_window
+
+    if o.limits:
+        raise click.UsageError("--time-limit/--score-limit: network matches have no match end yet")
+    if o.record_path is not None or o.replay_path is not None:
+        raise click.UsageError("network matches are not recorded: --record/--replay go without --host/--join")
+    password = resolve_password(password)      # '-': typed at a prompt, once for both paths below
+    if not o.headless and o.seconds is not None and _window_possible():
+        click.echo("warning: --seconds is ignored in a network match in the window (it lasts until you "
+                   "quit); use --headless for a timed network match", err=True)
+    if not o.headless and run_network_window(host, join, player_name, password, o.arena, o.vehicle, o.bots,
+                                             o.seed, o.view, o.size, o.fullscreen, echo):
+        return
+    run_network(host, join, player_name, password, o.arena, o.vehicle, o.seconds, o.seed, o.report_path, echo)
+
+
+def _replay_setup(o: _Options) -> bool:
+    """--record/--replay: check them, render a replay's frame or show it in the window
+    (True: done), else set the options up for the headless match that records or
+    plays it back."""
+    if o.record_path is not None and o.replay_path is not None:
+        raise click.UsageError("--record and --replay cannot be used together")
+    if o.replay_path is not None and (o.frames is not None or o.screenshot is not None):
+        _replay_picture(o)
+        return True
+    if o.frames is not None or o.screenshot is not None:
+        raise click.UsageError("--record records a match, --frames/--screenshot render a picture: "
+                               "use --picture for the final view")
+    _check_folders(o.record_path, o.report_path, o.picture)
+    if o.replay_path is None:
+        return False
+    if o.seconds is not None:
+        click.echo(f"warning: --seconds {o.seconds:g} ignored: a replay lasts as long as its recording", err=True)
+        o.seconds = None
+    if o.limits:
+        click.echo("warning: --time-limit/--score-limit ignored: a replay keeps the rules it was recorded with",
+                   err=True)
+        o.time_limit = o.score_limit = None
+    if not o.headless and o.report_path is None and o.picture is None:
+        # the recording in the game window; no display: the headless playback and its check
+        from ..sim.replay import read_replay
+
+        if _play_window(o, window_config(o, replay=read_replay(o.replay_path)), what="show the replay",
+                        instead="playing it back headless instead."):
+            return True
+    o.headless = True
+    return False
+
+
+def _replay_picture(o: _Options) -> None:
+    """One frame of the recorded match, rendered like --screenshot (default: the last)."""
+    from ..game.headless import FRAME
+    from ..game.headless import screenshot as take_screenshot
+    from ..game.replay_session import replay_frames, replay_session
+    from ..sim.replay import read_replay
+
+    if o.screenshot is None:
+        raise click.UsageError("--frames needs --screenshot FILE.png")
+    tape = read_replay(o.replay_path)
+    total = replay_frames(tape, FRAME)
+    n = total if o.frames is None else o.frames
+    if n > total:
+        raise TanktoolError(f"{o.replay_path}: the recording has {total} frames, --frames asked for {n}")
+    shot = take_screenshot(o.screenshot, view=o.view, frames=n, size=o.size,
+                           session=replay_session(tape, o.arena, o.vehicle))
+    echo(f"{shot['view']} view of {o.replay_path} at frame {shot['frames']} of {total}: {shot['path']}")
+
+
+def _screenshot(o: _Options) -> None:
+    from ..game.headless import screenshot as take_screenshot
+
+    if o.screenshot is None:
+        raise click.UsageError("--frames needs --screenshot FILE.png")
+    shot = take_screenshot(o.screenshot, view=o.view, frames=120 if o.frames is None else o.frames, arena=o.arena,
+                           vehicle=o.vehicle, bots=8 if o.bots is None else o.bots, seed=o.seed, size=o.size,
+                           difficulty=o.difficulty, bot=o.bot_driver, quality=o.quality or "medium")
+    echo(f"{shot['view']} view after {shot['frames']} frames: {shot['path']}")
+
+
+def _play_window(o: _Options, config: "MatchConfig", what: str = "open the game window",
+                 instead: str = "running a short headless match instead (tanktool play --headless for options; "
+                                "--picture F.png saves a top view).") -> bool:
+    """The game window with ``config``; False (and a line) when there is no display."""
+    from ..game.app import NoDisplay, run_window
+
+    try:
+        saved = run_window(config)
+    except NoDisplay as e:
+        echo(f"no display to {what} ({e}); {instead}")
+        return False
+    for line in saved:
+        echo(line)
+    if o.record_path is not None and not saved:
+        echo(f"replay: nothing recorded (no match was played), {o.record_path} not written")
+    return True
+
+
+def _check_folders(*outs: Path | None) -> None:
+    for out in outs:
+        if out is not None and not out.parent.exists():
+            raise TanktoolError(f"{out}: folder {out.parent} does not exist")
+
+
+def _play_headless(o: _Options) -> None:
+    """A match without a window, as fast as the machine allows: scoreboard, report,
+    picture, recording, or a replay played back and checked."""
     from ..sim.match import (choose_vehicle, default_vehicle, format_report, load_match_arena, load_tank_spec,
                              run_match, scoreboard)
 
-    width, height = _size(size)
-    if record_path is not None or replay_path is not None:
-        # replays are made and played by headless matches (sim/replay.py)
-        if record_path is not None and replay_path is not None:
-            raise click.UsageError("--record and --replay cannot be used together")
-        if replay_path is not None and (frames is not None or screenshot is not None):
-            # one frame of the recorded match, rendered like --screenshot (default: the last)
-            from ..game.headless import FRAME
-            from ..game.headless import screenshot as take_screenshot
-            from ..game.replay_session import replay_frames, replay_session
-            from ..sim.replay import read_replay
-
-            if screenshot is None:
-                raise click.UsageError("--frames needs --screenshot FILE.png")
-            tape = read_replay(replay_path)
-            total = replay_frames(tape, FRAME)
-            n = total if frames is None else frames
-            if n > total:
-                raise TanktoolError(f"{replay_path}: the recording has {total} frames, --frames asked for {n}")
-            shot = take_screenshot(screenshot, view=view, frames=n, size=(width, height),
-                                   session=replay_session(tape, arena, vehicle))
-            echo(f"{shot['view']} view of {replay_path} at frame {shot['frames']} of {total}: {shot['path']}")
-            return
-        if frames is not None or screenshot is not None:
-            raise click.UsageError("--record records a match, --frames/--screenshot render a picture: "
-                                   "use --picture for the final view")
-        for out in (record_path, report_path, picture):
-            if out is not None and not out.parent.exists():
-                raise TanktoolError(f"{out}: folder {out.parent} does not exist")
-        if replay_path is not None and seconds is not None:
-            click.echo(f"warning: --seconds {seconds:g} ignored: a replay lasts as long as its recording",
-                       err=True)
-            seconds = None
-        if replay_path is not None and limits:
-            click.echo("warning: --time-limit/--score-limit ignored: a replay keeps the rules it was recorded with",
-                       err=True)
-            time_limit = score_limit = None
-            limits = False
-        if replay_path is not None and not headless and report_path is None and picture is None:
-            # the recording in the game window; no display: the headless playback and its check
-            from ..game.app import NoDisplay, run_window
-            from ..sim.replay import read_replay
-
-            tape = read_replay(replay_path)
-            try:
-                run_window(view=view, size=(width, height), fullscreen=fullscreen, replay=tape,
-                           replay_name=str(replay_path), quality=quality)
-                return
-            except NoDisplay as e:
-                echo(f"no display to show the replay ({e}); playing it back headless instead.")
-        if replay_path is not None:
-            headless = True
-    if headless and (frames is not None or screenshot is not None):
-        from ..game.headless import screenshot as take_screenshot
-
-        if screenshot is None:
-            raise click.UsageError("--frames needs --screenshot FILE.png")
-        shot = take_screenshot(screenshot, view=view, frames=120 if frames is None else frames, arena=arena,
-                               vehicle=vehicle, bots=8 if bots is None else bots, seed=seed, size=(width, height),
-                               difficulty=difficulty, bot=bot_driver, quality=quality or "medium")
-        echo(f"{shot['view']} view after {shot['frames']} frames: {shot['path']}")
-        return
-    if not headless:
-        from ..game.app import NoDisplay, run_window
-
-        try:
-            extra = _window_limits(run_window, time_limit, score_limit, seconds)
-            if "seconds" in extra:
-                seconds = extra.pop("seconds")
-            saved = run_window(arena=arena, vehicle=vehicle, bots=3 if bots is None else max(bots - 1, 0),
-                               seed=seed, view=view, size=(width, height), fullscreen=fullscreen,
-                               difficulty=difficulty, bot=bot_driver, record=record_path, seconds=seconds,
-                               quality=quality, **extra)
-            for line in saved:
-                echo(line)
-            if record_path is not None and not saved:
-                echo(f"replay: nothing recorded (no match was played), {record_path} not written")
-            return
-        except NoDisplay as e:
-            echo(f"no display to open the game window ({e}); running a short headless match instead "
-                 "(tanktool play --headless for options; --picture F.png saves a top view).")
-        bots = 4 if bots is None else bots
-        seconds = 20.0 if seconds is None else seconds
-    bots = 8 if bots is None else bots
-    if seconds is None:
-        seconds = time_limit if time_limit is not None else 60.0
-    replay = None
-    if replay_path is not None:
+    bots = 8 if o.bots is None else o.bots
+    seconds = o.seconds if o.seconds is not None else o.time_limit if o.time_limit is not None else 60.0
+    arena, vehicle, replay = o.arena, o.vehicle, None
+    if o.replay_path is not None:
         from ..sim.replay import read_replay
 
-        replay = read_replay(replay_path)
+        replay = read_replay(o.replay_path)
         # the recording says what was played; --arena/--vehicle may point at moved bundles
         arena = arena or replay.header.get("arena_ref")
         vehicle = vehicle or replay.header.get("vehicle_ref")
         bots, seconds = int(replay.header["bots"]), float(replay.header["seconds"])
-    for out in (report_path, picture, record_path):
-        if out is not None and not out.parent.exists():
-            raise TanktoolError(f"{out}: folder {out.parent} does not exist")
-
+    _check_folders(o.report_path, o.picture, o.record_path)
     info = load_match_arena(_arena_ref(arena))
     # a replay plays what it recorded; a new match only with a vehicle the arena is built for
     vref = (vehicle or default_vehicle()) if replay is not None else choose_vehicle(info, vehicle, echo)
@@ -248,37 +322,37 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
 
             playback = play_replay(replay, info, spec, on_progress=bar.update)
             result = playback.result
-        elif record_path is not None:
+        elif o.record_path is not None:
             from ..sim.replay import record_match
 
-            result, tape = record_match(info, spec, bots=bots, seconds=seconds, seed=seed,
+            result, tape = record_match(info, spec, bots=bots, seconds=seconds, seed=o.seed,
                                         arena_ref=_stored_ref(_arena_ref(arena)), vehicle_ref=_stored_ref(vref),
-                                        on_progress=bar.update, integrator=integrator, bot=bot_driver,
-                                        difficulty=difficulty, **_limit_options(time_limit, score_limit))
+                                        on_progress=bar.update, integrator=o.integrator, bot=o.bot_driver,
+                                        difficulty=o.difficulty, **_limit_options(o.time_limit, o.score_limit))
         else:
-            result = run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
-                               integrator=integrator, on_progress=bar.update, bot=bot_driver, difficulty=difficulty,
-                               time_limit=time_limit, score_limit=score_limit)
+            result = run_match(info, spec, bots=bots, seconds=seconds, seed=o.seed, integrator=o.integrator,
+                               on_progress=bar.update, bot=o.bot_driver, difficulty=o.difficulty,
+                               time_limit=o.time_limit, score_limit=o.score_limit)
     report = result.report
     echo(scoreboard(report))
     timing = report["timing"]
     echo(f"{report['steps']} steps in {timing['wall_clock_s']:.2f} s: "
          f"{timing['steps_per_second']:.0f} steps/s, {timing['realtime_factor']:.1f}x real time")
-    if report_path is not None:
+    if o.report_path is not None:
         from ..formats.bundle import atomic_write_text
 
-        atomic_write_text(report_path, format_report(report))
-        echo(f"report: {report_path}")
-    if picture is not None:
+        atomic_write_text(o.report_path, format_report(report))
+        echo(f"report: {o.report_path}")
+    if o.picture is not None:
         from ..plots.match import save_match_picture
 
-        save_match_picture(result, picture)
-        echo(f"picture: {picture}")
-    if record_path is not None:
+        save_match_picture(result, o.picture)
+        echo(f"picture: {o.picture}")
+    if o.record_path is not None:
         from ..sim.replay import write_replay
 
-        nbytes = write_replay(record_path, tape)
-        echo(f"replay: {record_path} ({nbytes} bytes, {len(tape)} command changes)")
+        nbytes = write_replay(o.record_path, tape)
+        echo(f"replay: {o.record_path} ({nbytes} bytes, {len(tape)} command changes)")
     if replay is not None:
         if not playback.matches:
             raise click.ClickException(f"replay diverged from the recording: final state sha256 "
@@ -289,28 +363,6 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
 def _limit_options(time_limit: float | None, score_limit: int | None) -> dict:
     """The limits as run_match options (only those given: a recording stores them)."""
     return {k: v for k, v in (("time_limit", time_limit), ("score_limit", score_limit)) if v is not None}
-
-
-def _window_limits(run_window, time_limit: float | None, score_limit: int | None,
-                   seconds: float | None) -> dict:
-    """What the window is told of the match end: the rules, where it takes them
-    (``run_window(rules=...)``); else a time limit becomes the window's match length
-    (``seconds``) and a score limit is refused with a word."""
-    import inspect
-
-    if time_limit is None and score_limit is None:
-        return {}
-    if "rules" in inspect.signature(run_window).parameters:
-        from ..sim.match import match_rules
-
-        return {"rules": match_rules(None, time_limit, score_limit)}
-    out: dict = {}
-    if time_limit is not None:
-        out["seconds"] = time_limit if seconds is None else min(seconds, time_limit)
-    if score_limit is not None:
-        click.echo("warning: --score-limit is not applied in the game window yet (headless matches and the "
-                   "no-display fallback apply it)", err=True)
-    return out
 
 
 def _window_possible() -> bool:

@@ -276,6 +276,26 @@ class InputState:
                        strafe=s("strafe_right") - s("strafe_left"), fire=s("fire") >= 0.5)
 
 
+#: the pause screen's own keys (fixed, as a menu's are; the bound "pause" action resumes too)
+PAUSE_KEYS: dict[str, tuple[str, ...]] = {
+    "resume": ("key:p", "key:escape", "key:return"),
+    "restart": ("key:r",),
+    "menu": ("key:m",),
+    "quit": ("key:q", "key:f10"),
+}
+
+
+def screen_action(event: Any, keys: dict[str, tuple[str, ...]]) -> str | None:
+    """The screen action (a key of ``keys``) a key press stands for, or None: screens
+    such as the pause screen read keys through this, never as key codes."""
+    import pygame
+
+    if event.type != pygame.KEYDOWN:
+        return None
+    name = input_name(event)
+    return next((a for a, names in keys.items() if name in names), None)
+
+
 def describe(names: Iterable[str]) -> str:
     """Input names for people: ``key:space`` -> ``SPACE``, ``joyaxis:1-`` -> ``axis 1-``."""
     out = []

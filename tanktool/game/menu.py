@@ -16,12 +16,14 @@ overriding it), the resolution and full screen; every change is saved at once to
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import pygame
 
 from .hud import panel, text
-from .quality import NAME_CHARS, PARTICLES, PRESETS, SHADOWS, save_settings
+from .quality import NAME_CHARS, PARTICLES, PRESETS, SHADOWS, Settings
+from .session import DIFFICULTY
 
 BG = (18, 22, 20)
 HILITE = (250, 210, 70)
@@ -33,6 +35,72 @@ FIELDS = ("address", "name", "password")
 ACTION_LABELS = {"settings": "settings...", "bindings": "key and joystick bindings...", "start": "START", "quit": "quit",
                  "back": "back"}
 SETTINGS_ITEMS = ("quality", "shadows", "particles", "resolution", "fullscreen", "back")
+RESOLUTIONS = ["1280x720", "1600x900", "1920x1080", "1024x576", "800x600"]
+#: the menu's network address: host on it, or join the session there
+DEFAULT_ADDRESS = "127.0.0.1:5000"
+
+
+# ---------------------------------------------------------------- state
+@dataclass
+class Choice:
+    label: str
+    options: list[Any]
+    index: int = 0
+
+    @property
+    def value(self) -> Any:
+        return self.options[self.index]
+
+    def shift(self, d: int) -> None:
+        self.index = (self.index + d) % len(self.options)
+
+    def set(self, value: Any) -> None:
+        if value in self.options:
+            self.index = self.options.index(value)
+
+
+@dataclass
+class Menu:
+    """The start menu and the settings page: their choices (the 2002 game let the
+    player pick vehicle and arena), cursors, the field being typed into and the
+    clickable rectangles last drawn.  The handlers below change only this; they tell
+    the window what to do next by the action they return."""
+
+    arena: Choice
+    vehicle: Choice
+    bots: Choice = field(default_factory=lambda: Choice("opponents", list(range(0, 8)), 3))
+    difficulty: Choice = field(default_factory=lambda: Choice("difficulty", list(DIFFICULTY), 1))
+    view: Choice = field(default_factory=lambda: Choice("view", ["3d", "top"]))
+    resolution: Choice = field(default_factory=lambda: Choice("resolution", list(RESOLUTIONS)))
+    fullscreen: Choice = field(default_factory=lambda: Choice("fullscreen", [False, True]))
+    #: network play: off, host a session (listening on ``address``), or join the one at ``address``
+    network: Choice = field(default_factory=lambda: Choice("network", ["off", "host", "join"]))
+    address: str = DEFAULT_ADDRESS
+    #: the network session's password ("" for none), typed into a field that shows only stars
+    password: str = ""
+    #: the player's name in a network session (saved in the settings)
+    name: str = ""
+    cursor: int = 0
+    settings_cursor: int = 0
+    #: clickable rectangles of the page last drawn: (item index, rect), (kind, rect)
+    hits: list[Any] = field(default_factory=list)
+    preview_hits: list[Any] = field(default_factory=list)
+    #: typing into a field: ``field`` says which ("address", "name" or "password");
+    #: last, as the name hides dataclasses.field in the class body
+    editing: bool = False
+    field: str = "address"
+
+    #: the main menu; resolution and full screen are on the settings page
+    ITEMS = ("arena", "vehicle", "bots", "difficulty", "view", "network", "address", "name", "password", "settings",
+             "bindings", "start", "quit")
+    CHOICES = ("arena", "vehicle", "bots", "difficulty", "view", "network")
+
+    def item(self) -> str:
+        return self.ITEMS[self.cursor]
+
+    def size(self) -> tuple[int, int]:
+        w, h = (int(v) for v in str(self.resolution.value).split("x"))
+        return w, h
 
 
 # ---------------------------------------------------------------- labels
@@ -44,16 +112,15 @@ def _shown(value: Any) -> str:
     return str(value)
 
 
-def item_label(app: Any, item: str, selected: bool) -> tuple[str, str]:
+def item_label(m: Menu, item: str, selected: bool) -> tuple[str, str]:
     """(label, value) of a main-menu item, as drawn in two columns."""
-    m = app.menu
     if item in ACTION_LABELS:
         label = ACTION_LABELS[item]
         if item == "start" and m.network.value != "off":
             label = f"START: {m.network.value} {m.address}"
         return label, ""
     if item in FIELDS:
-        typing = app.editing and app.field == item
+        typing = m.editing and m.field == item
         value = getattr(m, item)
         if item == "password":
             shown = "*" * len(value) + ("_" if typing else "") if value or typing else "none"
@@ -61,13 +128,12 @@ def item_label(app: Any, item: str, selected: bool) -> tuple[str, str]:
             shown = value + ("_" if typing else "") if value or typing else "(for network play)"
         else:
             shown = value + ("_" if typing else "")
-        return item, f"[ {shown} ]" + ("" if app.editing or not selected else "  Enter: type")
+        return item, f"[ {shown} ]" + ("" if m.editing or not selected else "  Enter: type")
     c = getattr(m, item)
     return c.label, f"<  {_shown(c.value)}  >"
 
 
-def settings_label(app: Any, item: str) -> tuple[str, str]:
-    s = app.settings
+def settings_label(m: Menu, s: Settings, item: str) -> tuple[str, str]:
     if item == "back":
         return "back", ""
     if item == "quality":
@@ -76,7 +142,7 @@ def settings_label(app: Any, item: str) -> tuple[str, str]:
         v = getattr(s, item)
         preset = getattr(PRESETS[s.quality], item)
         return item, f"<  {v if v is not None else f'as the preset ({preset})'}  >"
-    c = getattr(app.menu, item)
+    c = getattr(m, item)
     return c.label, f"<  {_shown(c.value)}  >"
 
 
@@ -99,8 +165,12 @@ def _list(surf: "pygame.Surface", labels: list[tuple[str, str]], cursor: int, x:
     return hits
 
 
-def draw_menu(app: Any, surf: "pygame.Surface") -> None:
-    m = app.menu
+Preview = Callable[[str, Any, tuple[int, int]], "pygame.Surface | None"]
+
+
+def draw_menu(m: Menu, surf: "pygame.Surface", preview: Preview, notice: str = "") -> None:
+    """The main menu; ``preview(kind, ref, size)`` renders an arena's or vehicle's picture
+    (None while it is being made)."""
     surf.fill(BG)
     w, h = surf.get_size()
     title = max(min(72, h // 8), 28)
@@ -111,9 +181,9 @@ def draw_menu(app: Any, surf: "pygame.Surface") -> None:
     size = max(int(line * 0.8), 13)
     wide = w >= 640
     x = int(w * 0.06) if wide else 18
-    app.menu_hits = _list(surf, [item_label(app, it, i == m.cursor) for i, it in enumerate(items)], m.cursor,
-                          x, top, line, size)
-    app.preview_hits = []
+    m.hits = _list(surf, [item_label(m, it, i == m.cursor) for i, it in enumerate(items)], m.cursor,
+                   x, top, line, size)
+    m.preview_hits = []
     if wide:
         # two 16:9 pictures one above the other, as large as the window lets them be
         ph = min(int(w * 0.36) * 9 // 16, (h - top - 80) // 2 - 24)
@@ -121,7 +191,7 @@ def draw_menu(app: Any, surf: "pygame.Surface") -> None:
         px = w - pw - int(w * 0.05)
         py = top
         for kind, choice in (("arenas", m.arena), ("vehicles", m.vehicle)):
-            pic = app.preview(kind, choice.value, (pw, ph))
+            pic = preview(kind, choice.value, (pw, ph))
             rect = pygame.Rect(px, py, pw, ph)
             pygame.draw.rect(surf, (70, 80, 74), rect.inflate(6, 6), 3)
             if pic is None:                      # rendered on the next frame: the menu shows first
@@ -131,23 +201,23 @@ def draw_menu(app: Any, surf: "pygame.Surface") -> None:
                 surf.blit(pic, rect)
             caption = f"{'arena' if kind == 'arenas' else 'vehicle'}: {_shown(choice.value)}"
             text(surf, caption, (rect.x + 8, rect.bottom - 6), 24, anchor="bottomleft")
-            app.preview_hits.append((kind, rect))
+            m.preview_hits.append((kind, rect))
             py += ph + 24
     text(surf, "up/down choose, left/right or mouse change, Enter or click select, Esc quit", (w // 2, h - 56),
          max(min(22, w // 40), 14), HELP, anchor="midtop")
-    if app.notice:
-        text(surf, app.notice, (w // 2, h - 30), 22, (240, 160, 120), anchor="midtop")
+    if notice:
+        text(surf, notice, (w // 2, h - 30), 22, (240, 160, 120), anchor="midtop")
 
 
-def draw_settings(app: Any, surf: "pygame.Surface") -> None:
+def draw_settings(m: Menu, settings: Settings, surf: "pygame.Surface", notice: str = "") -> None:
     surf.fill(BG)
     w, h = surf.get_size()
     text(surf, "settings", (w // 2, 24), max(min(60, h // 9), 26), anchor="midtop")
     line = max(min(40, (h - 200) // len(SETTINGS_ITEMS)), 16)
     x = int(w * 0.12) if w >= 640 else 18
-    app.menu_hits = _list(surf, [settings_label(app, it) for it in SETTINGS_ITEMS], app.settings_cursor,
-                          x, 100, line, max(int(line * 0.8), 13))
-    q = app.settings.graphics()
+    m.hits = _list(surf, [settings_label(m, settings, it) for it in SETTINGS_ITEMS], m.settings_cursor,
+                   x, 100, line, max(int(line * 0.8), 13))
+    q = settings.graphics()
     lines = [f"shadows {q.shadows} ({q.shadow_size or 'no'} map), particles {q.particles}, sky {q.sky}, "
              f"arena lit per {q.arena_light}",
              "low keeps software OpenGL (Mesa llvmpipe) fastest; high is everything on"]
@@ -158,8 +228,8 @@ def draw_settings(app: Any, surf: "pygame.Surface") -> None:
         text(surf, s, (x, y + 26 * i), 22, HELP)
     text(surf, "saved at once; a new resolution opens with the next match.   Esc: back", (w // 2, h - 56), 20,
          HELP, anchor="midtop")
-    if app.notice:
-        text(surf, app.notice, (w // 2, h - 30), 22, (170, 220, 170), anchor="midtop")
+    if notice:
+        text(surf, notice, (w // 2, h - 30), 22, (170, 220, 170), anchor="midtop")
 
 
 # ---------------------------------------------------------------- input
@@ -171,8 +241,8 @@ def _choice_step(event: Any) -> int:
     return 0
 
 
-def _hit(app: Any, pos: tuple[int, int]) -> int | None:
-    for i, rect in getattr(app, "menu_hits", []):
+def _hit(m: Menu, pos: tuple[int, int]) -> int | None:
+    for i, rect in m.hits:
         if rect.collidepoint(pos):
             return i
     return None
@@ -186,26 +256,21 @@ def _click_step(rect: "pygame.Rect", pos: tuple[int, int], button: int) -> int:
     return 1
 
 
-def type_into(app: Any, event: Any) -> None:
-    """A key while typing into the address, name or password field."""
-    m = app.menu
+def type_into(m: Menu, event: Any) -> str | None:
+    """A key while typing into the address, name or password field; returns "name"
+    when the name has been typed (the window keeps it in the settings)."""
     if event.type != pygame.KEYDOWN:
-        return
-    field = app.field
+        return None
+    field = m.field
     value = getattr(m, field)
     if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_TAB):
-        app.editing = False
+        m.editing = False
         if field == "address":
-            from .app import DEFAULT_ADDRESS
-
             m.address = m.address.strip() or DEFAULT_ADDRESS
-        elif field == "name":
-            app.settings.name = m.name
-            app.save_settings()
-        return
+        return "name" if field == "name" else None
     if event.key == pygame.K_BACKSPACE:
         setattr(m, field, value[:-1])
-        return
+        return None
     ch = getattr(event, "unicode", "") or ""
     if field == "address":
         ch = ch.lower()
@@ -216,16 +281,17 @@ def type_into(app: Any, event: Any) -> None:
             m.name += ch
     elif len(ch) == 1 and ch.isprintable() and len(value) < MAX_PASSWORD:
         m.password += ch
+    return None
 
 
-def handle_menu(app: Any, event: Any) -> None:
-    m = app.menu
-    if app.editing:
+def handle_menu(m: Menu, event: Any) -> str | None:
+    """One event on the main menu.  Returns what the window should do: "start",
+    "quit", "settings", "bindings", "name" (the player's name was typed), or None."""
+    if m.editing:
         if event.type == pygame.MOUSEBUTTONDOWN:
-            app.editing = False               # a click elsewhere ends the typing
+            m.editing = False               # a click elsewhere ends the typing
         else:
-            type_into(app, event)
-            return
+            return type_into(m, event)
     step = _choice_step(event)
     if event.type == pygame.KEYDOWN:
         if event.key in (pygame.K_UP, pygame.K_w):
@@ -233,107 +299,98 @@ def handle_menu(app: Any, event: Any) -> None:
         elif event.key in (pygame.K_DOWN, pygame.K_s):
             m.cursor = (m.cursor + 1) % len(m.ITEMS)
         elif event.key in (pygame.K_RETURN, pygame.K_SPACE, pygame.K_KP_ENTER):
-            activate(app)
+            return activate(m)
         elif event.key == pygame.K_ESCAPE:
-            app.state = "quit"
+            return "quit"
     elif event.type == pygame.JOYHATMOTION:
         hx, hy = event.value
         m.cursor = (m.cursor - hy) % len(m.ITEMS)
         step = hx
     elif event.type == pygame.JOYBUTTONDOWN and event.button == 0:
-        activate(app)
+        return activate(m)
     elif event.type == pygame.MOUSEMOTION:
-        i = _hit(app, event.pos)
+        i = _hit(m, event.pos)
         if i is not None:
             m.cursor = i
     elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 3):
-        for kind, rect in getattr(app, "preview_hits", []):
+        for kind, rect in m.preview_hits:
             if rect.collidepoint(event.pos):
                 (m.arena if kind == "arenas" else m.vehicle).shift(1 if event.button == 1 else -1)
-                return
-        i = _hit(app, event.pos)
+                return None
+        i = _hit(m, event.pos)
         if i is None:
-            return
+            return None
         m.cursor = i
         if m.item() in m.CHOICES:
-            rect = dict(app.menu_hits)[i]
+            rect = dict(m.hits)[i]
             step = _click_step(rect, event.pos, event.button)
         elif event.button == 1:
-            activate(app)
+            return activate(m)
     if step and m.item() in m.CHOICES:
         getattr(m, m.item()).shift(step)
+    return None
 
 
-def activate(app: Any) -> None:
-    from ..errors import TanktoolError
-
-    item = app.menu.item()
-    if item == "start":
-        try:
-            app.start()
-        except TanktoolError as e:
-            app.notice = str(e)       # a broken bundle, nobody at the address: say so, stay in the menu
-    elif item in FIELDS:
-        app.editing, app.field = True, item
-        setattr(app.menu, item, "")
-    elif item == "bindings":
-        app.state = "remap"
-        app.remap_cursor = 0
-        app.remap_waiting = False
-    elif item == "settings":
-        app.state = "settings"
-        app.settings_cursor = 0
-    elif item == "quit":
-        app.state = "quit"
+def activate(m: Menu) -> str | None:
+    """Enter on the item under the cursor: start typing into a field, or the action
+    the window carries out ("start", "settings", "bindings", "quit")."""
+    item = m.item()
+    if item in FIELDS:
+        m.editing, m.field = True, item
+        setattr(m, item, "")
+        return None
+    if item == "settings":
+        m.settings_cursor = 0
+    return item if item in ("start", "settings", "bindings", "quit") else None
 
 
-def handle_settings(app: Any, event: Any) -> None:
+def handle_settings(m: Menu, settings: Settings, event: Any) -> str | None:
+    """One event on the settings page.  Returns "back", the name of the setting that
+    was changed (the window saves and applies it), or None."""
     n = len(SETTINGS_ITEMS)
     step = _choice_step(event)
     enter = False
     if event.type == pygame.KEYDOWN:
         if event.key in (pygame.K_UP, pygame.K_w):
-            app.settings_cursor = (app.settings_cursor - 1) % n
+            m.settings_cursor = (m.settings_cursor - 1) % n
         elif event.key in (pygame.K_DOWN, pygame.K_s):
-            app.settings_cursor = (app.settings_cursor + 1) % n
+            m.settings_cursor = (m.settings_cursor + 1) % n
         elif event.key in (pygame.K_RETURN, pygame.K_SPACE, pygame.K_KP_ENTER):
             enter = True
         elif event.key == pygame.K_ESCAPE:
-            app.state = "menu"
-            return
+            return "back"
     elif event.type == pygame.JOYHATMOTION:
         hx, hy = event.value
-        app.settings_cursor = (app.settings_cursor - hy) % n
+        m.settings_cursor = (m.settings_cursor - hy) % n
         step = hx
     elif event.type == pygame.JOYBUTTONDOWN and event.button == 0:
         enter = True
     elif event.type == pygame.MOUSEMOTION:
-        i = _hit(app, event.pos)
+        i = _hit(m, event.pos)
         if i is not None:
-            app.settings_cursor = i
+            m.settings_cursor = i
     elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 3):
-        i = _hit(app, event.pos)
+        i = _hit(m, event.pos)
         if i is None:
-            return
-        app.settings_cursor = i
+            return None
+        m.settings_cursor = i
         if SETTINGS_ITEMS[i] == "back":
             enter = True
         else:
-            step = _click_step(dict(app.menu_hits)[i], event.pos, event.button)
-    item = SETTINGS_ITEMS[app.settings_cursor]
+            step = _click_step(dict(m.hits)[i], event.pos, event.button)
+    item = SETTINGS_ITEMS[m.settings_cursor]
     if item == "back":
-        if enter:
-            app.state = "menu"
-        return
+        return "back" if enter else None
     if enter and not step:
         step = 1
-    if step:
-        change_setting(app, item, step)
+    if not step:
+        return None
+    change_setting(m, settings, item, step)
+    return item
 
 
-def change_setting(app: Any, item: str, step: int) -> None:
-    """Turn one setting by ``step`` and save the settings."""
-    s = app.settings
+def change_setting(m: Menu, s: Settings, item: str, step: int) -> None:
+    """Turn one setting by ``step``."""
     if item == "quality":
         names = list(PRESETS)
         s.quality = names[(names.index(s.quality) + step) % len(names)]
@@ -343,23 +400,9 @@ def change_setting(app: Any, item: str, step: int) -> None:
         cur = getattr(s, item)
         setattr(s, item, options[(options.index(cur) + step) % len(options)])
     else:
-        c = getattr(app.menu, item)
+        c = getattr(m, item)
         c.shift(step)
         if item == "resolution":
             s.resolution = str(c.value)
         else:
             s.fullscreen = bool(c.value)
-    path = app.save_settings()
-    app.notice = f"{item} changed (saved to {path})" if path is not None else f"{item} changed"
-    app.apply_quality()
-
-
-def save(app: Any) -> Any:
-    """Write the settings file; returns its path (None if it could not be written)."""
-    from ..errors import TanktoolError
-
-    try:
-        return save_settings(app.settings, app.settings_file)
-    except (OSError, TanktoolError) as e:
-        app.notice = f"settings not saved: {e}"
-        return None
