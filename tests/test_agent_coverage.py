@@ -8,7 +8,8 @@ import numpy as np
 
 from sim_fixtures import box_arena
 from tanktool.sim.agents import Agent
-from tanktool.sim.agents.navigation import Coverage, Views, agent_grid, views_for
+from tanktool.sim.agents.navigation import agent_grid
+from tanktool.sim.agents.sight import Coverage, Views, views_for
 from bot_helpers import driver, perceiver
 from tanktool.bots import Senses
 from tanktool.sim.body import TankSpec

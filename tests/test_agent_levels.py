@@ -21,7 +21,8 @@ from click.testing import CliRunner
 
 from tanktool.cli.main import cli
 from tanktool.formats.walls_txt import WallList
-from tanktool.sim.agents.navigation import SearchPlan, agent_grid, plan_path, views_for
+from tanktool.sim.agents.navigation import SearchPlan, agent_grid, plan_path
+from tanktool.sim.agents.sight import views_for
 from bot_helpers import perceiver, view_of
 from tanktool.bots import Senses
 from tanktool.sim.match import load_match_arena, load_tank_spec, make_bots, run_match

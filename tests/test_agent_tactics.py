@@ -13,7 +13,7 @@ from tanktool.sim.agents import Agent
 from tanktool.sim.agents.agent import GUARDS
 from tanktool.sim.agents.combat import RETURN_FIRE
 from tanktool.sim.agents.explore import STALE, SWEEP, WATCH_COVER, WATCH_STINT
-from tanktool.sim.agents.navigation import vantages_for
+from tanktool.sim.agents.sight import vantages_for
 from tanktool.sim.agents.perception import ENGINE_FULL, ENGINE_QUIET, Percept, Sighting, can_see
 from tanktool.sim.commands import IDLE
 from tanktool.sim.match import load_match_arena, load_tank_spec

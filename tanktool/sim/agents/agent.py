@@ -3,32 +3,14 @@
 Each think (``think_hz`` times a second; the command is held in between, as a person
 holds a key) the agent digests its view into a ``perception.Percept`` (its
 ``memory.AgentMemory`` keeps what it learnt: target, hits, kills, camps, trail), runs
-the state machine (``machine.StateMachine``) over the table below, dodges the shells
+the state machine (``machine.StateMachine``) over ``TRANSITIONS``, dodges the shells
 it sees (``dodge.Evasion``) and backs out when it is stuck (``driving.Pilot``).
 
 The states (``explore``: wander, watch, ambush, search; ``combat``: attack, evade,
-hunt, return_fire) and when it goes from one to another, checked in this order (the
-first that holds is taken; ``done``: the state has nothing more to do)::
-
-    from                          when              to
-    any but evade                 ambushed          evade        hit twice in 4 s, nobody in sight
-    attack                        losing            evade        out-traded (levels with cover)
-    evade                         done              search       in cover or 5 s: from the threat
-    any but evade, attack         shot_from_open    return_fire  hit, the shot heard from a place in sight
-    any but evade, attack         enemy_acquired    attack       in sight, reaction time over
-    return_fire                   done              search       facing the shot: from there
-    wander, watch, search         camp_known        hunt         an enemy seen standing (cover levels)
-    hunt                          done              wander       it was not there
-    attack                        enemy_killed      wander       it comes back at a spawn point
-    attack                        enemy_lost        search       from where it was last seen, moved on
-    wander, watch                 heard             search       from the shot or engine heard
-    wander, watch                 hit_unseen        search       from behind
-    search                        heard_again       search       a new noise after 2 s of searching
-    search                        done              wander       every quadrant, or 60 s
-    wander, watch                 leading           ambush       kills above deaths
-    ambush                        done              wander       not leading any more
-    wander                        vantage           watch        an arena with a vantage point
-    watch                         done              wander       part of the arena unseen: explore
+hunt, return_fire) and when it goes from one to another are the table
+``TRANSITIONS``, rows ``(from, when, to, why)`` checked in this order (the first that
+holds is taken; ``done``: the state has nothing more to do); ``transition_table()``
+prints it, and docs/agents.md shows it (``tools/agent_docs.py`` writes it there).
 
 Everything the agent knows comes from its view: sight, hearing, shells in sight, its
 own state, the events of hits and kills, and the static map (walls, spawn points, its
@@ -50,9 +32,10 @@ from .difficulty import DIFFICULTIES, Difficulty, difficulty
 from .dodge import Evasion
 from .driving import Pilot
 from .explore import STALE, WATCH_COVER, Search, Wander, Watch
-from .machine import State, StateMachine, Transition
+from .machine import State, StateMachine, Transition, table_text
 from .memory import AgentMemory
-from .navigation import Coverage, Memory, Vantages, Views, Wanderer, vantages_for
+from .navigation import Memory, Wanderer
+from .sight import Coverage, Vantages, Views, vantages_for
 
 if TYPE_CHECKING:  # pragma: no cover
     from ...nav.navgrid import NavGrid
@@ -69,25 +52,30 @@ def _but(*names: str) -> tuple[str, ...]:
 
 
 TRANSITIONS = tuple(Transition(*row) for row in (
-    (_but("evade"), "ambushed", "evade"),
-    (("attack",), "losing", "evade"),
-    (("evade",), "done", "search"),
-    (_but("evade", "attack"), "shot_from_open", "return_fire"),
-    (_but("evade", "attack"), "enemy_acquired", "attack"),
-    (("return_fire",), "done", "search"),
-    (("wander", "watch", "search"), "camp_known", "hunt"),
-    (("hunt",), "done", "wander"),
-    (("attack",), "enemy_killed", "wander"),
-    (("attack",), "enemy_lost", "search"),
-    (_ROAM, "heard", "search"),
-    (_ROAM, "hit_unseen", "search"),
-    (("search",), "heard_again", "search"),
-    (("search",), "done", "wander"),
-    (_ROAM, "leading", "ambush"),
-    (("ambush",), "done", "wander"),
-    (("wander",), "vantage", "watch"),
-    (("watch",), "done", "wander"),
+    (_but("evade"), "ambushed", "evade", "hit twice in 4 s, nobody in sight"),
+    (("attack",), "losing", "evade", "out-traded (levels with cover)"),
+    (("evade",), "done", "search", "in cover or 5 s: from the threat"),
+    (_but("evade", "attack"), "shot_from_open", "return_fire", "hit, the shot heard from a place in sight"),
+    (_but("evade", "attack"), "enemy_acquired", "attack", "in sight, reaction time over"),
+    (("return_fire",), "done", "search", "facing the shot: from there"),
+    (("wander", "watch", "search"), "camp_known", "hunt", "an enemy seen standing (cover levels)"),
+    (("hunt",), "done", "wander", "it was not there"),
+    (("attack",), "enemy_killed", "wander", "it comes back at a spawn point"),
+    (("attack",), "enemy_lost", "search", "from where it was last seen, moved on"),
+    (_ROAM, "heard", "search", "from the shot or engine heard"),
+    (_ROAM, "hit_unseen", "search", "from behind"),
+    (("search",), "heard_again", "search", "a new noise after 2 s of searching"),
+    (("search",), "done", "wander", "every quadrant, or 60 s"),
+    (_ROAM, "leading", "ambush", "kills above deaths"),
+    (("ambush",), "done", "wander", "not leading any more"),
+    (("wander",), "vantage", "watch", "an arena with a vantage point"),
+    (("watch",), "done", "wander", "part of the arena unseen: explore"),
 ))
+
+
+def transition_table() -> str:
+    """``TRANSITIONS`` as text (``machine.table_text``), as docs/agents.md shows it."""
+    return table_text(TRANSITIONS, STATES)
 
 
 class Nav:
@@ -327,4 +315,5 @@ def make_agents(world: Any, level: str | Difficulty = "normal", which: range | l
     return [BotDriver(Agent(level), world.rng.getrandbits(64), name=difficulty(level).name) for _ in idx]
 
 
-__all__ = ["Agent", "DIFFICULTIES", "Difficulty", "GUARDS", "STATES", "TRANSITIONS", "difficulty", "make_agents"]
+__all__ = ["Agent", "DIFFICULTIES", "Difficulty", "GUARDS", "STATES", "TRANSITIONS", "difficulty", "make_agents",
+           "transition_table"]

@@ -62,7 +62,7 @@ HEIGHT_TOLERANCE = 0.25
 
 def _eye(y: float | None) -> float | None:
     """The eye height over a tank standing at ``y`` (None: not known)."""
-    from .navigation import EYE
+    from .sight import EYE
 
     return None if y is None else y + EYE
 

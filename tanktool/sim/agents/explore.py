@@ -1,12 +1,12 @@
 """The agent's states for finding enemies: Wander, Watch, Ambush, Search.
 
 * **Wander**: explore.  A* to the block that sees the most of what was not seen in
-  the last minute per metre of path (``navigation.Coverage.goal``: the sight memory);
+  the last minute per metre of path (``sight.Coverage.goal``: the sight memory);
   when nothing is left unseen, a route of grid nodes chosen by the paper's three-node
   heuristic with memory (``navigation.Wanderer``).
 * **Watch** (in an arena with a vantage point: a block from which the vision cone,
   pointed one way, sees at least ``WATCH_COVER`` of the arena's blocks;
-  ``navigation.Vantages``): drive to the nearest good vantage and hold it, facing
+  ``sight.Vantages``): drive to the nearest good vantage and hold it, facing
   that way and sweeping the cone, so that an enemy coming in is seen first and far
   off.  After ``WATCH_STINT`` s, if more than ``STALE`` of the arena has gone unseen
   for a minute, it is done (the agent explores until all has been seen again).

@@ -53,12 +53,28 @@ class Transition:
     source: tuple[str, ...]
     when: str
     target: str
+    #: what the row means, for the table in the docs
+    why: str = ""
 
     def applies(self, state: str) -> bool:
         return self.source == ("*",) or state in self.source
 
 
 Guard = Callable[[A, "View", "Percept"], Any]
+
+
+def table_text(table: Sequence[Transition], states: Sequence[str]) -> str:
+    """The transition table as text, one row a line (``from  when  to  why``); a row
+    from most of ``states`` reads "any but" the others."""
+    def source(row: Transition) -> str:
+        if row.source == ("*",) or set(row.source) == set(states):
+            return "any"
+        if len(row.source) > len(states) / 2:
+            return "any but " + ", ".join(n for n in states if n not in row.source)
+        return ", ".join(row.source)
+
+    rows = [("from", "when", "to", "")] + [(source(r), r.when, r.target, r.why) for r in table]
+    return "\n".join(f"{a:<30}{w:<18}{b:<13}{why}".rstrip() for a, w, b, why in rows)
 
 
 class StateMachine(Generic[A]):

@@ -37,7 +37,7 @@ from ..bots import IDLE, Command, Senses
 from ..driver import Roam
 from . import aim, dodge
 from .driving import Pilot, trim
-from .navigation import vantages_for
+from .sight import vantages_for
 from .perception import Sighting, wrap
 
 if TYPE_CHECKING:  # pragma: no cover

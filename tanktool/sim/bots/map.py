@@ -12,7 +12,7 @@ world and no tank.  Its queries are the ones the built-in agents use:
 * ``line_blocked`` / ``blocked_from``: lines of sight (walls on a flat arena, the
   model's solid on a ground), as the game tests sight;
 * ``walls_of(level)``: the walls a tank on that level can run into (for feelers);
-* ``sight_table()``: which parts of the arena see which (``agents.navigation.Views``).
+* ``sight_table()``: which parts of the arena see which (``agents.sight.Views``).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
     from ...nav.navgrid import NavGrid
-    from ..agents.navigation import Views
+    from ..agents.sight import Views
     from ..collide import WallSet
 
 #: eye height over the surface of a point of sight given without a height [m]
@@ -86,8 +86,8 @@ class Map:
         return plan_path(self.grid if grid is None else grid, tuple(start), tuple(goal))
 
     def sight_table(self, grid: "NavGrid | None" = None) -> "Views":
-        """Which blocks of the arena see which (``agents.navigation.Views``; cached)."""
-        from ..agents.navigation import views_for
+        """Which blocks of the arena see which (``agents.sight.Views``; cached)."""
+        from ..agents.sight import views_for
 
         return views_for(self, self.grid if grid is None else grid)
 
