@@ -95,3 +95,52 @@ def test_usage_errors_are_one_error_line(args, needle, tmp_path, monkeypatch):
     (tmp_path / "DIR").mkdir()
     line = one_error_line(run(*args), needle)
     assert re.search(r"see `tanktool( play)? --help`", line), line
+
+
+# ----------------------------------------------------------------- model files
+
+def _damaged_texture_glb(tmp_path) -> Path:
+    """The bundled box's model.glb with one byte changed inside its first PNG's pixels."""
+    import json
+    import struct
+
+    data = bytearray((ROOT / "arenas" / "box" / "model.glb").read_bytes())
+    jlen = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(bytes(data[20:20 + jlen]))
+    view = doc["bufferViews"][doc["images"][0]["bufferView"]]
+    start = 20 + jlen + 8 + view.get("byteOffset", 0)
+    assert data[start:start + 4] == b"\x89PNG"
+    data[start + 100] ^= 0xFF                      # inside IDAT: the header still reads
+    out = tmp_path / "model.glb"
+    out.write_bytes(bytes(data))
+    return out
+
+
+@pytest.mark.parametrize("command", ["import-arena", "import-vehicle"])
+def test_a_damaged_png_inside_a_glb_names_the_file_and_the_image(tmp_path, command):
+    glb = _damaged_texture_glb(tmp_path)
+    one_error_line(run(command, str(glb), "-o", str(tmp_path / "out")),
+                   f"{glb}: images[0]", "image/png", "damaged")
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_obj_with_a_latin1_comment_reads(tmp_path):
+    from tanktool.formats.models import load_scene
+
+    obj = tmp_path / "room.obj"
+    obj.write_bytes(b"# caf\xe9 cr\xe9\xe9 par l'\xe9quipe\no sal\xf3n\nv 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 2 3\n")
+    scene = load_scene(obj)
+    assert sum(len(g.faces) for g in scene.geometry.values()) == 1
+
+
+def test_a_bad_face_index_names_the_line(tmp_path):
+    from tanktool.errors import FormatError
+    from tanktool.formats.models import load_scene
+
+    obj = tmp_path / "room.obj"
+    obj.write_text("v 0 0 0\nv 1 0 0\nv 0 0 1\nv 1 0 1\nf 1 2 3\n# a comment\nf 1 2 9\n")
+    with pytest.raises(FormatError, match=rf"{obj}:7: face names vertex 9, but the file defines 4 vertices"):
+        load_scene(obj)
+    obj.write_text("v 0 0 0\nv 1 0 0\nf 1 2 -3\n")
+    with pytest.raises(FormatError, match=rf"{obj}:3: face names vertex -3"):
+        load_scene(obj)

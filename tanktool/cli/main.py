@@ -123,6 +123,9 @@ class LazyGroup(click.Group):
                 traceback.print_exc()
             from ..formats.bundle import os_error_text
 
+            if e.errno is None and e.filename is None:
+                # a library's OSError (PIL's "broken data stream ..."), not the system's
+                raise UserError(f"cannot read a file: {' '.join(str(e).split())[:200] or type(e).__name__}") from e
             where, e.filename = e.filename, None
             raise UserError(f"{where or 'the system'}: {os_error_text(e)}") from e
 

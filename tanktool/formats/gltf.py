@@ -395,6 +395,20 @@ def _image_size(data: bytes) -> tuple[int, int] | None:
         return None
 
 
+def _decode_error(data: bytes) -> str | None:
+    """Why an image's pixels cannot be decoded (its size is checked first), or None."""
+    import io
+
+    from PIL import Image
+
+    try:
+        with Image.open(io.BytesIO(data)) as im:
+            im.load()
+    except Exception as e:  # PIL raises OSError, SyntaxError, ValueError, zlib.error ...
+        return " ".join(str(e).split())[:160] or type(e).__name__
+    return None
+
+
 def _textures(doc: dict, g: Gltf) -> tuple[list[dict], list[dict], list[dict], dict[int, int]]:
     """Sanitised images, samplers and textures, and old texture index -> new.
 
@@ -418,6 +432,12 @@ def _textures(doc: dict, g: Gltf) -> tuple[list[dict], list[dict], list[dict], d
         size = _image_size(data)
         if size is None or size[0] < 1 or size[1] < 1 or size[0] * size[1] > MAX_IMAGE_PIXELS:
             continue
+        damage = _decode_error(data)
+        if damage:  # a header that reads but pixels that do not: trimesh decodes lazily, far from here
+            name = im.get("name")
+            named = f" {name!r:.60}" if isinstance(name, str) and name else ""
+            raise FormatError(f"{g.label}: images[{i}]{named} ({mime} in bufferView {vi}): "
+                              f"the image is damaged: {damage}")
         image_map[i] = len(images)
         images.append({"bufferView": vi, "mimeType": mime})
     samplers: list[dict] = []

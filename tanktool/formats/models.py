@@ -290,8 +290,54 @@ def _load_with_trimesh(path: Path, fmt: str):
         raise FormatError(f"{path}: byte 0: empty file, expected a .{fmt} model")
     if fmt == "stl":
         _check_binary_stl(path, data)
-    return trimesh.load(io.BytesIO(data), file_type=fmt, force="scene", process=False,
-                        resolver=_FolderResolver(path.parent, str(path)))
+    if fmt == "obj":
+        data = obj_text(data).encode("utf-8")
+    try:
+        return trimesh.load(io.BytesIO(data), file_type=fmt, force="scene", process=False,
+                            resolver=_FolderResolver(path.parent, str(path)))
+    except IndexError:
+        if fmt == "obj":
+            where = obj_bad_index(data.decode("utf-8"))
+            if where:
+                raise FormatError(f"{path}:{where}") from None
+        raise
+
+
+def obj_text(data: bytes) -> str:
+    """An .obj file's text: UTF-8, else Latin-1 (old exporters write names and
+    comments in their system's 8-bit code page; every byte is a Latin-1 character, so
+    this never fails and the numbers, which are ASCII, read the same)."""
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
+
+def obj_bad_index(text: str) -> str | None:
+    """``"<line>: <what>"`` for the first face of an .obj naming a vertex that does not
+    exist (looked for only after trimesh failed: a scan costs a pass over the text)."""
+    count = {"v": 0, "vt": 0, "vn": 0}
+    names = {0: "v", 1: "vt", 2: "vn"}
+    for lineno, line in enumerate(text.splitlines(), 1):
+        head, _, rest = line.strip().partition(" ")
+        if head in count:
+            count[head] += 1
+        elif head == "f":
+            for corner in rest.split():
+                for k, field in enumerate(corner.split("/")[:3]):
+                    if not field:
+                        continue
+                    try:
+                        i = int(field)
+                    except ValueError:
+                        return f"{lineno}: face corner {corner!r:.40} is not vertex numbers"
+                    n = count[names[k]]
+                    if not (1 <= i <= n or -n <= i <= -1):
+                        what, many = {"v": ("vertex", "vertices"), "vt": ("texture coordinate", "texture coordinates"),
+                                      "vn": ("normal", "normals")}[names[k]]
+                        return (f"{lineno}: face names {what} {i}, but the file defines {n} {many} "
+                                f"before this line (1..{n}, or -1..-{n} counting back)")
+    return None
 
 
 def _load_gltf(path: Path):
