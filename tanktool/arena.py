@@ -106,6 +106,9 @@ def load_arena(path: str | os.PathLike) -> ArenaBundle:
     if not path.is_dir():
         clean_stale(path.parent, path.name)  # a replacement killed half-way: put the bundle back
     if not path.is_dir():
+        from .formats.models import refuse_model
+
+        refuse_model(path, "arena")
         raise ArenaError(f"{path}: no such arena folder")
     manifest = path / MANIFEST
     if not manifest.is_file():

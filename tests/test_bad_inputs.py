@@ -144,3 +144,30 @@ def test_a_bad_face_index_names_the_line(tmp_path):
     obj.write_text("v 0 0 0\nv 1 0 0\nf 1 2 -3\n")
     with pytest.raises(FormatError, match=rf"{obj}:3: face names vertex -3"):
         load_scene(obj)
+
+
+# ----------------------------------------------------------------- a model where a bundle is expected
+
+@pytest.mark.parametrize("args, kind", [
+    (["build-navgrid", "{m}"], "arena"),
+    (["play", "--headless", "--seconds", "1", "--arena", "{m}"], "arena"),
+    (["play", "--headless", "--seconds", "1", "--vehicle", "{m}"], "vehicle"),
+])
+def test_a_model_where_a_bundle_is_expected_says_import_it(tmp_path, args, kind):
+    model = tmp_path / "room.obj"
+    shutil.copy(ROOT / "arenas" / "box" / "box.obj", model)
+    one_error_line(run(*[a.format(m=model) for a in args]),
+                   f"{model} is a model: import it first with `tanktool import-{kind} {model}`")
+
+
+def test_check_of_a_model_and_of_missing_names(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(ROOT / "arenas" / "box" / "box.obj", tmp_path / "room.obj")
+    res = run("check", "room.obj")
+    assert res.exit_code == 2 and "room.obj is a model: import it first" in res.output, res.output
+    assert "A101" not in res.output
+    res = run("check", "fort", "mytank")
+    assert res.exit_code == 2, res.output
+    assert "error: fort: no such file or folder" in res.output and "error: mytank: no such file" in res.output
+    assert "0 errors" not in res.output and "in 0 files" not in res.output, res.output
+    assert "nothing checked: 2 paths could not be read" in res.output

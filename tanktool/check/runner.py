@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..formats.models import BUILT_EXTENSIONS, MESH_EXTENSIONS
 from .arena_rules import ArenaInfo, VehicleSize, check_arena, check_walls_file
 from .diagnostics import ERROR, WARNING, Diagnostic, diag
 from .vehicle_rules import check_vehicle, vehicle_fit
@@ -53,7 +54,11 @@ class Report:
     def summary(self) -> str:
         def n(k: int, word: str) -> str:
             return f"{k} {word}{'' if k == 1 else 's'}"
-        return f"{n(self.errors, 'error')}, {n(self.warnings, 'warning')} in {n(len(self.files), 'file')}"
+        unread = n(len(self.unreadable), "path")
+        if self.unreadable and not self.files:  # "0 errors in 0 files" would contradict the errors above
+            return f"nothing checked: {unread} could not be read"
+        text = f"{n(self.errors, 'error')}, {n(self.warnings, 'warning')} in {n(len(self.files), 'file')}"
+        return f"{text}; {unread} could not be read" if self.unreadable else text
 
     def to_dict(self) -> dict:
         return {"files": self.files,
@@ -75,6 +80,10 @@ class Targets:
             lst.append(p)
 
 
+#: model files: check reads bundles and walls files, not models
+MODEL_SUFFIXES = MESH_EXTENSIONS | BUILT_EXTENSIONS
+
+
 def _is_walls_file(p: Path) -> bool:
     return p.name == "walls.txt" or p.name.endswith(".walls.txt") or p.name.endswith("_walls.txt")
 
@@ -91,6 +100,9 @@ def discover(paths: list[Path]) -> Targets:
                 t.add("arenas", p.parent)
             elif p.name == VEHICLE_MANIFEST:
                 t.add("vehicles", p.parent)
+            elif p.suffix.lower() in MODEL_SUFFIXES:
+                t.unreadable.append(f"{p} is a model: import it first with `tanktool import-arena {p}` "
+                                    f"(or import-vehicle), then check the bundle")
             else:
                 t.add("walls", p)  # any other file is taken as a wall list
         elif not os.access(p, os.R_OK | os.X_OK):

@@ -63,6 +63,9 @@ def open_target(path: Path) -> Target:
         if (path.parent / "arena.toml").is_file():
             raise ArenaError(f"{path} belongs to the arena bundle {path.parent}: run build-navgrid on the bundle "
                              f"folder (its grid then follows the model and arena.toml stays current)")
+        from ..formats.models import refuse_model
+
+        refuse_model(path, "arena")
         walls = read_walls(path)
         if len(walls) == 0:
             raise ArenaError(f"{path}: no walls")

@@ -76,6 +76,15 @@ def detect_format(path: str | os.PathLike) -> str:
     raise FormatError(f"{path}: not a model file this tool reads (expected one of {kinds})")
 
 
+def refuse_model(path: str | os.PathLike, kind: str = "arena") -> None:
+    """Where a bundle (or a walls file) is expected but ``path`` is a model file, say
+    so and how to make the bundle (a walls reader's "expected 5 fields" or "no such
+    folder" would send the user the wrong way).  ``kind``: 'arena' or 'vehicle'."""
+    p = Path(path)
+    if p.suffix.lower() in MESH_EXTENSIONS | BUILT_EXTENSIONS and p.is_file():
+        raise FormatError(f"{p} is a model: import it first with `tanktool import-{kind} {p}`")
+
+
 def _check_binary_stl(path: Path, data: bytes) -> None:
     """Refuse a damaged binary STL with the byte offset, before trimesh sees it.
 

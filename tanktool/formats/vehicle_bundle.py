@@ -177,6 +177,9 @@ def load_vehicle(path: str | os.PathLike) -> VehicleBundle:
     if not path.is_dir():
         clean_stale(path.parent, path.name)  # a replacement killed half-way: put the bundle back
     if not path.is_dir():
+        from .models import refuse_model
+
+        refuse_model(path, "vehicle")
         raise VehicleError(f"{path}: no such vehicle bundle folder")
     if not manifest.exists():
         raise VehicleError(f"{path}: not a vehicle bundle (no vehicle.toml)")
