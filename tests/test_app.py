@@ -176,3 +176,38 @@ def test_remap_on_an_unwritable_config_folder_says_so_and_goes_on(app, tmp_path,
     press(app, pygame.K_ESCAPE)
     assert app.state == "menu"
     assert blocker.read_text().startswith("a file")       # nothing written over it
+
+
+def test_a_tie_at_the_top_is_a_draw_everywhere(make_app):
+    """2-2 with equal deaths: the end screen names no winner and says a draw, as the
+    match report does."""
+    from tanktool.game.scoreboard import winner
+    from tanktool.sim.match import make_report
+
+    app = make_app((480, 320), bots=1, seconds=0.05)
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    w = app.session.world
+    for t in w.tanks:
+        t.kills, t.deaths = 2, 1
+    app.advance(0.2)
+    assert app.state == "over" and "a draw" in app.over_reason and "wins" not in app.over_reason
+    assert winner(app.session) is None
+    assert make_report(w, "box", "light", 0, [])["winner"] is None
+    app.frame(0.016)                        # the end screen draws, nobody marked
+    w.tanks[1].kills = 3
+    assert winner(app.session) == 1
+
+
+def test_view_notices_stay_over_the_match(make_app):
+    """The camera/overlay notice is the match's: the menu does not show it."""
+    app = make_app((480, 320), bots=1)
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    app.view = "3d"                        # as if in the 3D view: an overlay key says where overlays show
+    press(app, pygame.K_F3)
+    assert "overlays" in app.match_notice
+    app.frame(0.016)
+    press(app, pygame.K_ESCAPE)
+    press(app, pygame.K_m)
+    assert app.state == "menu" and "overlays" not in app.notice

@@ -133,3 +133,15 @@ def test_the_window_gets_one_match_config(tmp_path, monkeypatch):
     assert (cfg.view.mode, cfg.view.size, cfg.view.quality) == ("top", (800, 600), "low")
     assert cfg.recording.record == rec and cfg.network is None
     assert "nothing recorded" in r.output
+
+
+def test_help_and_readme_name_every_bundled_arena(root_dir):
+    from tanktool.content import bundled_names
+
+    r = CliRunner().invoke(cli, ["play", "--help"])
+    readme = (root_dir / "README.md").read_text()
+    names = bundled_names("arenas")
+    assert len(names) >= 5
+    for name in names:
+        assert name in r.output, name
+        assert f"| `arenas/{name}` |" in readme, name

@@ -60,7 +60,7 @@ def _size(text: str) -> tuple[int, int]:
 @click.command("play")
 @click.option("--headless", is_flag=True, help="No window or sound: run the bots as fast as possible.")
 @click.option("--arena", "arena", default=None, metavar="A",
-              help="Arena bundle: a folder, or the name of a bundled one (box, maze, paper2002).")
+              help="Arena bundle: a folder, or the name of a bundled one (box, fort, hills, maze, paper2002).")
 @click.option("--vehicle", "vehicle", default=None, metavar="V",
               help="Vehicle bundle: a folder, or the name of a bundled one (light, heavy).")
 @click.option("--bots", type=click.IntRange(1, 64), default=None, help="Number of tanks (default 8 headless, 4 otherwise).")

@@ -466,7 +466,9 @@ class App:
         self.end_match()
         self.acc = 0.0
         self.state = "over"
-        self.over_reason = f"time up: the match lasted {seconds:g} s (--seconds)"
+        from .scoreboard import result_line
+
+        self.over_reason = f"time up: the match lasted {seconds:g} s (--seconds): {result_line(self.session)}"
         self.notice = self.over_reason
         return True
 
@@ -481,8 +483,9 @@ class App:
         self.acc = 0.0
         self.state = "over"
         why = {"time": "time up", "score": "score limit reached"}.get(m.reason, "the match is over")
-        winner = w.tanks[m.winner].name if m.winner is not None else None
-        self.over_reason = f"{why}: {winner} wins" if winner else f"{why}: a draw"
+        from .scoreboard import result_line
+
+        self.over_reason = f"{why}: {result_line(self.session)}"
         self.notice = self.over_reason
         return True
 

@@ -203,7 +203,8 @@ class Hud:
         rects.append(pygame.Rect(topleft, mm))
         rects += self._status(surface, session, focus, now)
         if message:
-            m = text(surface, message, (w // 2, h // 2 + (90 if not focus.alive else 0)), 48, anchor="center")
+            # a quarter down the screen: the crosshair and the respawn count are at its middle
+            m = text(surface, message, (w // 2, h // 4 + 24), 48, anchor="center")
             rects.append(self._behind(surface, [m]))
         # one pixel of slack: text shadows and antialiasing sit on the edges
         area = surface.get_rect()

@@ -30,6 +30,24 @@ def final_rows(session: Any) -> list[dict[str, Any]]:
     return rows
 
 
+def winner(session: Any) -> int | None:
+    """The index of the match's winner, as the report names it (``sim.match.make_report``):
+    the tank alone at the top of the standings with at least one kill; None for a draw
+    (equal kills and deaths at the top) or a match nobody scored in."""
+    world = getattr(session, "world_all", session.world)
+    match = getattr(world, "match", None)
+    if match is None:
+        return None
+    lead = match.winner if match.over else match.leader(world)
+    return lead if lead is not None and world.tanks[lead].kills > 0 else None
+
+
+def result_line(session: Any) -> str:
+    """Who won, for the end screen: "bot1 wins", or "a draw"."""
+    w = winner(session)
+    return f"{getattr(session, 'world_all', session.world).tanks[w].name} wins" if w is not None else "a draw"
+
+
 def draw_end(app: Any, surf: "pygame.Surface") -> None:
     surf.fill(BG)
     w, h = surf.get_size()
@@ -46,10 +64,11 @@ def draw_end(app: Any, surf: "pygame.Surface") -> None:
     y = 40 + big + 30
     cols = (0, 50, 200, 260, 320, 390, 450)
     player = getattr(session, "player", None)
+    best = winner(session)
     table = [(("#", "tank", "K", "D", "shots", "hits", "accuracy"), HELP)]
     for rank, r in enumerate(rows, 1):
         acc = f"{100 * r['accuracy']:.0f} %" if r["accuracy"] is not None else "-"
-        cells = (rank, r["name"] + ("  (winner)" if rank == 1 and r["kills"] > 0 else ""), r["kills"],
+        cells = (rank, r["name"] + ("  (winner)" if r["index"] == best else ""), r["kills"],
                  r["deaths"], r["shots"], r["hits"], acc)
         table.append((cells, tank_colour(r["index"]) if r["index"] == player else (230, 230, 225)))
     panel(surf, pygame.Rect(x, y, min(cols[-1] + 110, w - x), line * len(table)), (30, 36, 34, 255))
