@@ -145,3 +145,4 @@ def test_help_and_readme_name_every_bundled_arena(root_dir):
     for name in names:
         assert name in r.output, name
         assert f"| `arenas/{name}` |" in readme, name
+
