@@ -16,6 +16,11 @@ height-field grids, seeded, so a seed gives the same file:
 * ``hills`` / ``fort`` the bundled arenas of the same names (tools/make_arena_models.py)
 * ``corridor``, ``islands``, ``narrow_deck``: degenerate arenas (one corridor, platforms
   apart from each other, a catwalk in the air) the agents must cope with
+* ``town``, ``junkyard``, ``living_room``: what exporters and careless modelling write --
+  objects pasted twice, overlapping boxes, faces wound inside out, zero-thickness fences
+  a hair apart, rooms of single faces seen from inside, furniture on legs
+* ``stacked_floors`` (a car park of two decks), ``terraces`` (terrain cut into steps by
+  retaining walls, a footbridge), ``big_terrain`` (a 300 m smooth hillside)
 """
 
 from __future__ import annotations
@@ -28,78 +33,10 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-COLOURS = {
-    "ground": (0.42, 0.45, 0.38),
-    "grass": (0.38, 0.52, 0.30),
-    "rock": (0.50, 0.48, 0.45),
-    "wall": (0.62, 0.36, 0.27),
-    "deck": (0.55, 0.42, 0.22),
-    "ramp": (0.60, 0.55, 0.40),
-}
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-
-def box(x0: float, z0: float, x1: float, z1: float, y0: float, y1: float) -> trimesh.Trimesh:
-    """An axis-aligned box from its (x, z) corners and its y range."""
-    b = trimesh.creation.box(extents=[x1 - x0, y1 - y0, z1 - z0])
-    b.apply_translation([(x0 + x1) / 2, (y0 + y1) / 2, (z0 + z1) / 2])
-    return b
-
-
-def ramp(x0: float, z0: float, x1: float, z1: float, y_low: float, y_high: float, along: str = "+x",
-         base: float = 0.0) -> trimesh.Trimesh:
-    """A solid wedge over the rectangle, rising from ``y_low`` to ``y_high`` in the
-    direction ``along`` (+x, -x, +z, -z), its bottom at ``base``."""
-    corners = np.array([[x0, z0], [x1, z0], [x1, z1], [x0, z1]], dtype=np.float64)
-    axis = {"+x": (0, 1), "-x": (0, -1), "+z": (1, 1), "-z": (1, -1)}[along]
-    lo, hi = (x0, x1) if axis[0] == 0 else (z0, z1)
-    t = (corners[:, axis[0]] - lo) / (hi - lo)
-    if axis[1] < 0:
-        t = 1 - t
-    top = y_low + t * (y_high - y_low)
-    v = np.concatenate([np.column_stack([corners[:, 0], np.full(4, base), corners[:, 1]]),
-                        np.column_stack([corners[:, 0], top, corners[:, 1]])])
-    return trimesh.convex.convex_hull(v)
-
-
-def heightfield_mesh(xs: np.ndarray, zs: np.ndarray, h: np.ndarray) -> trimesh.Trimesh:
-    """A terrain surface: a grid of quads (two triangles each), faces up."""
-    X, Z = np.meshgrid(xs, zs)
-    v = np.column_stack([X.ravel(), h.ravel(), Z.ravel()])
-    nx = len(xs)
-    i, j = np.meshgrid(np.arange(len(zs) - 1), np.arange(nx - 1), indexing="ij")
-    a = (i * nx + j).ravel()
-    b, c, d = a + 1, a + nx, a + nx + 1
-    # (a, c, b) and (b, c, d) face +y in the (x, y, z) right-handed frame
-    f = np.concatenate([np.column_stack([a, c, b]), np.column_stack([b, c, d])])
-    return trimesh.Trimesh(v, f, process=False)
-
-
-def paint(mesh: trimesh.Trimesh, kind: str) -> trimesh.Trimesh:
-    mesh.visual.face_colors = (np.array(COLOURS[kind]) * 255).astype(np.uint8).tolist() + [255]
-    return mesh
-
-
-def join(parts: list[tuple[str, trimesh.Trimesh]]) -> trimesh.Trimesh:
-    return trimesh.util.concatenate([paint(m, k) for k, m in parts])
-
-
-def walled_yard(w: float, d: float, wall_h: float = 3.0, t: float = 1.0, slab: float = 0.5) -> list:
-    """A floor slab from (0, 0) to (w, d) with a wall of thickness ``t`` around it."""
-    return [("ground", box(0, 0, w, d, -slab, 0)),
-            ("wall", box(0, 0, w, t, 0, wall_h)), ("wall", box(0, d - t, w, d, 0, wall_h)),
-            ("wall", box(0, t, t, d - t, 0, wall_h)), ("wall", box(w - t, t, w, d - t, 0, wall_h))]
-
-
-def sine_waves(rng: np.random.Generator, X: np.ndarray, Z: np.ndarray, count: int, k: tuple[float, float],
-               weight_min: float) -> np.ndarray:
-    """A sum of ``count`` seeded waves sin(kx x + a) cos(kz z + b) over the grid X, Z,
-    wave numbers in ``k``, each weighted between ``weight_min`` and 1."""
-    h = np.zeros_like(X)
-    for _ in range(count):
-        kx, kz = rng.uniform(k[0], k[1], 2)
-        ph = rng.uniform(0, 2 * math.pi, 2)
-        h += rng.uniform(weight_min, 1.0) * np.sin(kx * X + ph[0]) * np.cos(kz * Z + ph[1])
-    return h
+from level_parts import (COLOURS, box, fence, heightfield_mesh, inverted, join, paint, quad,  # noqa: F401
+                         ramp, room_shell, sine_waves, walled_yard)
 
 
 def rolling_terrain(size: float = 90.0, n: int = 52, amp: float = 3.5, seed: int = 1) -> list:
@@ -247,6 +184,123 @@ def narrow_deck(length: float = 60.0, width: float = 7.5) -> list:
     return [("deck", box(0, 0, length, width, 4.5, 5.0))]
 
 
+def town(seed: int = 4) -> list:
+    """A 120 x 120 m walled town as exporters write them: streets between blocks of
+    houses where the same house is pasted twice on the spot, an L-shaped house made
+    of two overlapping boxes, a row of houses sharing their party walls, a house with
+    its faces wound inside out, a roofless shell of single faces, raised pavements
+    (15 cm kerbs), zero-thickness fences (one pasted twice, two overlapping along a
+    line) and seeded kiosks."""
+    rng = np.random.default_rng(seed)
+    parts = walled_yard(120, 120, wall_h=4.0)
+    parts += [("ground", box(8, 8, 52, 52, 0, 0.15)), ("ground", box(68, 68, 112, 112, 0, 0.15))]
+    house = box(12, 12, 24, 22, 0.15, 6)
+    parts += [("wall", house), ("wall", house.copy())]                            # pasted twice
+    parts += [("wall", box(30, 12, 48, 20, 0.15, 7)), ("wall", box(38, 14, 46, 30, 0.15, 7))]  # an L
+    for k in range(4):                                                           # a row, party walls shared
+        parts.append(("wall", box(12 + 9 * k, 38, 21 + 9 * k, 48, 0.15, 5 + k % 2)))
+    parts.append(("wall", inverted(box(72, 72, 86, 84, 0.15, 6))))                # wound inside out
+    shell = [("wall", fence(92, 74, 108, 74, 0.15, 5)), ("wall", fence(108, 74, 108, 88, 0.15, 5)),
+             ("wall", fence(108, 88, 92, 88, 0.15, 5)), ("wall", fence(92, 88, 92, 74, 0.15, 5))]
+    parts += shell                                                               # a roofless shell
+    parts += [("wall", fence(60, 20, 60, 46, 0, 2)), ("wall", fence(60, 20, 60, 46, 0, 2)),  # pasted twice
+              ("wall", fence(20, 62, 44, 62, 0, 2)), ("wall", fence(34, 62, 52, 62, 0, 2.5))]  # overlapping
+    for _ in range(5):
+        x, z = rng.uniform(70, 105), rng.uniform(92, 106)
+        parts.append(("rock", box(x, z, x + 3, z + 3, 0.15, 3)))
+    return parts
+
+
+def junkyard(seed: int = 0) -> list:
+    """A 100 x 100 m walled yard of what careless modelling leaves: zero-thickness fences
+    pasted twice a hair (0.05 - 5 mm) apart or overlapping half their length, a fence
+    written both ways, two fences crossing in an X, a block pasted 0.1 mm off itself with
+    a fence along its face, a box wound inside out overlapping a normal one."""
+    parts = walled_yard(100, 100)
+    for x, dx, dz in ((10, 0.00005, 0), (20, 0.0002, 0), (30, 0.001, 0), (40, 0.005, 10), (50, 0.0001, 15)):
+        parts += [("wall", fence(x, 10, x, 40, 0, 2)), ("wall", fence(x + dx, 10 + dz, x + dx, 40 + dz, 0, 2))]
+    parts += [("wall", fence(50, 70, 90, 70, 0, 2)), ("wall", fence(70, 60, 70, 90, 0, 2)),
+              ("wall", box(60, 10, 70, 20, 0, 4)), ("wall", box(60.0001, 10.0001, 70.0001, 20.0001, 0, 4)),
+              ("wall", fence(58, 20.0002, 75, 20.0002, 0, 2)),
+              ("wall", fence(10, 60, 10, 90, 0, 2)), ("wall", fence(10, 90, 10, 60, 0, 2)),
+              ("wall", inverted(box(20, 60, 30, 70, 0, 4))), ("wall", box(25, 65, 35, 75, 0, 4))]
+    return parts
+
+
+def living_room(seed: int = 5) -> list:
+    """A living room at the scale of toy tanks (60 x 48 m, 24 m high) made of single
+    faces seen from inside, furnished: a sofa of overlapping boxes, a table and chairs
+    on legs, a rug 5 cm thick, a bookcase against a wall, a TV cabinet pasted twice, a
+    cushion lying across the sofa's arm, a standing lamp."""
+    rng = np.random.default_rng(seed)
+    parts = room_shell(0, 0, 60, 48, 0, 24)
+    parts += [("wall", box(6, 30, 34, 38, 0, 3.5)), ("wall", box(6, 36, 34, 42, 0, 9)),   # seat, back
+              ("wall", box(4, 30, 8, 42, 0, 5.5)), ("wall", box(32, 30, 36, 42, 0, 5.5)),  # arms
+              ("wall", box(30, 31, 38, 35, 5.5, 6.5)),                                   # a cushion
+              ("deck", box(10, 10, 40, 24, 0, 0.05))]                                    # the rug
+    for x, z in ((14, 12), (36, 12), (14, 21), (36, 21)):                                 # table legs
+        parts.append(("wall", box(x - 0.5, z - 0.5, x + 0.5, z + 0.5, 0.05, 7)))
+    parts.append(("deck", box(12, 10, 38, 23, 7, 7.6)))
+    for x0 in (44.0, 52.0):                                                               # chairs
+        for x, z in ((x0, 8), (x0 + 5, 8), (x0, 13), (x0 + 5, 13)):
+            parts.append(("wall", box(x - 0.3, z - 0.3, x + 0.3, z + 0.3, 0, 4)))
+        parts.append(("deck", box(x0 - 0.5, 7.5, x0 + 5.5, 13.5, 4, 4.4)))
+    parts.append(("wall", box(50, 44, 59.9, 47.9, 0, 18)))                              # bookcase
+    cabinet = box(44, 0.2, 56, 4, 0, 5)
+    parts += [("wall", cabinet), ("wall", cabinet.copy())]
+    x, z = rng.uniform(44, 52), rng.uniform(26, 34)
+    parts += [("wall", box(x, z, x + 2.5, z + 2.5, 0, 0.4)), ("wall", box(x + 1, z + 1, x + 1.5, z + 1.5, 0.4, 16))]
+    return parts
+
+
+def stacked_floors(seed: int = 0) -> list:
+    """A car park on two decks over a walled 112 x 34 m ground floor: deck 1 (4 m up,
+    70 x 30 m on pillars) reached by a 30 m ramp from the ground, deck 2 (8 m up, 30 x
+    30 m) standing on deck 1 and reached by a ramp on it; a parapet of single faces
+    along each deck's back edge."""
+    parts = walled_yard(112, 34, wall_h=3.0)
+    parts += [("deck", box(10, 1, 80, 31, 3.6, 4.0)), ("deck", box(10, 1, 40, 31, 7.6, 8.0)),
+              ("ramp", ramp(80, 1, 110, 12, 0.0, 4.0, "-x")),
+              ("ramp", ramp(40, 18, 70, 31, 4.0, 8.0, "-x", base=4.0))]
+    for y in (4.0, 8.0):
+        parts.append(("wall", fence(10, 1.3, 40 if y > 4 else 80, 1.3, y, y + 1.2)))
+    for x, z in ((11, 2), (11, 29), (38, 2), (38, 29), (78, 2), (78, 29)):
+        parts.append(("wall", box(x, z, x + 1, z + 1, 0, 3.6)))
+    return parts
+
+
+def terraces(seed: int = 6, size: float = 100.0) -> list:
+    """A hillside of terraces: rolling terrain cut into three flat steps by retaining
+    walls 3 m high, ramps between them, a pond hollow, and a footbridge over a gully."""
+    rng = np.random.default_rng(seed)
+    n = 61
+    xs = np.linspace(0, size, n)
+    X, Z = np.meshgrid(xs, xs)
+    h = sine_waves(rng, X, Z, 4, (0.04, 0.1), 0.5) * 0.8
+    step = np.floor(Z / (size / 3)) * 3.0
+    gully = np.clip(1 - np.abs(X - 0.5 * size) / 5.0, 0, 1) * 2.0 * (Z < size / 3)
+    parts = [("grass", heightfield_mesh(xs, xs, h + step - gully))]
+    for k in (1, 2):
+        z = k * size / 3
+        parts.append(("wall", box(0, z - 0.5, 0.55 * size, z + 0.5, -3, 3.0 * k + 1)))
+        parts.append(("ramp", ramp(0.6 * size, z - 14, 0.6 * size + 8, z, 3.0 * (k - 1) - 1, 3.0 * k + 0.5, "+z",
+                                   base=3.0 * (k - 1) - 3)))
+    parts.append(("deck", box(0.5 * size - 6, 10, 0.5 * size + 6, 16, 1.0, 1.4)))
+    return parts
+
+
+def big_terrain(size: float = 300.0, n: int = 151, amp: float = 12.0, seed: int = 8) -> list:
+    """A smooth hillside ``size`` m across (Recast's undulating terrain scaled up): long
+    gentle slopes whose contour walls must not be voxel staircases."""
+    rng = np.random.default_rng(seed)
+    xs = np.linspace(0, size, n)
+    X, Z = np.meshgrid(xs, xs)
+    h = sine_waves(rng, X, Z, 5, (0.01, 0.04), 0.4)
+    h *= amp / max(np.abs(h).max(), 1e-9)
+    ridge = np.clip(18.0 - np.abs((X - 0.7 * size) - 0.5 * (Z - 0.4 * size)) * 1.0, 0, None)
+    return [("grass", heightfield_mesh(xs, xs, h + ridge))]
+
+
 def level(name: str, **kw) -> trimesh.Trimesh:
     """One generated level as a single mesh (parts painted by kind)."""
     return join(LEVELS[name](**kw))
@@ -256,6 +310,8 @@ LEVELS = {
     "rolling_terrain": rolling_terrain, "ramps_and_decks": ramps_and_decks, "bridge": bridge,
     "bumpy_floor": bumpy_floor, "tiny_room": tiny_room, "two_storeys": two_storeys, "hills": hills, "fort": fort,
     "corridor": corridor, "islands": islands, "narrow_deck": narrow_deck,
+    "town": town, "junkyard": junkyard, "living_room": living_room, "stacked_floors": stacked_floors, "terraces": terraces,
+    "big_terrain": big_terrain,
 }
 
 
