@@ -77,6 +77,15 @@ def test_the_cli_writes_json_chart_and_replays_that_play_back(tmp_path):
     assert back.result.world.tanks[a_tank].kills == report["matches"][1]["kills"][0]
 
 
+def test_the_json_and_chart_folders_are_made(tmp_path):
+    out = tmp_path / "a" / "b" / "t.json"
+    r = CliRunner().invoke(cli, ["tournament", "--bot", "novice", "--bot", "easy", "--matches", "1",
+                                 "--seconds", "2", "--workers", "1", "--json", str(out), "--no-replays"])
+    assert r.exit_code == 0, r.output
+    assert out.is_file() and out.with_suffix(".png").is_file()
+    assert not (tmp_path / "a" / "b" / "t-replays").exists()
+
+
 def test_a_failing_bot_is_counted_and_the_tournament_goes_on():
     config = TournamentConfig(bots=(BROKEN, "novice"), matches=1, seconds=3.0, boot=0)
     rep = run_tournament(config, run="serial").report

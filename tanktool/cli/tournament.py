@@ -84,6 +84,9 @@ def tournament(bots: tuple[str, ...], arenas: tuple[str, ...], vehicles: tuple[s
     tasks = schedule(config, players)
     if replays is not None:
         _check_replay_dir(replays, [t.replay_name() for t in tasks])
+    for out in (json_path, chart):          # where the results go exists before the matches run
+        if out is not None:
+            out.parent.mkdir(parents=True, exist_ok=True)
     run = "ray" if ray_address else ("serial" if workers == 1 else "pool")
     n = workers or default_workers()
     with progress(length=len(tasks), label=f"{len(tasks)} matches ({run}, {n if run != 'serial' else 1} "
