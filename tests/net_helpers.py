@@ -102,3 +102,14 @@ def session(peers, n: int, password: str | None = None) -> list[Peer]:
     for i in range(2, n + 1):
         join(peers, host.tcp_address, f"peer{i}", password)
     return peers
+
+
+def match_kw(arena: str = "box", vehicle: str | None = None) -> dict:
+    """The ``digest`` and ``label`` a peer playing ``arena`` with ``vehicle`` joins with,
+    as ``tanktool play`` and the window compute them (a host refuses other digests)."""
+    from tanktool.net.digest import match_digest, match_label
+    from tanktool.sim.match import choose_vehicle, load_match_arena, load_tank_spec
+
+    info = load_match_arena(arena)
+    spec = load_tank_spec(choose_vehicle(info, vehicle, lambda line: None))
+    return {"digest": match_digest(info, spec), "label": match_label(info, spec)}

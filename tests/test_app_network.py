@@ -11,6 +11,7 @@ import time
 import pygame
 import pytest
 from app_helpers import goto, key, press
+from net_helpers import match_kw
 
 from tanktool.net.peer import Peer
 from tanktool.net.session import NetMatch
@@ -32,6 +33,11 @@ def type_address(app, text):
 @pytest.fixture
 def app(make_app):
     return make_app(bots=0)
+
+
+def _same(app) -> dict:
+    """The match digest the window's peer uses (the host refuses any other)."""
+    return match_kw(app.menu.arena.value, app.menu.vehicle.value)
 
 
 class Headless:
@@ -114,7 +120,7 @@ def test_window_hosts_a_headless_peer_joins(app):
     address = s.peer.tcp_address
     assert [t.index for t in s.world.tanks] == [0]          # alone: one tank shown, not 8
     x0, z0 = s.world_all.tanks[0].position
-    joiner = Headless(lambda: Peer.join(address, "bob", timeout=DEADLINE))
+    joiner = Headless(lambda: Peer.join(address, "bob", timeout=DEADLINE, **_same(app)))
     try:
         # the joiner's tank appears in the window's session, placed from its states;
         # meanwhile the player holds W and the tank drives on its own keys
@@ -141,7 +147,7 @@ def test_window_hosts_a_headless_peer_joins(app):
 
 
 def test_window_joins_a_headless_host_with_a_bot(app):
-    host = Headless(lambda: Peer.host(("127.0.0.1", 0), "alice"), bots=1)
+    host = Headless(lambda: Peer.host(("127.0.0.1", 0), "alice", **_same(app)), bots=1)
     try:
         assert host.ready.wait(DEADLINE) and host.error is None
         ip, port = host.match.peer.tcp_address
@@ -196,10 +202,11 @@ def test_menu_password_field_is_masked_and_used(app):
     assert s.peer.password == "S3cr et"
     address = s.peer.tcp_address
     out = {}
+    same = _same(app)
 
     def try_join(password):
         try:
-            out[password] = Peer.join(address, "bob", password, timeout=DEADLINE)
+            out[password] = Peer.join(address, "bob", password, timeout=DEADLINE, **same)
         except NetError as e:
             out[password] = e
 

@@ -10,6 +10,8 @@ import threading
 import pytest
 from click.testing import CliRunner
 
+from net_helpers import match_kw
+
 from tanktool.cli.main import cli
 from tanktool.net.peer import Peer
 
@@ -48,7 +50,7 @@ def test_port_in_use_and_nobody_there():
 
 def _serving(password: str | None):
     """A host peer polled by a thread; returns (host, stop)."""
-    host = Peer.host(("127.0.0.1", 0), "host", password)
+    host = Peer.host(("127.0.0.1", 0), "host", password, **match_kw("box"))
     done = threading.Event()
 
     def serve() -> None:

@@ -55,15 +55,15 @@ def test_ninth_refused(peers):
     assert len(peers) == 8 and all(len(p.table) == 8 for p in peers)
 
 
-def test_lowest_free_number_reused_but_host_stays(peers):
+def test_a_newcomer_gets_a_number_never_used_and_the_host_stays(peers):
     _session(peers, 4)
     peers[1].close()                           # player 2 leaves cleanly (EXIT)
     pump(peers, 0.2)
     assert all(sorted(p.table) == [1, 3, 4] for p in peers if not p.closed)
     newcomer = join(peers, peers[0].tcp_address, "again")
-    assert newcomer.number == 2 and newcomer.host_number == 1
+    assert newcomer.number == 5 and newcomer.host_number == 1
     pump(peers, 0.1)
-    assert all(sorted(p.table) == [1, 2, 3, 4] for p in peers if not p.closed)
+    assert all(sorted(p.table) == [1, 3, 4, 5] for p in peers if not p.closed)
 
 
 def test_host_crash_migrates_and_new_host_takes_joins(peers):
@@ -75,19 +75,19 @@ def test_host_crash_migrates_and_new_host_takes_joins(peers):
     assert peers[1].is_host and not peers[2].is_host
     assert all(p.host_changes and p.host_changes[-1][1] == 2 for p in alive)
     assert {me for me, e in events if e.kind == "host" and e.number == 2} == {2, 3, 4}
-    # a new player joins through the new host and gets the lowest free number
+    # a new player joins through the new host and gets a number never used
     newcomer = join(peers, peers[1].tcp_address, "late")
-    assert newcomer.number == 1 and newcomer.host_number == 2
+    assert newcomer.number == 5 and newcomer.host_number == 2
     pump(peers, 0.1)
     for p in peers:
         if not p.closed:
-            assert sorted(p.table) == [1, 2, 3, 4] and p.host_number == 2
-            assert sorted(p.links) == sorted({1, 2, 3, 4} - {p.number})
+            assert sorted(p.table) == [2, 3, 4, 5] and p.host_number == 2
+            assert sorted(p.links) == sorted({2, 3, 4, 5} - {p.number})
     # joining through a member that is not the host is redirected to the host
     peers[2].close()
     pump(peers, 0.1)
     other = join(peers, peers[3].tcp_address, "redirected")
-    assert other.number == 3 and other.host_number == 2
+    assert other.number == 6 and other.host_number == 2
 
 
 def test_silent_host_is_replaced(peers):

@@ -70,7 +70,7 @@ def test_header_fields_validated():
     good = P.encode(BODIES[3], 3, 1, 1.0)
     cases = {
         "magic": b"XX" + good[2:],
-        "version": good[:2] + bytes([2]) + good[3:],
+        "version": good[:2] + bytes([P.VERSION + 1]) + good[3:],
         "type": good[:3] + bytes([99]) + good[4:],
         "sender": good[:4] + bytes([9]) + good[5:],
         "length": good + b"\0",

@@ -392,8 +392,10 @@ def test_password_session_under_attack_and_migration(tmp_path):
         assert rep["latency_ms"]["samples"] > 100
     n, errors = _compare_views(reports + [late_report])
     assert n > 50 and sorted(errors)[len(errors) // 2] < 1.5
-    assert late_report["me"] == 1 and late_report["host"] == 2
-    assert sorted(p["number"] for p in late_report["peers"]) == [1, 2, 3, 4]
+    # not the old host's number 1: the flood's joiners used others, freed before it
+    me = late_report["me"]
+    assert me not in (1, 2, 3, 4) and late_report["host"] == 2
+    assert sorted(p["number"] for p in late_report["peers"]) == sorted([2, 3, 4, me])
     # the host's -v log: drops by kind with counts, not a line per packet
     lines = [ln for ln in host_err.splitlines() if ln.startswith("network: ")]
     kinds = {ln.split()[2].rstrip(":") for ln in lines}

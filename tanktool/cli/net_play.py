@@ -100,8 +100,8 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
                 report_path: Path | None, echo: Callable[[str], None], bots: int | None = None) -> dict[str, Any]:
     """Host or join a session, play it, print a summary, write the report.  ``bots``
     (default: ``play``'s own ``--bots``) computer opponents run on the host."""
-    from ..formats.bundle import atomic_write_text
     from ..net.peer import Peer, parse_address
+    from ..net.names import name_problem
     from ..net.protocol import name_bytes
     from ..net.session import NetMatch
     from ..sim.match import default_arena, load_match_arena, load_tank_spec
@@ -124,6 +124,9 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
         name_bytes(name)
     except ValueError as e:
         raise NetError(str(e)) from None
+    problem = name_problem(name, [])
+    if problem is not None:
+        raise NetError(problem)
     ref = arena or default_arena()
     if ref is None:
         raise TanktoolError("no arena given and none bundled under arenas/ (use --arena PATH)")
@@ -132,14 +135,17 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
 
     spec = load_tank_spec(choose_vehicle(info, vehicle, echo))   # one the arena is built for
     seconds = DEFAULT_NET_SECONDS if seconds is None else seconds
+    from ..net.digest import match_digest, match_label
 
+    # peers on another arena or vehicle are refused at the join (the digests differ)
+    same = {"digest": match_digest(info, spec), "label": match_label(info, spec)}
     if host is not None:
-        peer = Peer.host(parse_address(host), name, password)
+        peer = Peer.host(parse_address(host), name, password, **same)
         ip, port = peer.tcp_address
         echo(f"hosting on {ip}:{port} as player 1 ({name})")
     else:
         assert join is not None
-        peer = Peer.join(parse_address(join, need_host=True), name, password)
+        peer = Peer.join(parse_address(join, need_host=True), name, password, **same)
         h = peer.table[peer.host_number]
         me_ip, me_port = peer.tcp_address
         echo(f"joined {h.ip}:{h.tcp_port} as player {peer.number} ({name}), listening on {me_ip}:{me_port} "
@@ -147,7 +153,9 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
     match = None
 
     def stop(signum: int, frame: Any) -> None:
-        # Ctrl-C or SIGTERM ends the match cleanly: EXIT to everyone, and the report
+        # Ctrl-C or SIGTERM ends the match cleanly: EXIT to everyone, and the report.
+        # The handler stays until the report is written, so a second Ctrl-C while the
+        # peer says goodbye (up to 0.5 s a link) cannot lose the report
         if match is not None:
             match.stop = True
 
@@ -160,22 +168,32 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
     if hasattr(signal, "SIGUSR1"):
         old[signal.SIGUSR1] = signal.signal(signal.SIGUSR1, restart_stats)
     try:
-        match = NetMatch(peer, info, spec, seed=seed, log=echo, bots=bots)
-        report = match.run(seconds)
+        try:
+            match = NetMatch(peer, info, spec, seed=seed, log=echo, bots=bots)
+            report = match.run(seconds)
+        finally:
+            peer.close()
+        _summary(report, report_path, echo)
     finally:
-        peer.close()
         for sig, handler in old.items():
             signal.signal(sig, handler)
+    return report
+
+
+def _summary(report: dict[str, Any], report_path: Path | None, echo: Callable[[str], None]) -> None:
+    """Print the match summary and write the report (names from the network made visible)."""
+    from ..formats.bundle import atomic_write_text
+    from ..net.names import visible
+
     net = report["network"]
     lat = report["latency_ms"]
     echo(f"{report['seconds']:.1f} s as player {report['me']}; host at the end: player {report['host']}; "
          f"{len(report['peers'])} players")
     for p in report["peers"]:
-        echo(f"  p{p['number']} {p['name']:<12} kills {p['kills']:>2} deaths {p['deaths']:>2} "
+        echo(f"  p{p['number']} {visible(p['name']):<12} kills {p['kills']:>2} deaths {p['deaths']:>2} "
              f"position ({p['position'][0]:.1f}, {p['position'][1]:.1f})")
     echo(f"network: sent {net['sent']}, received {net['received']}, dropped {net['dropped']}; "
          f"state latency p50 {lat['p50']} ms, p99 {lat['p99']} ms")
     if report_path is not None:
         atomic_write_text(report_path, json.dumps(report, indent=1) + "\n")
         echo(f"report: {report_path}")
-    return report

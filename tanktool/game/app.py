@@ -236,12 +236,15 @@ class App:
         info = load_match_arena(m.arena.value)
         spec = load_tank_spec(choose_vehicle(info, m.vehicle.value))   # refuses one too big for the arena
         name = self.player_name or ("host" if mode == "host" else "player")
+        from ..net.digest import match_digest, match_label
+
+        same = {"digest": match_digest(info, spec), "label": match_label(info, spec)}   # refuse other arenas
         if mode == "host":
-            peer = Peer.host(parse_address(m.address), name, self.password)
+            peer = Peer.host(parse_address(m.address), name, self.password, **same)
             ip, port = peer.tcp_address
             said = f"hosting on {ip}:{port} as player 1 ({name})"
         else:
-            peer = Peer.join(parse_address(m.address, need_host=True), name, self.password)
+            peer = Peer.join(parse_address(m.address, need_host=True), name, self.password, **same)
             h = peer.table[peer.host_number]
             said = f"joined {h.ip}:{h.tcp_port} as player {peer.number} ({name})"
         try:

@@ -40,6 +40,7 @@ from ..errors import NetError
 from . import protocol as P
 from .auth import TAG_SIZE, datagram_key, hello_mac, join_mac, seal, unseal
 from .guard import Bucket, Buckets, DropLog, JoinLimiter, SeqWindow
+from .names import name_problem, visible
 
 __all__ = ["Peer", "NetEvent", "Link", "Bucket", "parse_address", "free_port", "join_mac", "hello_mac",
            "percentile"]
@@ -52,6 +53,10 @@ SILENCE = 3.0
 PENDING_TIMEOUT = 2.0
 #: a HELLO waits this long for the host's NEW_PLAYER to name its number [s]
 HELLO_WAIT = 5.0
+#: HELLOs waiting at once for a number the table does not know yet: a real joiner's
+#: waits a round trip at most (the host's NEW_PLAYER is on its way), so a few suffice;
+#: more would let parked HELLOs crowd real joiners out of the pending list
+MAX_HELLO_WAITING = 4
 #: unidentified connections at once, and from one address; past either, a new connection
 #: closes the oldest silent one (of the busiest address), so silent connections cannot
 #: lock a real player out: it answers within a round trip, they never do
@@ -144,6 +149,8 @@ class Link:
     outgoing: bool = False            # a mesh link we opened, waiting for its challenge
     initiated: bool = False           # a mesh link we opened (for simultaneous opens)
     refused: bool = False             # the other end refused this link: its closing is no exit
+    failed: bool = False              # a send failed: dropped at the end of the current handler
+    proven: bool = False              # it answered the password challenge right (a HELLO waiting)
 
 
 @dataclass(frozen=True)
@@ -161,9 +168,27 @@ class Peer:
     call :meth:`poll` often (it never blocks longer than its timeout)."""
 
     def __init__(self, name: str, password: str | None = None, clock: Callable[[], float] = time.time,
-                 silence: float = SILENCE) -> None:
+                 silence: float = SILENCE, digest: bytes = bytes(P.DIGEST_SIZE), label: str = "") -> None:
         P.name_bytes(name)      # validates the name early, with a clear message
+        if not name.isprintable():      # the protocol refuses such names: say so here
+            raise NetError(f"the name {visible(name)} has characters that are not printable")
+        problem = name_problem(name, [])
+        if problem is not None:
+            raise NetError(problem)
+        if len(digest) != P.DIGEST_SIZE:
+            raise ValueError(f"the match digest must be {P.DIGEST_SIZE} bytes")
         self.name = name
+        #: the arena + vehicle this peer plays (net/digest.py): a host refuses joiners on others
+        self.digest = bytes(digest)
+        self.label = label                  # what the digest is of, for the refusal text
+        #: the highest epoch ever seen: a new player's epoch is above it, never reused
+        self.max_epoch = 0
+        #: numbers ever given in this session, and the order the free ones were freed
+        self.used_numbers: set[int] = set()
+        self.freed: list[int] = []
+        #: links whose send failed: dropped after the current message is handled, so a
+        #: failure never pulls a player out of the table while a handler is using it
+        self._failed: list[tuple[Link, str]] = []
         self.password = password or None
         self.clock = clock
         self.silence = silence
@@ -240,6 +265,8 @@ class Peer:
         ip, tcp_port = peer.tcp_address
         peer.number = peer.host_number = 1
         peer.table = {1: P.Entry(1, 1, ip, tcp_port, peer.udp_address[1], name)}
+        peer.max_epoch = 1
+        peer.used_numbers = {1}
         peer.session_offset = peer.clock()
         return peer
 
@@ -308,7 +335,7 @@ class Peer:
                 self._listen(sock.getsockname()[0], port)
             mac = join_mac(self.password, msg.body.nonce, self.name) if self.password else bytes(P.MAC_SIZE)
             sent_at = self.clock()
-            self._send_blocking(sock, P.Join(self.name, self.tcp_address[1], self.udp_address[1], mac))
+            self._send_blocking(sock, P.Join(self.name, self.tcp_address[1], self.udp_address[1], mac, self.digest))
             msg = self._read_blocking(sock, reader, deadline, where)
         except BaseException:
             sock.close()
@@ -316,13 +343,13 @@ class Peer:
         if isinstance(msg.body, P.Refuse):
             sock.close()
             if msg.body.code == P.RefuseCode.RATE:
-                raise _Busy(f"join refused by {where}: {msg.body.text}")
+                raise _Busy(f"join refused by {where}: {visible(msg.body.text)}")
             if msg.body.code == P.RefuseCode.NOT_HOST:
                 try:
-                    return parse_address(msg.body.text, need_host=True)
+                    return parse_address(visible(msg.body.text), need_host=True)
                 except NetError:
                     raise NetError(f"{where} is not the host and did not say who is") from None
-            raise NetError(f"join refused by {where}: {msg.body.text}")
+            raise NetError(f"join refused by {where}: {visible(msg.body.text)}")
         if msg.type != P.MessageType.NUMBER or msg.sender != msg.body.table.host:
             sock.close()
             raise NetError(f"{where} did not answer the join request")
@@ -336,6 +363,7 @@ class Peer:
             if e.number == self.host_number and e.ip == "0.0.0.0":
                 e = P.Entry(e.number, e.epoch, address[0], e.tcp_port, e.udp_port, e.name)   # reach it as dialled
             self.table[e.number] = e
+            self._saw(e)
         sock.setblocking(False)
         link = Link(sock, reader, Bucket(TCP_RATE, TCP_BURST, now), now, addr=address, nonce=b"")
         if self.password:
@@ -404,6 +432,34 @@ class Peer:
         self.seq += 1
         return P.encode(body, self.number, self.seq, self.clock(), kind=kind)
 
+    def _pack_control(self, body: P.Body) -> bytes:
+        """A challenge or refusal to a connection not yet bound: it carries the game
+        counter without advancing it, so however many strangers knock, the members'
+        window on this peer's states does not move (finding 3 of issue 27)."""
+        return P.encode(body, self.number, self.seq, self.clock())
+
+    def _saw(self, e: P.Entry) -> None:
+        """Note an entry's epoch and number as used (never given again)."""
+        self.max_epoch = max(self.max_epoch, e.epoch)
+        self.used_numbers.add(e.number)
+        if e.number in self.freed:
+            self.freed.remove(e.number)
+
+    def _new_slot(self) -> tuple[int, int] | None:
+        """(number, epoch) for a newcomer: a number never used in this session while
+        there is one, else the one freed longest ago; an epoch above every one seen.
+        None when full."""
+        free = [n for n in range(1, P.MAX_PLAYERS + 1) if n not in self.table]
+        if not free:
+            return None
+        fresh = [n for n in free if n not in self.used_numbers]
+        if fresh:
+            n = fresh[0]
+        else:
+            order = [k for k in self.freed if k in free]
+            n = order[0] if order else free[0]
+        return n, self.max_epoch + 1
+
     def _send_blocking(self, sock: socket.socket, body: P.Body) -> None:
         data = self._pack(body)
         sock.sendall(data)
@@ -434,18 +490,24 @@ class Peer:
         """The host adds a computer opponent (it runs it): its number, or None when full."""
         if not self.is_host:
             raise NetError("only the host adds computer opponents")
-        free = [n for n in range(1, P.MAX_PLAYERS + 1) if n not in self.table]
-        if not free:
+        slot = self._new_slot()
+        if slot is None:
             return None
-        n = free[0]
+        n, epoch = slot
         me = self.table[self.number]
-        epoch = max(e.epoch for e in self.table.values()) + 1
+        taken = [e.name for e in self.table.values()]
+        base, k = name, 1
+        while name_problem(name, taken) is not None:     # a player already took "bot1"
+            k += 1
+            name = f"{base}-{k}"
         self.table[n] = P.Entry(n, epoch, me.ip, me.tcp_port, me.udp_port, name, owner=self.number)
+        self._saw(self.table[n])
         news = self._pack(P.Assign(n, self.session_time(), self._table()), P.MessageType.NEW_PLAYER)
         for link in list(self.links.values()):
             if not link.outgoing:
                 self._queue(link, news)
         self.events.append(NetEvent("joined", n, self.table[n]))
+        self._reap()
         return n
 
     # ------------------------------------------------------------------ sending
@@ -481,14 +543,20 @@ class Peer:
         data = self._pack(body)
         for link in list(self.links.values()):
             self._queue(link, data)
+        if not isinstance(body, P.Exit):
+            self._reap()
 
     def _queue(self, link: Link, data: bytes) -> None:
+        if link.failed:
+            return
         link.out += data
         self.counters["sent"] += 1
         self.counters["bytes_sent"] += len(data)
         self._flush(link)
 
     def _flush(self, link: Link) -> None:
+        if link.failed:
+            return
         if link.out:
             try:
                 n = link.sock.send(link.out)
@@ -496,10 +564,10 @@ class Peer:
             except (BlockingIOError, InterruptedError):
                 pass
             except OSError:
-                self._drop_link(link, "closed")
+                self._fail(link, "closed")
                 return
         if len(link.out) > MAX_OUTBUF:
-            self._drop_link(link, "too slow")
+            self._fail(link, "too slow")
             return
         want = selectors.EVENT_READ | (selectors.EVENT_WRITE if link.out else 0)
         try:
@@ -533,13 +601,16 @@ class Peer:
                     continue
                 if mask & selectors.EVENT_WRITE:
                     self._flush(link)
-                if mask & selectors.EVENT_READ and link.sock.fileno() >= 0:
+                if mask & selectors.EVENT_READ and link.sock.fileno() >= 0 and not link.failed:
                     self._read_tcp(link)
+                self._reap()
         # new connections last: one accepted at the previous poll has had its answer read
         # before any newer one can push it out of the pending list
         if accept:
             self._accept()
+            self._reap()
         self._check_timeouts()
+        self._reap()
 
     def _accept(self) -> None:
         assert self.tcp is not None
@@ -563,7 +634,7 @@ class Peer:
                         nonce=os.urandom(P.NONCE_SIZE))
             self.pending.append(link)
             self.sel.register(sock, selectors.EVENT_READ, link)
-            self._queue(link, self._pack(P.Challenge(link.nonce, self.password is not None)))
+            self._queue(link, self._pack_control(P.Challenge(link.nonce, self.password is not None)))
 
     def _make_room(self, ip: str) -> bool:
         """Room in the pending list for a connection from ``ip``: over the per-address
@@ -581,7 +652,7 @@ class Peer:
             return True
         if not victims:
             return False
-        victim = min(victims, key=lambda link: (not link.closing, link.hello is not None, link.opened))
+        victim = min(victims, key=lambda link: (not link.closing, link.proven, link.hello is not None, link.opened))
         self.dropped.source = victim.addr[0]
         self.dropped["evicted"] += 1
         self._close_link(victim)
@@ -608,6 +679,7 @@ class Peer:
                 self.dropped["rate"] += 1
                 continue
             self._on_tcp(link, m)
+            self._reap()
         if link.reader.broken:
             self._drop_link(link, "garbage")
 
@@ -678,19 +750,20 @@ class Peer:
         now = self.clock()
         ip = link.addr[0]
         if isinstance(body, (P.Join, P.Hello)) and self.password:
-            # guesses from an address that keeps getting the password wrong are not
-            # even checked for a while (a right one would otherwise still get in)
-            if not self.auth_failures.has_token(ip, now):
-                self._refuse(link, P.RefuseCode.RATE, f"too many wrong passwords from {ip}: try again later")
-                return
+            # every answer is checked: a player who proves the password gets in however
+            # many wrong guesses an attacker sharing its address made (finding 5); the
+            # guesses only earn "too many wrong passwords" once over their budget
             if isinstance(body, P.Join):
                 good = join_mac(self.password, link.nonce, body.name)
             else:
                 good = hello_mac(self.password, link.nonce, m.sender, body.epoch)
             if not hmac.compare_digest(body.mac, good):
-                self.auth_failures.take(ip, now)
-                self._refuse(link, P.RefuseCode.PASSWORD, "wrong password")
+                if not self.auth_failures.take(ip, now):
+                    self._refuse(link, P.RefuseCode.RATE, f"too many wrong passwords from {ip}: try again later")
+                else:
+                    self._refuse(link, P.RefuseCode.PASSWORD, "wrong password")
                 return
+            link.proven = True
         if isinstance(body, P.Join):
             if not self.is_host:
                 h = self.table.get(self.host_number)
@@ -717,8 +790,20 @@ class Peer:
         n = m.sender
         e = self.table.get(n)
         if e is None or e.epoch != m.body.epoch:
-            if (n, m.body.epoch) in self.departed:
+            epoch = m.body.epoch
+            if (n, epoch) in self.departed:
                 self._refuse(link, P.RefuseCode.BAD_REQUEST, "you left the session")
+            elif self.is_host or epoch <= self.max_epoch:
+                # the host knows every number it gave, and epochs only grow: this HELLO
+                # is for no player that is or will be (finding 5: parked HELLOs)
+                self.dropped["unknown"] += 1
+                self._refuse(link, P.RefuseCode.BAD_REQUEST, f"no player {n} with epoch {epoch} here")
+            else:
+                waiting = [k for k in self.pending if k.hello is not None and not k.closing]
+                if len(waiting) > MAX_HELLO_WAITING:
+                    # a real joiner's HELLO waits a round trip at most: the oldest goes
+                    self._refuse(min(waiting, key=lambda k: (k.proven, k.opened)), P.RefuseCode.BAD_REQUEST,
+                                 "no such player yet")
             return False
         try:
             ip = link.sock.getpeername()[0]
@@ -743,8 +828,17 @@ class Peer:
 
     def _admit(self, link: Link, m: P.Message) -> None:
         join: P.Join = m.body
-        free = [n for n in range(1, P.MAX_PLAYERS + 1) if n not in self.table]
-        if not free:
+        if not hmac.compare_digest(join.digest, self.digest):
+            what = f" ({self.label})" if self.label else ""
+            self._refuse(link, P.RefuseCode.MISMATCH,
+                         f"your arena or vehicle differs from the host's{what}: their hashes do not match")
+            return
+        problem = name_problem(join.name, [e.name for e in self.table.values()])
+        if problem is not None:
+            self._refuse(link, P.RefuseCode.NAME, problem)
+            return
+        slot = self._new_slot()
+        if slot is None:
             self._refuse(link, P.RefuseCode.FULL, f"session full: {P.MAX_PLAYERS} players already")
             return
         try:
@@ -752,9 +846,9 @@ class Peer:
         except OSError:
             self._drop_link(link, "closed")
             return
-        n = free[0]
-        epoch = max(e.epoch for e in self.table.values()) + 1
+        n, epoch = slot
         self.table[n] = P.Entry(n, epoch, ip, join.tcp_port, join.udp_port, join.name)
+        self._saw(self.table[n])
         self.pending.remove(link)
         if self.password:
             link.udp_key = datagram_key(self.password, join.mac)
@@ -771,7 +865,7 @@ class Peer:
 
     def _refuse(self, link: Link, code: P.RefuseCode, text: str) -> None:
         self.dropped[f"refused_{code.name.lower()}"] += 1
-        self._queue(link, self._pack(P.Refuse(code, text)))
+        self._queue(link, self._pack_control(P.Refuse(code, text)))
         link.closing = True
         link.hello = None
         self._flush(link)
@@ -782,6 +876,7 @@ class Peer:
     def _merge_table(self, table: P.Table, new: int) -> None:
         """The host's table: add who we do not know (unless we saw them leave)."""
         for e in table.entries:
+            self.max_epoch = max(self.max_epoch, e.epoch)
             if (e.number, e.epoch) in self.departed or e.number == self.number:
                 continue
             old = self.table.get(e.number)
@@ -794,6 +889,7 @@ class Peer:
                 if old is not None:
                     self._remove(e.number, "replaced")
                 self.table[e.number] = e
+                self._saw(e)
                 self.last_heard[e.number] = self.clock()
                 self.events.append(NetEvent("joined", e.number, e))
         for link in list(self.pending):
@@ -909,6 +1005,20 @@ class Peer:
                     and now - self.last_heard.get(n, now) > self.silence:
                 self._remove(n, "silent")
 
+    def _fail(self, link: Link, reason: str) -> None:
+        """A send on ``link`` failed: it is dropped by :meth:`_reap` once the message
+        being handled is done (dropping it here could take its player out of the
+        table in the middle of admitting another: the KeyError of finding 2)."""
+        if not link.failed:
+            link.failed = True
+            link.out.clear()
+            self._failed.append((link, reason))
+
+    def _reap(self) -> None:
+        while self._failed:
+            link, reason = self._failed.pop(0)
+            self._drop_link(link, reason)
+
     def _drop_link(self, link: Link, reason: str) -> None:
         if link.outgoing or link.refused:
             # a mesh link that never opened says nothing about its peer: silence will
@@ -948,6 +1058,7 @@ class Peer:
         if e is None:
             return
         self.departed.add((n, e.epoch))
+        self.freed.append(n)
         self.events.append(NetEvent("left", n, e, reason))
         players = [k for k, x in self.table.items() if not x.is_bot]
         if n == self.host_number and players:

@@ -29,12 +29,15 @@ from dataclasses import dataclass
 from typing import Union
 
 MAGIC = b"TK"
-VERSION = 1
+#: 2: the JOIN carries the digest of the arena and vehicle (peers on different ones
+#: refuse the match), control messages carry the game counter without advancing it
+VERSION = 2
 MAX_PLAYERS = 8
 MAX_NAME = 24                      # bytes of UTF-8
 MAX_PAYLOAD = 512
 MAC_SIZE = 32                      # HMAC-SHA256
 NONCE_SIZE = 16
+DIGEST_SIZE = 16                   # the arena + vehicle digest a JOIN carries (net/digest.py)
 HEADER = struct.Struct("!2sBBBIdH")
 #: positions, velocities: generous bounds that still reject absurd values [m, m/s];
 #: speeds and hit points travel as half floats in a state (|v| < 65504)
@@ -64,6 +67,8 @@ class RefuseCode(enum.IntEnum):
     NOT_HOST = 3
     BAD_REQUEST = 4
     RATE = 5         # too many joins (or wrong passwords) from your address: try again later
+    MISMATCH = 6     # your arena or vehicle is not the host's (their digests differ)
+    NAME = 7         # your name is blank or looks like a name already in the session
 
 
 @dataclass(frozen=True, slots=True)
@@ -110,6 +115,7 @@ class Join:
     tcp_port: int
     udp_port: int
     mac: bytes
+    digest: bytes = bytes(DIGEST_SIZE)   # of the arena + vehicle the joiner plays
 
 
 @dataclass(frozen=True, slots=True)
@@ -198,7 +204,7 @@ class BadMessage(Exception):
 
 # ---------------------------------------------------------------------- payloads
 _CHALLENGE = struct.Struct(f"!{NONCE_SIZE}sB")
-_JOIN = struct.Struct(f"!{MAC_SIZE}sHHB")
+_JOIN = struct.Struct(f"!{MAC_SIZE}s{DIGEST_SIZE}sHHB")
 _HELLO = struct.Struct(f"!{MAC_SIZE}sI")
 _ASSIGN = struct.Struct("!BdBB")          # number, session t, table host, entry count
 _ENTRY = struct.Struct("!BBI4sHHB")       # number, owner, epoch, ip, tcp, udp, name length
@@ -301,7 +307,7 @@ def encode_body(body: Body) -> tuple[MessageType, bytes]:
         return MessageType.CHALLENGE, _CHALLENGE.pack(body.nonce, int(body.password))
     if isinstance(body, Join):
         name = name_bytes(body.name)
-        return MessageType.JOIN, _JOIN.pack(body.mac, body.tcp_port, body.udp_port, len(name)) + name
+        return MessageType.JOIN, _JOIN.pack(body.mac, body.digest, body.tcp_port, body.udp_port, len(name)) + name
     if isinstance(body, Hello):
         return MessageType.HELLO, _HELLO.pack(body.mac, body.epoch)
     if isinstance(body, Assign):
@@ -352,12 +358,12 @@ def _decode_payload(mtype: MessageType, p: bytes) -> Body:
     if mtype == MessageType.JOIN:
         if len(p) < _JOIN.size:
             raise BadMessage("length")
-        mac, tcp, udp, nlen = _JOIN.unpack_from(p)
+        mac, digest, tcp, udp, nlen = _JOIN.unpack_from(p)
         if len(p) != _JOIN.size + nlen or not 1 <= nlen <= MAX_NAME:
             raise BadMessage("length")
         if tcp == 0 or udp == 0:
             raise BadMessage("range")
-        return Join(_read_name(p[_JOIN.size:]), tcp, udp, mac)
+        return Join(_read_name(p[_JOIN.size:]), tcp, udp, mac, digest)
     if mtype == MessageType.HELLO:
         mac, epoch = exact(_HELLO)
         return Hello(epoch, mac)

@@ -38,6 +38,7 @@ from ..sim.rules import DEFAULT as DEFAULT_RULES
 from ..sim.weapons import fire
 from ..sim.world import World
 from . import protocol as P
+from .names import visible
 from .peer import Peer, percentile
 from .remote import INTERP_DELAY, RemoteTank
 
@@ -184,18 +185,18 @@ class NetMatch:
             elif ev.kind == "joined":
                 self.names[ev.number] = ev.body.name
                 self.remotes.pop(ev.number, None)
-                self.log(f"player {ev.number} ({ev.body.name}) joined")
+                self.log(f"player {ev.number} ({visible(ev.body.name)}) joined")
             elif ev.kind == "left":
                 self.remotes.pop(ev.number, None)
                 self._absent(self.world.tanks[ev.number - 1])
                 self.left.append({"time": round(self.peer.session_time(), 3), "number": ev.number,
                                   "name": ev.body.name, "reason": ev.reason})
-                self.log(f"player {ev.number} ({ev.body.name}) left ({ev.reason})")
+                self.log(f"player {ev.number} ({visible(ev.body.name)}) left ({ev.reason})")
             elif ev.kind == "host":
                 self.log(f"host is now player {ev.number}" + (" (me)" if ev.number == self.peer.number else ""))
             elif ev.kind == "adopt":
                 self._adopt(ev.number)
-                self.log(f"running computer opponent {ev.number} ({ev.body.name})")
+                self.log(f"running computer opponent {ev.number} ({visible(ev.body.name)})")
 
     def _count_hit(self, shooter: int, victim: int, killed: bool) -> None:
         self._score(shooter).hits += 1
