@@ -46,6 +46,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tools"))
 
+from tanktool.errors import TanktoolError  # noqa: E402
 from tanktool.memory import keep_freed_memory  # noqa: E402
 from tanktool.nav.walkable import WalkableParams, grid_from_surface, walkable_surface  # noqa: E402
 
@@ -153,8 +154,12 @@ def main(argv: list[str] | None = None) -> int:
         work = Path(tmp)
         exe = build_harness(Path(tempfile.gettempdir()) / "tanktool-bench")
         for path in a.meshes or default_meshes(work):
-            V, F = load(path)
-            ms_ours, (surface, grid) = ours(V, F, a.repeat)
+            try:
+                V, F = load(path)
+                ms_ours, (surface, grid) = ours(V, F, a.repeat)
+            except TanktoolError as e:  # a mesh over the column limit, an unreadable file: one line
+                print(f"error: {path}: {' '.join(str(e).split())}", file=sys.stderr)
+                return 2
             row = {"mesh": str(path), "tris": int(len(F)), "ms_ours": round(ms_ours, 2), "ms_recast": None,
                    "nodes": int(grid.valid.sum()), "levels": int(grid.levels), "precision": None, "recall": None}
             if exe is not None:

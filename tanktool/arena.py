@@ -22,7 +22,7 @@ import numpy as np
 from . import __version__
 from .errors import ArenaError
 from .formats.walls_txt import WallList
-from .formats.limits import MAX_COORDINATE
+from .formats.limits import MAX_COORDINATE, check_cells
 
 #: defaults of the [navgrid] table until build-navgrid rewrites it
 NAVGRID_DEFAULTS = {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
@@ -238,6 +238,7 @@ def import_arena(
     headroom: float | None = None,
     cell: float | None = None,
     walkable: dict[str, Any] | None = None,
+    max_cells: int | None = None,
 ) -> ImportResult:
     """Read ``model``, find its walkable levels, walls and spawns and write the arena
     bundle ``out``.
@@ -300,6 +301,9 @@ def import_arena(
     if not meshes:
         raise ArenaError(f"{model}: the model has no triangles")
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
+    lo, hi = mesh.bounds
+    check_cells(str(model), float(hi[0] - lo[0]), float(hi[2] - lo[2]), params.cell, model.stat().st_size,
+                max_cells)  # before the heightfield: its cost follows the cells
     try:
         result = analyse_arena(mesh.vertices, mesh.faces, params, fleet, cut_height=height, tolerance=tolerance,
                                progress=progress)

@@ -171,3 +171,96 @@ def test_check_of_a_model_and_of_missing_names(tmp_path, monkeypatch):
     assert "error: fort: no such file or folder" in res.output and "error: mytank: no such file" in res.output
     assert "0 errors" not in res.output and "in 0 files" not in res.output, res.output
     assert "nothing checked: 2 paths could not be read" in res.output
+
+
+# ----------------------------------------------------------------- bounded work: cells
+
+def _stretched_dxf(tmp_path) -> Path:
+    """tests/data/plans/room.dxf with one coordinate changed from 10 to 65535 (the fuzzer's case)."""
+    lines = (ROOT / "tests" / "data" / "plans" / "room.dxf").read_text().split("\n")
+    k = next(i for i in range(len(lines) - 1) if lines[i].strip() == "20" and lines[i + 1].strip() == "10")
+    lines[k + 1] = "65535"
+    out = tmp_path / "stretched.dxf"
+    out.write_text("\n".join(lines))
+    return out
+
+
+def test_a_stretched_plan_is_refused_before_the_work_in_cells(tmp_path):
+    from tanktool.formats.limits import cell_budget
+
+    dxf = _stretched_dxf(tmp_path)
+    line = one_error_line(run("import-arena", str(dxf), "-o", str(tmp_path / "out")),
+                          f"{dxf}: the model is", "cells of 0.5 m", "--max-cells")
+    cells = int(re.search(r"m: ([\d,]+) cells", line).group(1).replace(",", ""))
+    assert cells > 10_000_000 and cells > cell_budget(dxf.stat().st_size)
+    assert not (tmp_path / "out").exists()
+
+
+def _terrain_obj(path: Path, size: float = 2000.0, samples: int = 101) -> Path:
+    """A real 2 km terrain: a height field sampled every 20 m, as an exporter writes it."""
+    import numpy as np
+
+    t = np.linspace(0.0, size, samples)
+    x, z = np.meshgrid(t, t)
+    y = 15.0 * np.sin(x / 170.0) * np.cos(z / 230.0)
+    rows = [f"v {a:.3f} {b:.3f} {c:.3f}" for a, b, c in zip(x.ravel(), y.ravel(), z.ravel())]
+    n = samples
+    for i in range(n - 1):
+        for j in range(n - 1):
+            a = i * n + j + 1
+            rows += [f"f {a} {a + n} {a + 1}", f"f {a + 1} {a + n} {a + n + 1}"]
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+def _town_dxf(path: Path, size: float = 2000.0, blocks: int = 20) -> Path:
+    """A real 4 km^2 town plan: a ring road and 20 x 20 blocks of houses, each a closed polyline."""
+    out = ["0", "SECTION", "2", "ENTITIES"]
+
+    def poly(pts):
+        out.extend(["0", "LWPOLYLINE", "8", "WALLS", "90", str(len(pts)), "70", "1"])
+        for px, py in pts:
+            out.extend(["10", f"{px:.2f}", "20", f"{py:.2f}"])
+
+    poly([(0, 0), (size, 0), (size, size), (0, size)])
+    step = size / blocks
+    for i in range(blocks):
+        for j in range(blocks):
+            x0, y0 = i * step + 15, j * step + 15
+            for hx in range(3):      # three houses a block
+                a, b = x0 + hx * 25, y0
+                poly([(a, b), (a + 18, b), (a + 18, b + 14), (a, b + 14)])
+    out.extend(["0", "ENDSEC", "0", "EOF"])
+    path.write_text("\n".join(out) + "\n")
+    return path
+
+
+def test_the_cell_limits_admit_real_levels(tmp_path):
+    """The defaults admit an 800 m BZFlag world, a 2 km terrain and a 4 km^2 town at 0.5 m
+    (asked of the same check import-arena runs, in cells: no import is run here)."""
+    from tanktool.formats.limits import check_cells
+
+    bzw = ROOT / "tests" / "data" / "bzw"
+    world = max(bzw.glob("*.bzw"), key=lambda p: p.stat().st_size)
+    assert check_cells(str(world), 800.0, 800.0, 0.5, world.stat().st_size) > 2_560_000
+    terrain = _terrain_obj(tmp_path / "terrain.obj")
+    assert check_cells(str(terrain), 2000.0, 2000.0, 0.5, terrain.stat().st_size) > 16_000_000
+    town = _town_dxf(tmp_path / "town.dxf")
+    assert check_cells(str(town), 2000.0, 2000.0, 0.5, town.stat().st_size) > 16_000_000
+    # --max-cells raises the limit for the stretched plan
+    dxf = _stretched_dxf(tmp_path)
+    with pytest.raises(TanktoolError, match="--max-cells"):
+        check_cells(str(dxf), 40.5, 65535.2, 0.5, dxf.stat().st_size)
+    assert check_cells(str(dxf), 40.5, 65535.2, 0.5, dxf.stat().st_size, max_cells=12_000_000) > 10_000_000
+
+
+def test_bench_walkable_over_the_column_limit_is_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    big = tmp_path / "huge.obj"
+    big.write_text("v 0 0 0\nv 30000 0 0\nv 0 0 30000\nf 1 3 2\n")
+    res = subprocess.run([sys.executable, str(ROOT / "bench" / "walkable.py"), str(big), "--repeat", "1"],
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 2, res.stderr
+    assert "Traceback" not in res.stderr and res.stderr.startswith(f"error: {big}: ") and "limit" in res.stderr

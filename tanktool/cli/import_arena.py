@@ -59,11 +59,14 @@ def _stages(model: Path) -> tuple[str, ...] | None:
               help="Floor plans (.dxf .svg): wall height in metres (default 3).")
 @click.option("--wall-thickness", type=float, default=None, metavar="T",
               help="Floor plans (.dxf .svg): wall thickness in metres (default 0.5).")
+@click.option("--max-cells", type=click.IntRange(1), default=None, metavar="N",
+              help="Most heightfield cells the import may use (default: 4,000,000 + 200 per byte of the "
+                   "model file, at most 40,000,000).")
 @force_option
 def import_arena(model: Path, out: Path | None, name: str | None, up: str | None, scale: float,
                  height: float, cell: float | None, max_slope: float | None, climb: float | None,
                  headroom: float | None, tolerance: float, wall_height: float | None, wall_thickness: float | None,
-                 force: bool) -> None:
+                 max_cells: int | None, force: bool) -> None:
     """Turn an arena MODEL (.3ds .obj .glb .stl .ply .off, BZFlag .bzw, floor plan
     .dxf .svg) into an arena bundle.
 
@@ -89,7 +92,7 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
     from ..nav.arena_levels import describe_levels
 
     kw = dict(warn=warn, wall_height=wall_height, wall_thickness=wall_thickness, max_slope=max_slope,
-              climb=climb, headroom=headroom, cell=cell)
+              climb=climb, headroom=headroom, cell=cell, max_cells=max_cells)
     stages = _stages(model)
     if stages:
         with progress(length=len(stages), label=f"importing {model.name}") as bar:

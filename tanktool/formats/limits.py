@@ -8,6 +8,7 @@ The figures are far above anything a real arena or vehicle needs.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 MiB = 1 << 20
@@ -61,3 +62,43 @@ def nesting_depth(value: Any, limit: int = MAX_DEPTH) -> int:
             return deepest
         stack.extend((c, d) for c in items if isinstance(c, (dict, list, tuple)))
     return deepest
+
+
+#: cells (columns of the voxel heightfield, nodes of the grid) an arena model may ask
+#: for: a base that admits an 800 m BZFlag world or a 1 km square at 0.5 m, plus a
+#: share for each byte of the file (a 2 km terrain at 0.5 m, 16 M cells, needs a
+#: file of 60 KB: any real terrain or town plan is larger), never above the
+#: heightfield's own ceiling.  A 385-byte drawing stretched to 65 km asks for 7 M
+#: cells, 3.7 GB and 40 s of work: refused before the work starts.
+CELLS_BASE = 4_000_000
+CELLS_PER_BYTE = 200
+MAX_CELLS = 40_000_000
+
+
+def cell_budget(file_bytes: int, max_cells: int | None = None) -> int:
+    """The cells a model file of ``file_bytes`` may ask for (``max_cells``: the
+    user's --max-cells, which replaces the file-size rule but not MAX_CELLS)."""
+    if max_cells is not None:
+        return min(int(max_cells), MAX_CELLS)
+    return min(CELLS_BASE + CELLS_PER_BYTE * int(file_bytes), MAX_CELLS)
+
+
+def check_cells(label: str, extent_x: float, extent_z: float, cell: float, file_bytes: int,
+                max_cells: int | None = None, what: str = "the model") -> int:
+    """The cells of an arena ``extent_x`` by ``extent_z`` metres at ``cell`` metres;
+    FormatError naming the limit and the options that change it when more than the
+    file may ask for (:func:`cell_budget`)."""
+    from ..errors import FormatError
+
+    nx = math.ceil(extent_x / cell) + 2   # the heightfield pads a cell on each side
+    nz = math.ceil(extent_z / cell) + 2
+    cells = nx * nz
+    budget = cell_budget(file_bytes, max_cells)
+    if cells > budget:
+        rule = (f"--max-cells {max_cells:,}" if max_cells is not None else
+                f"{CELLS_BASE:,} + {CELLS_PER_BYTE} per byte of its {file_bytes:,}-byte file")
+        raise FormatError(
+            f"{label}: {what} is {extent_x:,.1f} x {extent_z:,.1f} m: {cells:,} cells of {cell:g} m, more than the "
+            f"{budget:,} it may ask for ({rule}; at most {MAX_CELLS:,}): wrong units? use --scale, a larger "
+            f"--cell, or raise the limit with --max-cells")
+    return cells
