@@ -1,18 +1,21 @@
 """The difficulty ladder: a round robin of one-on-one duels between the computer
-agents (easy, normal, hard) and yardstick opponents written from issue 19
+agents (easy, normal, hard) and yardstick opponents written from issue 28
 (``sim.agents.robots``: a BZFlag-style robot, a camper, a duellist, a novice) and the scripted
-baseline (``sim.driver.ScriptedDriver``), on every bundled arena, under the game's
-rules (``sim.rules.DEFAULT``).
+baseline (``sim.driver.ScriptedDriver``), on every bundled arena and a level generated
+by tools/make_levels.py (imported as an arena bundle, cached in the temp folder),
+under the game's rules (``sim.rules.DEFAULT``).
 
 Every pair plays ``--duels`` duels of ``--seconds`` (120) on each arena: duel k uses
 seed k, and the first player of the pair is tank 0 when k is even and tank 1 when
 it is odd, so neither gets the better spawn points.  A win is more kills; equal
 kills is a draw.  Printed: win / loss / draw per pair and arena, then Elo ratings
 over all duels (a Bradley-Terry fit, draws counting half, with one virtual draw per
-pair so that a clean sweep stays finite; the players' mean is 1500) with 90 %
-bootstrap intervals (duels resampled within each pair and arena), and the goals.
+pair so that a clean sweep stays finite; the players' mean is 1500) with 95 %
+bootstrap intervals (duels resampled within each pair and arena), and the goals
+(issue 28's, and issue 30's for the novice).
 
     python bench/ladder.py [--duels N] [--json] [--arenas a,b] (default: every bundled arena)
+                           [--generated LEVEL[:SEED]] (default bridge; 'none': no generated arena)
                            [--players scripted,robot,camper,duellist,novice,easy,normal,hard]
                            [--seconds S] [--vehicle light] [--boot B]
 """
@@ -25,6 +28,7 @@ import json
 import math
 import random
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -42,6 +46,35 @@ from tanktool.sim.world import World  # noqa: E402
 PLAYERS = ("scripted", "robot", "camper", "duellist", "novice", "easy", "normal", "hard")
 #: every bundled arena (box, fort, hills, maze, paper2002 at the time of writing)
 ARENAS = tuple(bundled_names("arenas"))
+#: the generated level played besides them (tools/make_levels.py: two plateaus with
+#: ramps and a bridge over the passage between them)
+GENERATED = "bridge"
+
+
+def generated_arena(spec: str) -> Path:
+    """The arena bundle of a generated level ``NAME[:SEED]`` (tools/make_levels.py),
+    imported and its grid built once into the temp folder (``gen-NAME-SEED``)."""
+    name, _, seed = spec.partition(":")
+    sys.path.insert(0, str(ROOT / "tools"))
+    import make_levels
+
+    from click.testing import CliRunner
+
+    from tanktool.cli.main import cli
+
+    if not hasattr(make_levels, name) or name.startswith("_"):
+        raise ValueError(f"--generated: no level {name!r} in tools/make_levels.py")
+    kw = {"seed": int(seed)} if seed else {}
+    out = Path(tempfile.gettempdir()) / "tanktool-ladder" / f"gen-{name}-{seed or 'default'}"
+    if (out / "navgrid.npz").exists():
+        return out
+    out.parent.mkdir(parents=True, exist_ok=True)
+    src = make_levels.write_obj(make_levels.level(name, **kw), out.parent / f"gen-{name}-{seed or 'default'}.obj")
+    for args in (["-q", "import-arena", str(src), "-o", str(out), "--force"], ["-q", "build-navgrid", str(out)]):
+        r = CliRunner().invoke(cli, args)
+        if r.exit_code != 0:
+            raise ValueError(f"--generated {spec}: {' '.join(args[1:2])} failed: {r.output.strip()}")
+    return out
 
 
 def make_player(name: str, seed: int):
@@ -104,6 +137,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--duels", type=int, default=10, help="duels per pair and arena (default 10)")
     ap.add_argument("--seconds", type=float, default=120.0, help="simulated seconds per duel (default 120)")
     ap.add_argument("--arenas", default=",".join(ARENAS), help="comma-separated (default: every bundled arena)")
+    ap.add_argument("--generated", default=GENERATED,
+                    help=f"a tools/make_levels.py level NAME[:SEED] played too (default {GENERATED}; none: only --arenas)")
     ap.add_argument("--players", default=",".join(PLAYERS))
     ap.add_argument("--vehicle", default="light")
     ap.add_argument("--boot", type=int, default=300, help="bootstrap resamples for the Elo intervals")
@@ -117,22 +152,33 @@ def main(argv: list[str] | None = None) -> int:
     if len(players) < 2 or args.duels < 1:
         ap.error("need at least two players and one duel")
     spec = load_tank_spec(args.vehicle)
-    arenas = [load_match_arena(a) for a in args.arenas.split(",") if a]
+    refs: list = [a for a in args.arenas.split(",") if a]
+    if args.generated and args.generated != "none":
+        try:
+            refs.append(generated_arena(args.generated))
+        except ValueError as e:
+            print(f"error: {e}", file=sys.stderr)
+            return 2
+    arenas = [load_match_arena(a) for a in refs]
+    for a, ref in zip(arenas, refs):
+        if isinstance(ref, Path):
+            a.name = f"gen-{args.generated.replace(':', '-')}"
     t0 = time.perf_counter()
     cells = []              # one per (arena, pair)
     games: list[tuple[int, int, float, int]] = []       # (i, j, score of i, cell)
     for arena in arenas:
         for a, b in itertools.combinations(players, 2):
             w = l = d = 0
-            ka = kb = 0
+            ka = kb = sa = sb = 0
             for k in range(args.duels):
                 x, y = duel(arena, spec, a, b, args.first_seed + k, args.seconds)
-                ka, kb = ka + x, kb + y
+                ka, kb, sa, sb = ka + x, kb + y, sa + (x > 0), sb + (y > 0)
                 s = 1.0 if x > y else 0.0 if x < y else 0.5
                 w, l, d = w + (s == 1.0), l + (s == 0.0), d + (s == 0.5)
                 games.append((players.index(a), players.index(b), s, len(cells)))
             cells.append({"arena": arena.name, "a": a, "b": b, "wins": w, "losses": l, "draws": d,
-                          "kills": [ka, kb], "win_rate": w / args.duels})
+                          "kills": [ka, kb], "scored": [sa, sb], "win_rate": w / args.duels,
+                          "draw_rate": d / args.duels})
             if not args.json:
                 print(f"  {arena.name} {a}-{b}: {w}-{l}-{d} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
     elo = fit_elo(players, [(i, j, s) for i, j, s, _ in games])
@@ -150,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
     boots = np.array(boots) if boots else np.zeros((0, len(players)))
     ratings = []
     for k, p in enumerate(players):
-        lo, hi = (np.percentile(boots[:, k], [5, 95]) if len(boots) else (elo[k], elo[k]))
+        lo, hi = (np.percentile(boots[:, k], [2.5, 97.5]) if len(boots) else (elo[k], elo[k]))
         ratings.append({"player": p, "elo": round(float(elo[k]), 1), "lo": round(float(lo), 1),
                         "hi": round(float(hi), 1)})
     goals = _goals(cells, ratings, players, [a.name for a in arenas])
@@ -176,7 +222,7 @@ def main(argv: list[str] | None = None) -> int:
         row += f"{tw:>5}-{tl}-{td:<3} {100 * tw / max(tw + tl + td, 1):>3.0f}%"
         print(row)
     print()
-    print(f"{'player':<10} {'Elo':>6}  90 % interval")
+    print(f"{'player':<10} {'Elo':>6}  95 % interval")
     for r in sorted(ratings, key=lambda r: -r["elo"]):
         print(f"{r['player']:<10} {r['elo']:>6.0f}  [{r['lo']:.0f}, {r['hi']:.0f}]")
     print()
@@ -187,36 +233,52 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _goals(cells: list[dict], ratings: list[dict], players: list[str], arenas: list[str]) -> list[dict]:
-    """Issue 19's goals, each with the figures that decide it."""
+    """Issue 28's goals (and issue 30's for the novice), each with the figures that
+    decide it; on the point estimates."""
     out = []
 
-    def rate(a: str, b: str, arena: str) -> float | None:
+    def cell(a: str, b: str, arena: str) -> tuple[dict, bool] | None:
         for c in cells:
             if c["arena"] == arena and {c["a"], c["b"]} == {a, b}:
-                w = c["wins"] if c["a"] == a else c["losses"]
-                return w / (c["wins"] + c["losses"] + c["draws"])
+                return c, c["a"] == a
         return None
 
-    for level, need in (("hard", 0.7), ("normal", 0.5)):
-        for opp in ("robot", "camper"):
-            if level in players and opp in players:
-                rates = {n: rate(level, opp, n) for n in arenas}
-                worst = min(v for v in rates.values() if v is not None)
-                out.append({"goal": f"{level} wins >= {100 * need:.0f} % against {opp} on every arena",
-                            "value": ", ".join(f"{n} {100 * v:.0f} %" for n, v in rates.items()),
-                            "met": worst >= need})
+    def rate(a: str, b: str, arena: str) -> float | None:
+        found = cell(a, b, arena)
+        if found is None:
+            return None
+        c, first = found
+        return (c["wins"] if first else c["losses"]) / (c["wins"] + c["losses"] + c["draws"])
+
+    def every_arena(goal: str, a: str, b: str, need: float, of=rate) -> None:
+        if a in players and b in players:
+            rates = {n: of(a, b, n) for n in arenas}
+            out.append({"goal": goal, "value": ", ".join(f"{n} {100 * v:.0f} %" for n, v in rates.items()),
+                        "met": min(rates.values()) >= need})
+
+    for level, opp, need in (("hard", "robot", 0.7), ("hard", "camper", 0.7), ("hard", "duellist", 0.5),
+                             ("normal", "robot", 0.5)):
+        every_arena(f"{level} wins >= {100 * need:.0f} % against {opp} on every arena", level, opp, need)
+    draws = [(c["draw_rate"], f"{c['arena']} {c['a']}-{c['b']}") for c in cells]
+    if draws:
+        worst = max(draws)
+        out.append({"goal": "no cell with more than 1 in 6 duels drawn",
+                    "value": f"{sum(d > 1 / 6 for d, _ in draws)} of {len(draws)} cells over; most: {worst[1]} "
+                             f"{100 * worst[0]:.0f} %", "met": worst[0] <= 1 / 6})
     elo = {r["player"]: r["elo"] for r in ratings}
     for lo, hi in (("easy", "normal"), ("normal", "hard")):
         if lo in elo and hi in elo:
             out.append({"goal": f"{hi} >= 150 Elo above {lo}", "value": f"{elo[hi] - elo[lo]:+.0f}",
                         "met": elo[hi] - elo[lo] >= 150})
-    if "novice" in players and "easy" in players:
-        rates = {n: rate("novice", "easy", n) for n in arenas}
-        out.append({"goal": "novice wins >= 40 % against easy on every arena",
-                    "value": ", ".join(f"{n} {100 * v:.0f} %" for n, v in rates.items()),
-                    "met": min(rates.values()) >= 0.4})
-    return out
 
+    def scored(a: str, b: str, arena: str) -> float:
+        c, first = cell(a, b, arena)  # type: ignore[misc]
+        return c["scored"][0 if first else 1] / (c["wins"] + c["losses"] + c["draws"])
+
+    every_arena("novice wins >= 40 % against easy on every arena", "novice", "easy", 0.4)
+    every_arena("novice scores a kill in >= 80 % of duels against easy on every arena", "novice", "easy", 0.8,
+                of=scored)
+    return out
 
 if __name__ == "__main__":
     raise SystemExit(main())

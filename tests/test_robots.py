@@ -237,10 +237,19 @@ def test_elo_fit_orders_players_and_matches_the_expected_score():
 def test_a_short_ladder_runs_and_reports_its_goals(capsys):
     lad = _ladder()
     assert lad.main(["--duels", "1", "--seconds", "4", "--arenas", "box", "--players", "novice,easy,duellist",
-                     "--boot", "5", "--json"]) == 0
+                     "--boot", "5", "--generated", "none", "--json"]) == 0
     import json
 
     out = json.loads(capsys.readouterr().out)
     assert {c["a"] + "-" + c["b"] for c in out["cells"]} == {"novice-easy", "novice-duellist", "easy-duellist"}
-    assert [g for g in out["goals"] if g["goal"].startswith("novice wins")]
+    goals = {g["goal"] for g in out["goals"]}
+    assert "novice wins >= 40 % against easy on every arena" in goals
+    assert "novice scores a kill in >= 80 % of duels against easy on every arena" in goals
+    assert "no cell with more than 1 in 6 duels drawn" in goals
+    assert all(0 <= s <= 1 for c in out["cells"] for s in c["scored"])
     assert all(r["lo"] <= r["elo"] <= r["hi"] for r in out["elo"])
+
+
+def test_the_ladder_refuses_an_unknown_generated_level(capsys):
+    assert _ladder().main(["--duels", "1", "--arenas", "box", "--generated", "nowhere", "--json"]) == 2
+    assert capsys.readouterr().err.startswith("error: --generated: no level 'nowhere'")
