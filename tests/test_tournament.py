@@ -115,3 +115,12 @@ def test_it_does_not_overwrite_a_file_it_did_not_write(tmp_path):
                                  "--replays", str(tmp_path / "reps")])
     assert r.exit_code == 2 and "not a tanktool replay" in r.output
     assert (tmp_path / "reps" / name).read_text() == "mine"
+
+
+def test_ray_missing_is_one_error_line(monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "ray", None)        # as without the cluster extra
+    r = CliRunner().invoke(cli, ["tournament", "--bot", "easy", "--bot", "novice", "--matches", "1",
+                                 "--seconds", "1", "--no-replays", "--ray", "local"])
+    assert r.exit_code == 2 and "pip install 'tanktool[cluster]'" in r.output
