@@ -100,8 +100,8 @@ def test_seconds_ends_a_window_match(make_app, tmp_path):
 def test_views_and_overlays_toggle(app):
     goto(app, "start")
     press(app, pygame.K_RETURN)
-    press(app, pygame.K_F1)
-    press(app, pygame.K_F3)
+    press(app, pygame.K_F2)
+    press(app, pygame.K_F4)
     assert app.top.overlays == {"quadtree", "agents"}
     press(app, pygame.K_v)                 # 3D is not available on a plain window
     assert app.view == "top" and "OpenGL" in app.notice
@@ -205,9 +205,40 @@ def test_view_notices_stay_over_the_match(make_app):
     goto(app, "start")
     press(app, pygame.K_RETURN)
     app.view = "3d"                        # as if in the 3D view: an overlay key says where overlays show
-    press(app, pygame.K_F3)
+    press(app, pygame.K_F4)
     assert "overlays" in app.match_notice
     app.frame(0.016)
     press(app, pygame.K_ESCAPE)
     press(app, pygame.K_m)
     assert app.state == "menu" and "overlays" not in app.notice
+
+
+def test_a_first_start_offers_easy_and_shows_the_controls_once(make_app):
+    """No settings yet: the menu offers easy; the first match shows the controls
+    overlay (gone after its seconds, back on F1); the next start remembers both."""
+    from tanktool.game.controls import FIRST_S
+    from tanktool.game.quality import load_settings
+
+    app = make_app((480, 320), bots=1, difficulty=None)          # no --difficulty given
+    assert app.menu.difficulty.value == "easy"
+    goto(app, "difficulty")
+    press(app, pygame.K_RIGHT)                # normal
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    assert app.help_on
+    app.frame(0.016)
+    saved = load_settings()
+    assert saved.difficulty == "normal" and saved.controls_seen
+    for _ in range(int(FIRST_S / 0.25) + 2):
+        app.frame(0.25)
+    assert not app.help_on                    # it went by itself
+    press(app, pygame.K_F1)
+    assert app.help_on
+    app.frame(0.016)
+    press(app, pygame.K_F1)
+    assert not app.help_on
+    again = make_app((480, 320), bots=1, difficulty=None)
+    assert again.menu.difficulty.value == "normal"
+    goto(again, "start")
+    press(again, pygame.K_RETURN)
+    assert not again.help_on                  # seen once: only on F1 now

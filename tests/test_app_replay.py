@@ -138,7 +138,7 @@ def test_replay_in_the_window(window, tmp_path):
     press(app, pygame.K_m)                     # no menu in a replay
     assert app.state == "paused"
     press(app, pygame.K_p)
-    press(app, pygame.K_F1)
+    press(app, pygame.K_F2)
     press(app, pygame.K_TAB)
     assert app.session.focus() == 1 and "bot1" in app.match_notice
     drive(app, [((), 400)])                    # past the end: it stops there

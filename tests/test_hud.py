@@ -145,3 +145,29 @@ def test_no_crosshair_without_a_view(session):
     assert not any(r.colliderect(c) for r in rects)
     a = np.asarray(pygame.surfarray.pixels_alpha(surf.subsurface(c)))
     assert a.max() == 0
+
+
+def test_crosshair_sits_on_the_hit_point_and_never_leaves_the_screen(session):
+    """The crosshair and its landing ring are drawn where the predicted hit point
+    projects; a point above the screen (a hillside seen from below) is held inside it."""
+    me = session.world.tanks[0]
+    place(me, 30.0, 30.0, 0.0)
+    impact = predict(session.world, me).impact
+    centre = {}
+
+    def project(p, lift=0.0):
+        # a stand-in camera: the hit point at a chosen pixel, everything else far off
+        if np.allclose(p, impact):
+            return centre["at"][0], centre["at"][1], 0.5
+        return -9999.0, -9999.0, 0.5
+
+    for at in ((200.0, 150.0), (320.0, -400.0), (900.0, 500.0)):
+        centre["at"] = at
+        surf, rects = draw(session, project=project)
+        x = min(max(at[0], 24), SIZE[0] - 25)
+        y = min(max(at[1], 24), SIZE[1] - 25)
+        ring = pygame.Rect(int(x) - 9, int(y) - 9, 19, 19)
+        assert any(r.contains(ring) for r in rects), (at, rects)
+        assert all(surf.get_rect().contains(r) for r in rects)
+        a = np.asarray(pygame.surfarray.pixels_alpha(surf.subsurface(ring)))
+        assert a.max() > 0                       # the ring is drawn there

@@ -89,7 +89,8 @@ def test_mouse_button_fires_and_menu_actions_come_back():
     assert s.command().fire
     assert s.handle(key(pygame.K_p)) == ["pause"]
     assert s.handle(key(pygame.K_c)) == ["camera"]
-    assert s.handle(key(pygame.K_F2)) == ["overlay_navgrid"]
+    assert s.handle(key(pygame.K_F3)) == ["overlay_navgrid"]
+    assert s.handle(key(pygame.K_F1)) == ["help"]
     assert s.handle(key(pygame.K_w)) == []
 
 

@@ -105,14 +105,36 @@ def destroyed_shot(only: list[str] | None) -> None:
         r.release()
 
 
+def controls_shot(only: list[str] | None) -> None:
+    """A first match: the controls overlay over the 3D chase view, player in the hills."""
+    if only and "play-controls" not in only:
+        return
+    from tanktool.game.controls import controls_rows
+    from tanktool.game.hud import save_png, surface_from_rgb
+    from tanktool.game.input import Bindings
+    from tanktool.game.render3d import Renderer3D
+    from tanktool.game.session import GameSession
+
+    s = GameSession("hills", bots=3, seed=2, player=True)
+    for _ in range(90):
+        s.step()
+    r = Renderer3D(s, SIZE)
+    try:
+        pic = r.render(1.0, fps=0.0, controls=controls_rows(Bindings()))
+        print(save_png(surface_from_rgb(pic), DOCS / "play-controls.png"))
+    finally:
+        r.release()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", action="append",
-                    help="arena-box, play-3d, play-top, play-menu, play-settings, play-destroyed")
+                    help="arena-box, play-3d, play-top, play-menu, play-settings, play-destroyed, play-controls")
     args = ap.parse_args(argv)
     arena_shots(args.only)
     menu_shots(args.only)
     destroyed_shot(args.only)
+    controls_shot(args.only)
     return 0
 
 

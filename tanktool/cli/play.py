@@ -68,8 +68,9 @@ def _size(text: str) -> tuple[int, int]:
               help="Length of a match in simulated seconds: headless (default 60), in the window (each "
                    "match ends after it; default: when you quit), without a display (default 20).")
 @click.option("--seed", type=int, default=0, show_default=True, help="Random seed: same seed, same match.")
-@click.option("--difficulty", type=click.Choice(["easy", "normal", "hard"]), default="normal", show_default=True,
-              help="Computer opponents' skill: reaction time, aim noise, vision range (headless matches).")
+@click.option("--difficulty", type=click.Choice(["easy", "normal", "hard"]), default=None,
+              help="Computer opponents' skill: reaction time, aim noise, vision range (default: normal headless; "
+                   "in the window the menu's last choice, easy on a first start).")
 @click.option("--bot-driver", "bot_driver", type=click.Choice(["agent", "scripted"]), default="agent",
               show_default=True, help="Who drives the bots: the computer agent, or the old scripted bot (the baseline).")
 @click.option("--integrator", type=click.Choice(["semi-implicit", "euler"]), default="semi-implicit",
@@ -104,7 +105,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
          seed: int, integrator: str, report_path: Path | None, picture: Path | None, view: str,
          frames: int | None, screenshot: Path | None, size: str, fullscreen: bool,
          host: str | None = None, join: str | None = None, player_name: str | None = None,
-         password: str | None = None, difficulty: str = "normal", bot_driver: str = "agent",
+         password: str | None = None, difficulty: str | None = None, bot_driver: str = "agent",
          record_path: Path | None = None, replay_path: Path | None = None,
          time_limit: float | None = None, score_limit: int | None = None, quality: str | None = None) -> None:
     """Play a match: bots on an arena.
@@ -158,13 +159,18 @@ class _Options:
     screenshot: Path | None
     size: tuple[int, int]
     fullscreen: bool
-    difficulty: str
+    difficulty: str | None
     bot_driver: str
     record_path: Path | None
     replay_path: Path | None
     time_limit: float | None
     score_limit: int | None
     quality: str | None
+
+    @property
+    def level(self) -> str:
+        """The opponents' difficulty in a match without the window's menu."""
+        return self.difficulty or "normal"
 
     @property
     def limits(self) -> bool:
@@ -263,7 +269,7 @@ def _screenshot(o: _Options) -> None:
         raise click.UsageError("--frames needs --screenshot FILE.png")
     shot = take_screenshot(o.screenshot, view=o.view, frames=120 if o.frames is None else o.frames, arena=o.arena,
                            vehicle=o.vehicle, bots=8 if o.bots is None else o.bots, seed=o.seed, size=o.size,
-                           difficulty=o.difficulty, bot=o.bot_driver, quality=o.quality or "medium")
+                           difficulty=o.level, bot=o.bot_driver, quality=o.quality or "medium")
     echo(f"{shot['view']} view after {shot['frames']} frames: {shot['path']}")
 
 
@@ -328,10 +334,10 @@ def _play_headless(o: _Options) -> None:
             result, tape = record_match(info, spec, bots=bots, seconds=seconds, seed=o.seed,
                                         arena_ref=_stored_ref(_arena_ref(arena)), vehicle_ref=_stored_ref(vref),
                                         on_progress=bar.update, integrator=o.integrator, bot=o.bot_driver,
-                                        difficulty=o.difficulty, **_limit_options(o.time_limit, o.score_limit))
+                                        difficulty=o.level, **_limit_options(o.time_limit, o.score_limit))
         else:
             result = run_match(info, spec, bots=bots, seconds=seconds, seed=o.seed, integrator=o.integrator,
-                               on_progress=bar.update, bot=o.bot_driver, difficulty=o.difficulty,
+                               on_progress=bar.update, bot=o.bot_driver, difficulty=o.level,
                                time_limit=o.time_limit, score_limit=o.score_limit)
     report = result.report
     echo(scoreboard(report))

@@ -26,6 +26,7 @@ import pygame  # noqa: E402
 
 from ..errors import TanktoolError  # noqa: E402
 from .config import DEFAULT_SIZE, MatchConfig  # noqa: E402
+from .controls import controls_rows  # noqa: E402
 from .display import (DisplayError, NoDisplay, Presenter, display_problem, stale_display,  # noqa: E402,F401
                       x_display_socket)
 from .input import PAUSE_KEYS, Bindings, InputState, load_bindings, save_bindings, screen_action  # noqa: E402
@@ -77,6 +78,9 @@ class App:
         #: match view (camera, view, overlays), shown only over the match
         self.notice = ""
         self.match_notice = ""
+        #: the controls overlay is up (F1); over a first match it goes by itself at ``help_until`` [s]
+        self.help_on = False
+        self.help_until: float | None = None
         self.session: GameSession | None = None
         self.view = cfg.view.mode
         self.top = None
@@ -108,7 +112,8 @@ class App:
         menu.vehicle.set(vehicle or default_vehicle())
         menu.bots.set(min(max(cfg.opponents.count, 0), 7))
         menu.view.set(cfg.view.mode)
-        menu.difficulty.set(cfg.opponents.difficulty)
+        # a first start offers easy; then the menu's last choice (--difficulty wins)
+        menu.difficulty.set(cfg.opponents.difficulty or self.settings.difficulty or "easy")
         res = f"{size[0]}x{size[1]}"
         if res not in menu.resolution.options:
             menu.resolution.options.insert(0, res)
@@ -203,7 +208,21 @@ class App:
                                    bot=self.config.opponents.driver, rules=self.config.rules)
         if self.record_path is not None:
             self.session.record()
+        self._first_start_settings()
         self._begin(str(m.view.value))
+
+    def _first_start_settings(self) -> None:
+        """Remember the difficulty played; over a first match, the controls overlay."""
+        from .controls import FIRST_S
+
+        s, changed = self.settings, False
+        if s.difficulty != self.menu.difficulty.value:
+            s.difficulty, changed = str(self.menu.difficulty.value), True
+        if not s.controls_seen:
+            s.controls_seen, changed = True, True
+            self.help_on, self.help_until = True, FIRST_S
+        if changed:
+            self.save_settings()
 
     def _begin(self, view: str) -> None:
         self._make_views(view)
@@ -380,6 +399,8 @@ class App:
                 self.state = "paused"
             elif a == "quit":
                 self.state = "quit"
+            elif a == "help":
+                self.help_on, self.help_until = not self.help_on, None
             elif a == "camera" and self.r3d is not None:
                 self.match_notice = f"camera: {self.r3d.toggle_camera()}"
             elif a == "view":
@@ -561,11 +582,14 @@ class App:
             self._notice_seen, self._notice_t, self._notice_text = seen, time.perf_counter(), newest
         fresh = self.replay_done or time.perf_counter() - self._notice_t < NOTICE_S
         msg = paused if self.state == "paused" else (self._notice_text if self._notice_text and fresh else None)
+        if self.help_until is not None and self.session.t >= self.help_until:
+            self.help_on, self.help_until = False, None
+        controls = controls_rows(self.input.bindings) if self.help_on else None
         if self.view == "3d" and self.r3d is not None:
-            self.r3d.render(self.alpha, self.fps, msg)
+            self.r3d.render(self.alpha, self.fps, msg, controls=controls)
             pygame.display.flip()
         else:
-            self.top.draw(canvas, self.alpha, self.fps, msg)
+            self.top.draw(canvas, self.alpha, self.fps, msg, controls=controls)
             self.presenter.show(canvas)
 
 

@@ -25,11 +25,12 @@ DEFAULT_SIZE = (1280, 720)
 
 @dataclass
 class Opponents:
-    """The computer tanks: how many, how good, and who drives them ("agent": the
-    ``sim.agents`` computer player; "scripted": the old scripted bot)."""
+    """The computer tanks: how many, how good (None: the menu's last choice, "easy" on
+    a first start), and who drives them ("agent": the ``sim.agents`` computer player;
+    "scripted": the old scripted bot)."""
 
     count: int = 3
-    difficulty: str = "normal"
+    difficulty: str | None = None
     driver: str = "agent"
 
 

@@ -6,8 +6,9 @@ What it shows, for the followed tank (the player's, or the one a replay rides wi
 * health and reload bars, name and hit points (bottom left);
 * kills and deaths with their labels, frame rate, match time (top left);
 * the scoreboard, K and D columns (top right) and under it the **kill feed**;
-* the **crosshair** where the gun points and a ring where its shell would land
-  (red when it would hit a tank), from game/aim.py; a hit marker when your shell hits;
+* the **crosshair** on the point the shell would hit now, with the landing ring on it
+  (red when it would hit a tank), from game/aim.py (the simulation's own ``fire``),
+  never off the screen; a hit marker when your shell hits;
 * **hit-direction markers**: an arc towards whoever just hit you, fading;
 * **"DESTROYED by ... / respawn in N s"** across the middle while you are a wreck;
   a spawn-protection line while the simulation says you are protected
@@ -44,6 +45,8 @@ HIT_MARK_S = 1.6
 HIT_CONFIRM_S = 0.35
 FEED_SHOW_S = 6.0
 FEED_LINES = 5
+#: the crosshair stays this many pixels inside the screen's edge
+EDGE = 24
 _CACHE: "OrderedDict[tuple, pygame.Surface]" = OrderedDict()
 _CACHE_MAX = 600
 
@@ -172,13 +175,14 @@ class Hud:
              message: str | None = None, view: str = "",
              project: Callable[[Any], tuple[float, float, float]] | None = None,
              facing: float | None = None, to_px: Callable[[float, float], tuple[float, float]] | None = None,
-             ) -> list["pygame.Rect"]:
+             controls: list[tuple[str, str]] | None = None) -> list["pygame.Rect"]:
         """Draw the HUD; return the rectangles it covers (the 3D view blends only those:
         a full-window blend costs a software renderer more than the scene).
 
         ``project`` maps a world point to (column, row, depth) in the 3D view; the top
         view passes ``to_px`` (world x, z to pixels) instead; ``facing`` is the 3D
-        camera's heading (None in the top view)."""
+        camera's heading (None in the top view); ``controls``: the controls overlay's rows
+        (game/controls.py), drawn when given."""
         w, h = self.size
         focus = session.focus_tank()
         now = float(session.t)
@@ -202,6 +206,10 @@ class Hud:
         self.minimap.draw(surface, session, topleft, alpha)
         rects.append(pygame.Rect(topleft, mm))
         rects += self._status(surface, session, focus, now)
+        if controls:
+            from .controls import draw_controls
+
+            rects.append(draw_controls(surface, controls))
         if message:
             # a quarter down the screen: the crosshair and the respawn count are at its middle
             m = text(surface, message, (w // 2, h // 4 + 24), 48, anchor="center")
@@ -265,47 +273,51 @@ class Hud:
 
     def _crosshair(self, surface: "pygame.Surface", session: Any, focus: Any,
                    project: Callable | None, to_px: Callable | None) -> list["pygame.Rect"]:
+        """The crosshair on the point the shell would hit now (the simulation's own
+        ``fire``, game/aim.py) with the landing ring on it; red when that is a tank.
+        Kept inside the screen: a point off it is drawn at the edge, towards it."""
         if not focus.alive or (project is None and to_px is None):
             return []
         from .aim import predict
 
         aim = predict(session.world, focus)
-        out = []
-        hot = aim.target is not None
-        colour = RED if hot else (250, 250, 240)
-
-        def px(p):
-            if project is not None:
-                cx, cy, depth = project(p)
-                return (cx, cy) if -1.0 < depth < 1.0 else None
-            return to_px(p[0], p[2])
-
-        c = px(aim.aim)
-        if c is not None:
-            x, y = int(c[0]), int(c[1])
-            for dx, dy in ((1, 0), (-1, 0), (0, 1), (0, -1)):
-                a = (x + dx * 5, y + dy * 5)
-                b = (x + dx * 14, y + dy * 14)
-                pygame.draw.line(surface, SHADOW, (a[0] + 1, a[1] + 1), (b[0] + 1, b[1] + 1), 3)
-                pygame.draw.line(surface, colour, a, b, 2)
-            out.append(pygame.Rect(x - 16, y - 16, 34, 34))
-            if any(e.kind == "hit" and e.tank == focus.index and session.t - e.t < HIT_CONFIRM_S
-                   for e in getattr(session, "feed", [])):
-                for sx, sy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):     # a hit marker: your shell struck
-                    pygame.draw.line(surface, (255, 220, 80), (x + 6 * sx, y + 6 * sy), (x + 11 * sx, y + 11 * sy), 2)
-        i = px(aim.impact)
-        if i is not None:
-            x, y = int(i[0]), int(i[1])
-            pygame.draw.circle(surface, SHADOW, (x + 1, y + 1), 7, 2)
-            pygame.draw.circle(surface, colour, (x, y), 7, 2)
-            pygame.draw.circle(surface, colour, (x, y), 1)
-            out.append(pygame.Rect(x - 9, y - 9, 19, 19))
-        if to_px is not None and c is not None:          # top view: the line of fire
+        colour = RED if aim.target is not None else (250, 250, 240)
+        c = self._on_screen(aim.impact, project, to_px)
+        if c is None:                            # behind the camera: where the barrel points
+            c = self._on_screen(aim.aim, project, to_px)
+        if c is None:
+            return []
+        x, y = c
+        for dx, dy in ((1, 0), (-1, 0), (0, 1), (0, -1)):
+            a = (x + dx * 10, y + dy * 10)
+            b = (x + dx * 18, y + dy * 18)
+            pygame.draw.line(surface, SHADOW, (a[0] + 1, a[1] + 1), (b[0] + 1, b[1] + 1), 3)
+            pygame.draw.line(surface, colour, a, b, 2)
+        pygame.draw.circle(surface, SHADOW, (x + 1, y + 1), 7, 2)      # the landing ring, on the hit point
+        pygame.draw.circle(surface, colour, (x, y), 7, 2)
+        pygame.draw.circle(surface, colour, (x, y), 1)
+        out = [pygame.Rect(x - 20, y - 20, 42, 42)]
+        if any(e.kind == "hit" and e.tank == focus.index and session.t - e.t < HIT_CONFIRM_S
+               for e in getattr(session, "feed", [])):
+            for sx, sy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):     # a hit marker: your shell struck
+                pygame.draw.line(surface, (255, 220, 80), (x + 9 * sx, y + 9 * sy), (x + 15 * sx, y + 15 * sy), 2)
+        if to_px is not None:                    # top view: the line of fire
             m = to_px(aim.muzzle[0], aim.muzzle[2])
-            end = i if i is not None else c
-            r = pygame.draw.line(surface, colour + (120,), m, end, 1)
-            out.append(r)
+            out.append(pygame.draw.line(surface, colour + (120,), m, (x, y), 1))
         return out
+
+    def _on_screen(self, p: tuple[float, float, float], project: Callable | None,
+                   to_px: Callable | None) -> tuple[int, int] | None:
+        """A world point in pixels, held ``EDGE`` pixels inside the screen; None when it is
+        behind the 3D camera."""
+        if project is not None:
+            cx, cy, depth = project(p)
+            if not -1.0 < depth < 1.0 or not (math.isfinite(cx) and math.isfinite(cy)):
+                return None
+        else:
+            cx, cy = to_px(p[0], p[2])
+        w, h = self.size
+        return (int(min(max(cx, EDGE), w - 1 - EDGE)), int(min(max(cy, EDGE), h - 1 - EDGE)))
 
     def _hit_markers(self, surface: "pygame.Surface", session: Any, focus: Any, facing: float | None,
                      now: float) -> list["pygame.Rect"]:

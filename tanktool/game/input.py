@@ -32,7 +32,7 @@ from ..errors import FormatError
 from ..sim.commands import Command
 
 DRIVE_ACTIONS = ("advance", "reverse", "turn_left", "turn_right", "strafe_left", "strafe_right", "fire")
-MENU_ACTIONS = ("pause", "camera", "view", "overlay_quadtree", "overlay_navgrid", "overlay_agents", "quit")
+MENU_ACTIONS = ("pause", "help", "camera", "view", "overlay_quadtree", "overlay_navgrid", "overlay_agents", "quit")
 ACTIONS = DRIVE_ACTIONS + MENU_ACTIONS
 
 DEFAULTS: dict[str, list[str]] = {
@@ -44,11 +44,12 @@ DEFAULTS: dict[str, list[str]] = {
     "strafe_right": ["key:e", "joybutton:5"],
     "fire": ["key:space", "joybutton:0", "mouse:1"],
     "pause": ["key:p", "key:escape", "joybutton:7"],
+    "help": ["key:f1", "joybutton:6"],
     "camera": ["key:c", "joybutton:3"],
     "view": ["key:v"],
-    "overlay_quadtree": ["key:f1"],
-    "overlay_navgrid": ["key:f2"],
-    "overlay_agents": ["key:f3"],
+    "overlay_quadtree": ["key:f2"],
+    "overlay_navgrid": ["key:f3"],
+    "overlay_agents": ["key:f4"],
     "quit": ["key:f10"],
 }
 INPUT_NAME = re.compile(r"^(key:.+|mouse:\d{1,4}|mouse:[xy][+-]|joybutton:\d{1,4}|joyaxis:\d{1,4}[+-])$")

@@ -103,6 +103,11 @@ class Settings:
     resolution: str = "1280x720"
     fullscreen: bool = False
     name: str = ""
+    #: the menu's last difficulty; None before the player ever started a match (a first
+    #: start: the menu offers "easy")
+    difficulty: str | None = None
+    #: the controls overlay was shown at a first start (it then shows on F1 only)
+    controls_seen: bool = False
 
     def graphics(self) -> Quality:
         q = preset(self.quality)
@@ -116,6 +121,9 @@ class Settings:
             d["shadows"] = self.shadows
         if self.particles is not None:
             d["particles"] = self.particles
+        if self.difficulty is not None:
+            d["difficulty"] = self.difficulty
+        d["controls_seen"] = self.controls_seen
         return d
 
 
@@ -135,7 +143,8 @@ def load_settings(path: str | os.PathLike | None = None) -> Settings:
         return Settings()
     doc = read_toml(path)
     s = Settings()
-    allowed = {"quality": tuple(PRESETS), "shadows": SHADOWS, "particles": PARTICLES}
+    allowed = {"quality": tuple(PRESETS), "shadows": SHADOWS, "particles": PARTICLES,
+               "difficulty": ("easy", "normal", "hard")}
     for key, options in allowed.items():
         if key in doc:
             v = doc[key]
@@ -147,10 +156,11 @@ def load_settings(path: str | os.PathLike | None = None) -> Settings:
         if not (isinstance(v, str) and re.fullmatch(r"\d{2,5}x\d{2,5}", v)):
             raise FormatError(f"{path}: resolution must be like \"1280x720\", got {v!r}")
         s.resolution = v
-    if "fullscreen" in doc:
-        if not isinstance(doc["fullscreen"], bool):
-            raise FormatError(f"{path}: fullscreen must be true or false, got {doc['fullscreen']!r}")
-        s.fullscreen = doc["fullscreen"]
+    for key in ("fullscreen", "controls_seen"):
+        if key in doc:
+            if not isinstance(doc[key], bool):
+                raise FormatError(f"{path}: {key} must be true or false, got {doc[key]!r}")
+            setattr(s, key, doc[key])
     if "name" in doc:
         v = doc["name"]
         if not (isinstance(v, str) and (v == "" or NAME_CHARS.match(v))):

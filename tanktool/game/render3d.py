@@ -491,14 +491,14 @@ class Renderer3D:
 
     # ------------------------------------------------------------------ frame
     def render(self, alpha: float = 1.0, fps: float = 0.0, message: str | None = None,
-               hud: bool = True) -> np.ndarray | None:
+               hud: bool = True, controls: list[tuple[str, str]] | None = None) -> np.ndarray | None:
         """Draw one frame; headless, return it as an (h, w, 3) uint8 array (top row first)."""
         import moderngl
 
         ctx, s = self.ctx, self.session
         proj, view, eye = self.matrices(alpha)
         pv = proj @ view
-        hud_rects = self._prepare_hud(fps, alpha, message) if hud else []
+        hud_rects = self._prepare_hud(fps, alpha, message, controls) if hud else []
         self.effects.sync(s, self.floor_y)
         if self.shadow_fbo is not None:
             self._shadow_pass(alpha)
@@ -651,7 +651,8 @@ class Renderer3D:
             buf = getattr(self, name)
         buf.write(data)
 
-    def _prepare_hud(self, fps: float, alpha: float, message: str | None) -> list[Any]:
+    def _prepare_hud(self, fps: float, alpha: float, message: str | None,
+                     controls: list[tuple[str, str]] | None = None) -> list[Any]:
         """Draw the HUD on its surface and upload the rectangles it covers, before the
         scene: a texture upload waits for the rasteriser, so done after the scene it
         would stall the frame."""
@@ -666,7 +667,7 @@ class Renderer3D:
         for r in self._hud_rects:                 # clear only what the last frame drew
             surf.fill((0, 0, 0, 0), r)
         rects = self._hud.draw(surf, self.session, fps, alpha, message, view=f"3D {self.camera}",
-                               project=self.project, facing=self.camera_yaw())
+                               project=self.project, facing=self.camera_yaw(), controls=controls)
         self._hud_rects = rects
         self.hud_tex = self.hud_texs[1] if self.hud_tex is self.hud_texs[0] else self.hud_texs[0]
         for r in rects:

@@ -182,7 +182,8 @@ class TopView:
         return surf
 
     # ------------------------------------------------------------------ frame
-    def draw(self, surface: pygame.Surface, alpha: float = 1.0, fps: float = 0.0, message: str | None = None) -> None:
+    def draw(self, surface: pygame.Surface, alpha: float = 1.0, fps: float = 0.0, message: str | None = None,
+             controls: list[tuple[str, str]] | None = None) -> None:
         s = self.session
         surface.blit(self.base, (0, 0))
         if "quadtree" in self.overlays:
@@ -209,7 +210,7 @@ class TopView:
             radius = {"flash": 1.5, "impact": 1.2, "explosion": 5.0}[e.kind] * self.scale * (0.4 + a)
             colour = {"flash": (255, 230, 140), "impact": (255, 150, 60), "explosion": (255, 110, 30)}[e.kind]
             pygame.draw.circle(surface, colour, self.to_px(e.x, e.z), max(int(radius), 2), 0 if a < 0.5 else 2)
-        self.hud.draw(surface, s, fps, alpha, message, view="top view", to_px=self.to_px)
+        self.hud.draw(surface, s, fps, alpha, message, view="top view", to_px=self.to_px, controls=controls)
 
     def _draw_tank(self, surface: pygame.Surface, t: Any, alpha: float) -> None:
         x, z, h = self.session.pose(t.index, alpha)
