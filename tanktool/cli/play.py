@@ -71,6 +71,10 @@ def _size(text: str) -> tuple[int, int]:
 @click.option("--difficulty", type=click.Choice(["easy", "normal", "hard"]), default=None,
               help="Computer opponents' skill: reaction time, aim noise, vision range (default: normal headless; "
                    "in the window the menu's last choice, easy on a first start).")
+@click.option("--bot", "bot_specs", multiple=True, metavar="NAME|FILE.py:Class",
+              help="A bot driving a computer tank (repeat for more): easy, normal, hard, robot, camper, duellist, "
+                   "novice, or a bot class in a file (docs/bots.md); --bots fills the other tanks with "
+                   "--difficulty agents.")
 @click.option("--bot-driver", "bot_driver", type=click.Choice(["agent", "scripted"]), default="agent",
               show_default=True, help="Who drives the bots: the computer agent, or the old scripted bot (the baseline).")
 @click.option("--integrator", type=click.Choice(["semi-implicit", "euler"]), default="semi-implicit",
@@ -107,7 +111,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
          host: str | None = None, join: str | None = None, player_name: str | None = None,
          password: str | None = None, difficulty: str | None = None, bot_driver: str = "agent",
          record_path: Path | None = None, replay_path: Path | None = None,
-         time_limit: float | None = None, score_limit: int | None = None, quality: str | None = None) -> None:
+         time_limit: float | None = None, score_limit: int | None = None, quality: str | None = None,
+         bot_specs: tuple[str, ...] = ()) -> None:
     """Play a match: bots on an arena.
 
     \b
@@ -120,10 +125,13 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
       tanktool play --replay match.ttr --report again.json --picture end.png
       tanktool play --arena maze --record mine.ttr      (the window; the file holds the last match)
       tanktool play --replay mine.ttr                   (watch it in the window)
+      tanktool play --headless --bot examples/bots/sniper.py:Sniper --bot hard --bots 4
     """
     opts = _Options(headless, arena, vehicle, bots, seconds, seed, integrator, report_path, picture, view, frames,
                     screenshot, _size(size), fullscreen, difficulty, bot_driver, record_path, replay_path,
-                    time_limit, score_limit, quality)
+                    time_limit, score_limit, quality, tuple(bot_specs))
+    if bot_specs:
+        _check_bots(opts, host is not None or join is not None)
     if host is not None or join is not None:
         _play_network(opts, host, join, player_name, password)
         return
@@ -166,6 +174,7 @@ class _Options:
     time_limit: float | None
     score_limit: int | None
     quality: str | None
+    bot_specs: tuple[str, ...] = ()
 
     @property
     def level(self) -> str:
@@ -184,12 +193,32 @@ def window_config(o: _Options, replay: Any = None) -> "MatchConfig":
     from ..sim.match import match_rules
 
     rules = match_rules(None, o.time_limit, o.score_limit) if o.limits else None
+    count = max(3 if o.bots is None else max(o.bots - 1, 0), len(o.bot_specs))
     return MatchConfig(arena=o.arena, vehicle=o.vehicle,
-                       opponents=Opponents(3 if o.bots is None else max(o.bots - 1, 0), o.difficulty, o.bot_driver),
+                       opponents=Opponents(count, o.difficulty, o.bot_driver, tuple(o.bot_specs)),
                        seed=o.seed, rules=rules, seconds=o.seconds,
                        view=ViewConfig(o.view, o.size, o.fullscreen, o.quality),
                        recording=Recording(record=o.record_path, replay=replay,
                                            replay_name=str(o.replay_path or "")))
+
+
+def _check_bots(o: _Options, network: bool) -> None:
+    """--bot: where it applies, and every bot loaded once (a bad one is one error line)."""
+    from ..sim.bots.lineup import lineup
+
+    if network:
+        raise click.UsageError("--bot: network matches do not take bots from files yet; play them headless or "
+                               "in the window")
+    if o.frames is not None or o.screenshot is not None:
+        raise click.UsageError("--bot plays a match; --frames/--screenshot render a picture (use --picture)")
+    if o.replay_path is not None:
+        click.echo("warning: --bot ignored: a replay plays the recorded commands", err=True)
+        o.bot_specs = ()
+        return
+    if o.bots is not None and o.bots < len(o.bot_specs) + (0 if o.headless else 1):
+        raise click.UsageError(f"--bots {o.bots} leaves no tank for {len(o.bot_specs)} --bot "
+                               f"(it counts every tank{'' if o.headless else ', yours too'})")
+    lineup(o.bot_specs)
 
 
 def _play_network(o: _Options, host: str | None, join: str | None, player_name: str | None,
@@ -303,8 +332,16 @@ def _play_headless(o: _Options) -> None:
     from ..sim.match import (choose_vehicle, default_vehicle, format_report, load_match_arena, load_tank_spec,
                              run_match, scoreboard)
 
-    bots = 8 if o.bots is None else o.bots
+    bots = max(8, len(o.bot_specs)) if o.bots is None else o.bots
     seconds = o.seconds if o.seconds is not None else o.time_limit if o.time_limit is not None else 60.0
+    wrap = None
+    if o.bot_specs:         # --bot: the first tanks are those bots, the others --difficulty agents
+        from ..sim.bots.lineup import lineup, seat
+
+        listed = lineup(o.bot_specs)
+
+        def wrap(world: Any, drivers: list) -> list:
+            return seat(world, listed, 0, drivers)
     arena, vehicle, replay = o.arena, o.vehicle, None
     if o.replay_path is not None:
         from ..sim.replay import read_replay
@@ -334,11 +371,13 @@ def _play_headless(o: _Options) -> None:
             result, tape = record_match(info, spec, bots=bots, seconds=seconds, seed=o.seed,
                                         arena_ref=_stored_ref(_arena_ref(arena)), vehicle_ref=_stored_ref(vref),
                                         on_progress=bar.update, integrator=o.integrator, bot=o.bot_driver,
-                                        difficulty=o.level, **_limit_options(o.time_limit, o.score_limit))
+                                        difficulty=o.level, wrap_drivers=wrap,
+                                        extra={"bot_specs": list(o.bot_specs)} if o.bot_specs else None,
+                                        **_limit_options(o.time_limit, o.score_limit))
         else:
             result = run_match(info, spec, bots=bots, seconds=seconds, seed=o.seed, integrator=o.integrator,
                                on_progress=bar.update, bot=o.bot_driver, difficulty=o.level,
-                               time_limit=o.time_limit, score_limit=o.score_limit)
+                               time_limit=o.time_limit, score_limit=o.score_limit, wrap_drivers=wrap)
     report = result.report
     echo(scoreboard(report))
     timing = report["timing"]

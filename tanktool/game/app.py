@@ -203,9 +203,10 @@ class App:
         if m.network.value != "off":
             self.start_network()
             return
-        self.session = GameSession(m.arena.value, m.vehicle.value, bots=int(m.bots.value), seed=self.config.seed,
-                                   difficulty=str(m.difficulty.value), player=True,
-                                   bot=self.config.opponents.driver, rules=self.config.rules)
+        bots = self.config.opponents.bots       # play --bot: the first computer tanks
+        self.session = GameSession(m.arena.value, m.vehicle.value, bots=max(int(m.bots.value), len(bots)),
+                                   seed=self.config.seed, difficulty=str(m.difficulty.value), player=True,
+                                   bot=self.config.opponents.driver, rules=self.config.rules, bot_specs=bots)
         if self.record_path is not None:
             self.session.record()
         self._first_start_settings()

@@ -27,11 +27,13 @@ DEFAULT_SIZE = (1280, 720)
 class Opponents:
     """The computer tanks: how many, how good (None: the menu's last choice, "easy" on
     a first start), and who drives them ("agent": the ``sim.agents`` computer player;
-    "scripted": the old scripted bot)."""
+    "scripted": the old scripted bot); ``bots``: bot specs (``play --bot``) driving the
+    first computer tanks, the others as above."""
 
     count: int = 3
     difficulty: str | None = None
     driver: str = "agent"
+    bots: tuple[str, ...] = ()
 
 
 @dataclass

@@ -104,16 +104,18 @@ class GameSession:
     bot : "agent" (``sim.agents.Agent`` at ``difficulty``) or "scripted" (the simple bot)
     drivers : optional drivers for the computer tanks, instead of ``bot``
     rules : the match's ``sim.rules.Rules`` (None: the default rules)
+    bot_specs : bots (``play --bot``: names or FILE.py:Class) driving the first computer tanks
     """
 
     def __init__(self, arena: str | Path | None = None, vehicle: str | Path | None = None, bots: int = 3,
                  seed: int = 0, difficulty: str = "normal", player: bool = True,
-                 drivers: Sequence[Driver] | None = None, bot: str = "agent", rules: Any = None) -> None:
+                 drivers: Sequence[Driver] | None = None, bot: str = "agent", rules: Any = None,
+                 bot_specs: Sequence[str] = ()) -> None:
         from ..errors import TanktoolError
         from ..sim.match import choose_vehicle, default_arena, load_match_arena, load_tank_spec, make_bots
 
         self._args = dict(arena=arena, vehicle=vehicle, bots=bots, seed=seed, difficulty=difficulty,
-                          player=player, drivers=drivers, bot=bot, rules=rules)
+                          player=player, drivers=drivers, bot=bot, rules=rules, bot_specs=tuple(bot_specs))
         if difficulty not in DIFFICULTY:
             raise TanktoolError(f"difficulty must be one of {', '.join(DIFFICULTY)}, got {difficulty!r}")
         self.arena_ref = arena or default_arena()
@@ -142,6 +144,12 @@ class GameSession:
                     d.period, d.aim_spread, d.sight = 1.0 / hz, math.radians(spread), sight
             if player:
                 self.drivers[0] = None
+        if bot_specs:
+            from ..sim.bots.lineup import lineup, seat
+
+            if len(bot_specs) > bots:
+                raise TanktoolError(f"{len(bot_specs)} bots named for {bots} computer tanks")
+            self.drivers = seat(self.world, lineup(bot_specs), 1 if player else 0, self.drivers)
         self.effects: list[Effect] = []
         #: hits, kills and respawns of the last few seconds (kill feed, hit markers)
         self.feed: list[Event] = []

@@ -439,19 +439,27 @@ def read_replay(path: str | os.PathLike) -> Replay:
 def record_match(arena: "ArenaInfo", spec: "TankSpec", *, bots: int, seconds: float, seed: int,
                  arena_ref: str | None = None, vehicle_ref: str | None = None,
                  on_progress: Callable[[int], None] | None = None,
+                 wrap_drivers: Callable[["World", list], list] | None = None,
+                 extra: dict[str, Any] | None = None,
                  **options: Any) -> tuple["MatchResult", Replay]:
     """Run a match with :func:`run_match` (``options``: integrator, dt, bot kind,
-    difficulty, ...) and record it."""
+    difficulty, ...) and record it; ``wrap_drivers`` changes the drivers before the
+    recorder wraps them (``play --bot``), ``extra`` goes into the header."""
     from .match import run_match
 
     rec = Recorder()
+
+    def wrap(world: "World", drivers: list) -> list:
+        return rec.wrap(world, drivers if wrap_drivers is None else wrap_drivers(world, drivers))
+
     result = run_match(arena, spec, bots=bots, seconds=seconds, seed=seed, on_progress=on_progress,
-                       wrap_drivers=rec.wrap, **options)
+                       wrap_drivers=wrap, **options)
     w = result.world
     if w.match.over:            # ended on a limit: the recording is as long as the match was
         seconds = w.steps * w.dt
     header = match_header(arena, spec, w, seconds=seconds, seed=seed, arena_ref=arena_ref,
-                          vehicle_ref=vehicle_ref, options=options, winner=result.report.get("winner"))
+                          vehicle_ref=vehicle_ref, options=options, winner=result.report.get("winner"),
+                          **(extra or {}))
     return result, rec.replay(header)
 
 
