@@ -4,8 +4,10 @@ The walkable surface (:mod:`tanktool.nav.walkable`) says where a tank can stand,
 by cell.  Its walls are drawn per *region*: a connected piece of one level (cells of
 the level joined by links that stay on the level).  For each region:
 
-* ``V``: the outline of its cells, simplified (Douglas-Peucker, ``SIMPLIFY`` cells) so
-  that a staircase of cells along a slanted edge becomes one straight wall;
+* ``V``: the outline of its cells, simplified as Recast simplifies contours (at most
+  ``EDGE_ERROR`` cells off the cells' outline, edges over a curve no longer than
+  ``EDGE_MAX_LEN``: :mod:`tanktool.geometry.contours`) so that a staircase of cells
+  along a slanted edge or a hillside becomes a few straight walls;
 * where the region is flat (cells whose surface is a horizontal face at a height
   ``h`` shared by horizontal faces of the model), the exact free space ``E_h`` of
   today's 2002 cut replaces the cells near them (``M_h``: those cells grown by
@@ -34,12 +36,15 @@ import numpy as np
 import shapely
 
 from ..formats.walls_txt import WallList, aux_rectangle
+from ..geometry import contours
 from ..geometry import walls as cut
 from ..geometry.heightfield import FLAT_GAP, flat_heights
 from .walkable import DIRS, Surface, surface_layers
 
-#: simplification of cell outlines, in cells
-SIMPLIFY = 0.6
+#: simplification of cell outlines as Recast does: the maximum edge error (cells) and
+#: the maximum edge length (m) of :func:`tanktool.geometry.contours.simplify_contour`
+EDGE_ERROR = contours.EDGE_ERROR
+EDGE_MAX_LEN = contours.EDGE_MAX_LEN
 #: exact free space replaces the cells' outline this far (cells) around flat cells:
 #: the foot of a steep obstacle (free below the cut, too low for a tank in the cells)
 #: can be two cells wide
@@ -231,8 +236,14 @@ def _portal_pieces(pieces: np.ndarray, level: int, region_cells: np.ndarray, sur
 
 
 def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_height: float,
-                headroom: float, climb_m: float, tolerance: float, max_slope: float) -> LevelWalls:
-    """Walls of every region of the surface's main region (see the module docstring)."""
+                headroom: float, climb_m: float, tolerance: float, max_slope: float,
+                edge_error: float = EDGE_ERROR, edge_max_len: float | None = EDGE_MAX_LEN,
+                smooth_margin: bool = True) -> LevelWalls:
+    """Walls of every region of the surface's main region (see the module docstring).
+    ``edge_error`` (cells) and ``edge_max_len`` (m, None: no limit) simplify the
+    cells' outlines; ``smooth_margin`` simplifies the margins ``M_h`` so too (False,
+    with ``edge_error=0.6, edge_max_len=None``: the walls before Recast's
+    simplification, for bench/walls.py)."""
     from scipy import ndimage
 
     hf = surface.hf
@@ -261,7 +272,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
             cells = labels == k
             ys = height[level][cells]
             V = cells_polygon(cells, origin, cell, tolerance)
-            V = shapely.simplify(V, SIMPLIFY * cell, preserve_topology=True)
+            V = contours.simplify_contour(V, edge_error * cell, edge_max_len)
             exact_parts, removed, chains_in = [], [], []
             used_h = []
             floor = np.zeros_like(cells)  # cells of the exact floors (their walls are the cut's)
@@ -290,14 +301,21 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
                     mask |= rim & (np.abs(height[level] - flat_h[c]) <= climb_m)
                     floor |= mask
                     sub, sub_origin = _crop(mask, _mask_box(mask, origin, cell, MARGIN + 1), origin, cell)
-                    M = shapely.buffer(cells_polygon(sub, sub_origin, cell, tolerance), MARGIN * cell,
-                                       join_style="mitre")
+                    # simplified as V is: where the exact floor reaches past the region's cells
+                    # (a walkable face beside a steep one in the same cell), M's outline is
+                    # the region's, and a staircase there is voxel steps again
+                    M = cells_polygon(sub, sub_origin, cell, tolerance)
+                    M = shapely.buffer(contours.simplify_contour(M, edge_error * cell, edge_max_len)
+                                       if smooth_margin else M, MARGIN * cell, join_style="mitre")
                     box = M.bounds
                     # the region's other cells (terrain, ramps rising from the floor or
                     # coming up to a deck) are no obstacle of this floor: their outline stays
                     rising = _crop(cells & ~mask, box, origin, cell)
                     if rising is not None:
-                        M = shapely.difference(M, cells_polygon(rising[0], rising[1], cell, tolerance))
+                        up = cells_polygon(rising[0], rising[1], cell, tolerance)
+                        if smooth_margin:
+                            up = contours.simplify_contour(up, edge_error * cell, edge_max_len)
+                        M = shapely.difference(M, up)
                     E, chains = cuts.at(float(flat_h[c]), box, base)
                     exact_parts.append(shapely.intersection(E, M))
                     removed.append(shapely.difference(M, E))
