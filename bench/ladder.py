@@ -12,12 +12,13 @@ kills is a draw.  Printed: win / loss / draw per pair and arena, then Elo rating
 over all duels (a Bradley-Terry fit, draws counting half, with one virtual draw per
 pair so that a clean sweep stays finite; the players' mean is 1500) with 95 %
 bootstrap intervals (duels resampled within each pair and arena), and the goals
-(issue 28's, and issue 30's for the novice).
+(issue 28's, and issue 30's for the novice).  The round robin and the Elo fit are
+``tanktool tournament``'s (tanktool/tournament/), run on ``--workers`` local processes.
 
     python bench/ladder.py [--duels N] [--json] [--arenas a,b] (default: every bundled arena)
                            [--generated LEVEL[:SEED]] (default bridge; 'none': no generated arena)
                            [--players scripted,robot,camper,duellist,novice,easy,normal,hard]
-                           [--seconds S] [--vehicle light] [--boot B]
+                           [--seconds S] [--vehicle light] [--boot B] [--workers N]
 """
 
 from __future__ import annotations
@@ -25,23 +26,19 @@ from __future__ import annotations
 import argparse
 import itertools
 import json
-import math
-import random
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from tanktool.bots import BUILTIN, load_bot  # noqa: E402
 from tanktool.content import bundled_names  # noqa: E402
-from tanktool.sim.driver import ScriptedDriver  # noqa: E402
 from tanktool.sim.match import load_match_arena, load_tank_spec  # noqa: E402
-from tanktool.sim.world import World  # noqa: E402
+from tanktool.tournament import TournamentConfig, default_workers, run_tournament  # noqa: E402
+from tanktool.tournament.elo import fit_elo as tournament_elo  # noqa: E402
 
 PLAYERS = ("scripted", "robot", "camper", "duellist", "novice", "easy", "normal", "hard")
 #: every bundled arena (box, fort, hills, maze, paper2002 at the time of writing)
@@ -77,59 +74,9 @@ def generated_arena(spec: str) -> Path:
     return out
 
 
-def make_player(name: str, seed: int):
-    """A driver for a player of the ladder (a built-in bot, or the scripted baseline)."""
-    if name == "scripted":
-        return ScriptedDriver(random.Random(seed))
-    if name in BUILTIN:
-        return load_bot(name).driver(seed)
-    raise ValueError(f"unknown player {name!r} (one of {', '.join(PLAYERS)})")
-
-
-def duel(arena, spec, a: str, b: str, seed: int, seconds: float) -> tuple[int, int]:
-    """Kills of ``a`` and of ``b`` in one duel (``a`` is tank 0 on even seeds)."""
-    first = seed % 2
-    world = World(arena.walls, [spec, spec], arena.spawns, seed=seed, bounds=arena.bounds,
-                  ground=arena.ground)
-    drivers: list = [None, None]
-    # the seeds are drawn in tank order, so a seed gives each side the same stream
-    seeds = [world.rng.getrandbits(64) for _ in range(2)]
-    drivers[first] = make_player(a, seeds[first])
-    drivers[1 - first] = make_player(b, seeds[1 - first])
-    tanks = world.tanks
-    for _ in range(int(round(seconds / world.dt))):
-        world.step(None, [d(world, t) for d, t in zip(drivers, tanks)])
-    return tanks[first].kills, tanks[1 - first].kills
-
-
-def fit_elo(players: list[str], games: list[tuple[int, int, float]], prior: float = 1.0) -> np.ndarray:
-    """Elo ratings (mean 1500) from games (i, j, score of i in [0, 1]): the
-    Bradley-Terry maximum likelihood with ties as half points (MM iterations),
-    ``prior`` virtual draws per pair."""
-    n = len(players)
-    wins = np.zeros(n)
-    count = np.zeros((n, n))
-    for i, j, s in games:
-        wins[i] += s
-        wins[j] += 1.0 - s
-        count[i, j] += 1.0
-        count[j, i] += 1.0
-    for i, j in itertools.combinations(range(n), 2):
-        wins[i] += 0.5 * prior
-        wins[j] += 0.5 * prior
-        count[i, j] += prior
-        count[j, i] += prior
-    g = np.ones(n)
-    for _ in range(2000):
-        denom = (count / (g[:, None] + g[None, :])).sum(axis=1)
-        new = wins / np.maximum(denom, 1e-300)
-        new /= np.exp(np.mean(np.log(new)))
-        if np.max(np.abs(np.log(new) - np.log(g))) < 1e-10:
-            g = new
-            break
-        g = new
-    r = 400.0 * np.log10(g)
-    return r - r.mean() + 1500.0
+def fit_elo(players: list[str], games: list[tuple[int, int, float]], prior: float = 1.0):
+    """The tournament's Bradley-Terry Elo fit (``tanktool.tournament.elo``) by player names."""
+    return tournament_elo(len(players), games, prior)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -143,6 +90,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--vehicle", default="light")
     ap.add_argument("--boot", type=int, default=300, help="bootstrap resamples for the Elo intervals")
     ap.add_argument("--first-seed", type=int, default=0, help="duel k uses seed first_seed + k")
+    ap.add_argument("--workers", type=int, default=default_workers(), help="processes (default: the local cores)")
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
     args = ap.parse_args(argv)
     players = [p for p in args.players.split(",") if p]
@@ -164,41 +112,33 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(ref, Path):
             a.name = f"gen-{args.generated.replace(':', '-')}"
     t0 = time.perf_counter()
+    # the round robin and the Elo fit are the tournament's (tanktool.tournament): the
+    # duels run on every local core, seeds and sides fixed as there
+    config = TournamentConfig(bots=tuple(players), arenas=tuple(str(r) for r in refs), vehicles=(args.vehicle,),
+                              matches=args.duels, seconds=args.seconds, first_seed=args.first_seed,
+                              boot=args.boot)
+    done = [0]
+
+    def progress(r: dict) -> None:
+        done[0] += 1
+        if not args.json and done[0] % max(args.duels, 1) == 0:
+            print(f"  {done[0]} duels ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
+
+    report = run_tournament(config, run="serial" if args.workers == 1 else "pool", workers=args.workers,
+                            record=False, on_match=progress).report
+    names = {a_info.name: a_info.name for a_info in arenas}
+    for a_info, ref in zip(arenas, refs):
+        if isinstance(ref, Path):
+            names[load_match_arena(ref).name] = a_info.name
     cells = []              # one per (arena, pair)
-    games: list[tuple[int, int, float, int]] = []       # (i, j, score of i, cell)
-    for arena in arenas:
-        for a, b in itertools.combinations(players, 2):
-            w = l = d = 0
-            ka = kb = sa = sb = 0
-            for k in range(args.duels):
-                x, y = duel(arena, spec, a, b, args.first_seed + k, args.seconds)
-                ka, kb, sa, sb = ka + x, kb + y, sa + (x > 0), sb + (y > 0)
-                s = 1.0 if x > y else 0.0 if x < y else 0.5
-                w, l, d = w + (s == 1.0), l + (s == 0.0), d + (s == 0.5)
-                games.append((players.index(a), players.index(b), s, len(cells)))
-            cells.append({"arena": arena.name, "a": a, "b": b, "wins": w, "losses": l, "draws": d,
-                          "kills": [ka, kb], "scored": [sa, sb], "win_rate": w / args.duels,
-                          "draw_rate": d / args.duels})
-            if not args.json:
-                print(f"  {arena.name} {a}-{b}: {w}-{l}-{d} ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
-    elo = fit_elo(players, [(i, j, s) for i, j, s, _ in games])
-    rng = np.random.default_rng(1)
-    by_cell: dict[int, list[tuple[int, int, float]]] = {}
-    for i, j, s, c in games:
-        by_cell.setdefault(c, []).append((i, j, s))
-    boots = []
-    for _ in range(args.boot):
-        sample = []
-        for c, gs in by_cell.items():
-            idx = rng.integers(0, len(gs), len(gs))
-            sample.extend(gs[k] for k in idx)
-        boots.append(fit_elo(players, sample))
-    boots = np.array(boots) if boots else np.zeros((0, len(players)))
-    ratings = []
-    for k, p in enumerate(players):
-        lo, hi = (np.percentile(boots[:, k], [2.5, 97.5]) if len(boots) else (elo[k], elo[k]))
-        ratings.append({"player": p, "elo": round(float(elo[k]), 1), "lo": round(float(lo), 1),
-                        "hi": round(float(hi), 1)})
+    for p in report["pairings"]:
+        rows = [m for m in report["matches"] if (m["a"], m["b"], m["arena"]) == (p["a"], p["b"], p["arena"])]
+        n = len(rows)
+        cells.append({"arena": names.get(p["arena"], p["arena"]), "a": p["a"], "b": p["b"], "wins": p["wins"],
+                      "losses": p["losses"], "draws": p["draws"], "kills": p["kills"],
+                      "scored": [sum(m["kills"][0] > 0 for m in rows), sum(m["kills"][1] > 0 for m in rows)],
+                      "win_rate": p["wins"] / n, "draw_rate": p["draws"] / n})
+    ratings = [{"player": r["bot"], "elo": r["elo"], "lo": r["lo"], "hi": r["hi"]} for r in report["elo"]]
     goals = _goals(cells, ratings, players, [a.name for a in arenas])
     out = {"vehicle": spec.name, "seconds_per_duel": args.seconds, "duels_per_cell": args.duels,
            "arenas": [a.name for a in arenas], "players": players, "rules": "sim.rules.DEFAULT",

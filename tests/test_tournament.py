@@ -124,3 +124,9 @@ def test_ray_missing_is_one_error_line(monkeypatch):
     r = CliRunner().invoke(cli, ["tournament", "--bot", "easy", "--bot", "novice", "--matches", "1",
                                  "--seconds", "1", "--no-replays", "--ray", "local"])
     assert r.exit_code == 2 and "pip install 'tanktool[cluster]'" in r.output
+
+
+def test_the_scripted_baseline_plays_as_a_player():
+    config = TournamentConfig(bots=("scripted", "novice"), matches=1, seconds=3.0, boot=0)
+    rep = run_tournament(config, run="serial").report
+    assert [b["name"] for b in rep["bots"]] == ["scripted", "novice"] and len(rep["matches"]) == 1

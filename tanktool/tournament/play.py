@@ -21,7 +21,7 @@ from ..bots import load_bot
 from ..errors import TanktoolError
 from ..sim.match import load_match_arena, load_tank_spec, run_match
 from ..sim.replay import Recorder, encode, match_header
-from .schedule import MatchTask, Player
+from .schedule import SCRIPTED, MatchTask, Player
 
 _ARENAS: dict[str, Any] = {}
 _SPECS: dict[str, Any] = {}
@@ -40,11 +40,27 @@ def _spec(ref: str) -> Any:
     return _SPECS[ref]
 
 
+class _Scripted:
+    """The scripted baseline as a maker: ``driver(seed)`` like a bot's."""
+
+    name = SCRIPTED
+
+    @staticmethod
+    def driver(seed: int, budget: float = 0.0) -> Any:
+        import random
+
+        from ..sim.driver import ScriptedDriver
+
+        return ScriptedDriver(random.Random(seed))
+
+
 def _maker(player: Player) -> Any:
     key = (player.spec, player.sha256)
     if key in _MAKERS:
         return _MAKERS[key]
-    if player.path is None:
+    if player.spec == SCRIPTED:
+        maker: Any = _Scripted()
+    elif player.path is None:
         maker = load_bot(player.spec)
     else:
         path = Path(player.path)

@@ -77,12 +77,21 @@ class Player:
         return d
 
 
+#: the scripted baseline (``sim.driver.ScriptedDriver``): a player, not a bot (it reads
+#: the world), kept so that the difficulty ladder (bench/ladder.py) measures against it
+SCRIPTED = "scripted"
+
+
 def resolve_players(specs: list[str] | tuple[str, ...]) -> list[Player]:
     """Load every spec once here (a bad spec is one error before any match runs) and
     name the players uniquely (``Sniper``, ``Sniper#2``)."""
     players: list[Player] = []
     seen: dict[str, int] = {}
     for spec in specs:
+        if spec.strip() == SCRIPTED:
+            seen[SCRIPTED] = seen.get(SCRIPTED, 0) + 1
+            players.append(Player(SCRIPTED if seen[SCRIPTED] == 1 else f"{SCRIPTED}#{seen[SCRIPTED]}", SCRIPTED))
+            continue
         maker = load_bot(spec)
         name = maker.name
         seen[name] = seen.get(name, 0) + 1
