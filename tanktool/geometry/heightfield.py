@@ -547,7 +547,6 @@ def neighbour_columns(col: np.ndarray, shape: tuple[int, int]) -> list[np.ndarra
 def filter_spans(hf_col, smin, smax, walk, shape, headroom: int, climb: int):
     """Recast's three filters (see the module docstring); returns the new walkable flags
     and how many spans each filter took away."""
-    nz, nx = shape
     ceil = _next_in_column(hf_col, smin, OPEN)
     # 1. low hanging obstacles: walkable from the span below (its flag before this pass)
     w = walk.copy()
@@ -559,17 +558,42 @@ def filter_spans(hf_col, smin, smax, walk, shape, headroom: int, climb: int):
     w |= ~walk & below_walk & (np.abs(smax - below_top) <= climb)
     lifted = int((w & ~walk).sum())
     # 2. ledges and steep spans: each walkable span against every floor of each
-    # neighbour column, the empty space below its first span counting as a floor at
-    # -climb (a drop to the bottom of the world).  Neighbour spans are visited k-th by
-    # k-th: the k-th pass only sees columns with more than k spans (few beyond two).
-    start = column_starts(hf_col, nz * nx)
-    count = np.diff(start)
+    # neighbour column (_ledge_scan)
     s_idx = np.flatnonzero(w)
+    minh, asmin, asmax = _ledge_scan(hf_col, smin, smax, ceil, s_idx, shape, headroom, climb)
+    ledge = minh < -climb
+    steep = ~ledge & ((asmax - asmin) > climb)
+    w2 = w.copy()
+    w2[s_idx[ledge | steep]] = False
+    # 3. too little headroom
+    low = w2 & ((ceil - smax) <= headroom)
+    w3 = w2 & ~low
+    counts = {"lifted": lifted, "ledge": int(ledge.sum()), "steep": int(steep.sum()), "low": int(low.sum())}
+    return w3, counts, low
+
+
+def _ledge_scan(hf_col, smin, smax, ceil, s_idx, shape, headroom: int, climb: int):
+    """For each span ``s_idx``: the lowest reachable neighbour floor relative to its own
+    (minh) and the range of the neighbour floors within the climb (asmin, asmax), over
+    every floor of each neighbour column, the empty space below a column's first span
+    counting as a floor at -climb (a drop to the bottom of the world).  The compiled
+    kernel when built (one pass), else numpy, neighbour spans visited k-th by k-th (the
+    k-th pass only sees columns with more than k spans: few beyond two)."""
+    from .kernels import active, i64
+
+    nz, nx = shape
+    start = column_starts(hf_col, nz * nx)
     bot = smax[s_idx]
     top = ceil[s_idx]
     minh = np.full(len(s_idx), OPEN, dtype=np.int64)
-    asmin = bot.copy()
-    asmax = bot.copy()
+    asmin = bot.astype(np.int64)
+    asmax = bot.astype(np.int64)
+    kern = active()
+    if kern is not None:
+        kern.ledge_scan(i64(hf_col[s_idx]), i64(bot), i64(top), i64(start), i64(smin), i64(smax), i64(ceil), nz, nx,
+                     int(headroom), int(climb), minh, asmin, asmax)
+        return minh, asmin, asmax
+    count = np.diff(start)
     for ncol in neighbour_columns(hf_col[s_idx], shape):
         off = ncol < 0
         minh[off] = np.minimum(minh[off], -climb - bot[off])
@@ -598,15 +622,7 @@ def filter_spans(hf_col, smin, smax, walk, shape, headroom: int, climb: int):
             asmin[i_n] = np.minimum(asmin[i_n], nb[near])
             asmax[i_n] = np.maximum(asmax[i_n], nb[near])
             k += 1
-    ledge = minh < -climb
-    steep = ~ledge & ((asmax - asmin) > climb)
-    w2 = w.copy()
-    w2[s_idx[ledge | steep]] = False
-    # 3. too little headroom
-    low = w2 & ((ceil - smax) <= headroom)
-    w3 = w2 & ~low
-    counts = {"lifted": lifted, "ledge": int(ledge.sum()), "steep": int(steep.sum()), "low": int(low.sum())}
-    return w3, counts, low
+    return minh, asmin, asmax
 
 
 def build_heightfield(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, max_slope: float,

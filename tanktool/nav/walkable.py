@@ -133,11 +133,17 @@ def link_spans(col: np.ndarray, floor: np.ndarray, ceil: np.ndarray, shape: tupl
     The spans of each neighbour column are tried k-th by k-th, lowest first; a span's
     link is the first that fits.
     """
+    from ..geometry.kernels import active, i64
+
     nz, nx = shape
     n = len(col)
     start = column_starts(col, nz * nx)
-    count = np.diff(start)
     link = np.full((n, 4), -1, dtype=np.int64)
+    kern = active()
+    if kern is not None:
+        kern.link_spans(i64(col), i64(floor), i64(ceil), start, nz, nx, int(headroom), int(climb), link)
+        return link
+    count = np.diff(start)
     for d, ncol in enumerate(neighbour_columns(col, shape)):
         off = ncol < 0
         nc = np.where(off, 0, ncol)
@@ -167,9 +173,15 @@ def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
     present).  Values stop growing at ``limit``: only whether a span is that far
     matters, and the relaxation needs about limit / 2 rounds.
     """
+    from ..geometry.kernels import active, i64
+
     n = len(link)
     dist = np.where((link < 0).any(axis=1), 1, limit).astype(np.int32)
     if n == 0:
+        return dist
+    kern = active()
+    if kern is not None:  # sweeps to the same fixed point (tanktool/_kernels.c)
+        kern.chamfer(i64(link), dist, int(limit))
         return dist
     # index n is a sentinel at distance 0: a missing link leads off the edge
     safe = [np.ascontiguousarray(np.where(link[:, d] < 0, n, link[:, d])) for d in range(4)]

@@ -1,0 +1,31 @@
+"""The optional C kernels (tanktool/_kernels.c); everything else is in pyproject.toml.
+
+The extension is optional: without a C compiler or Python's headers the build goes on
+without it and tanktool uses its numpy code instead (tanktool/geometry/kernels.py),
+with identical results, only slower.
+"""
+
+from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
+
+
+class OptionalBuildExt(build_ext):
+    """build_ext that warns instead of failing when the kernels cannot be compiled."""
+
+    def run(self):
+        try:
+            super().run()
+        except Exception as e:  # no compiler at all (setuptools raises before compiling)
+            self.warn(f"tanktool._kernels not built ({e}); the numpy code is used instead")
+
+    def build_extension(self, ext):
+        try:
+            super().build_extension(ext)
+        except Exception as e:  # a compiler that fails, missing Python.h
+            self.warn(f"tanktool._kernels not built ({e}); the numpy code is used instead")
+
+
+setup(
+    ext_modules=[Extension("tanktool._kernels", ["tanktool/_kernels.c"], extra_compile_args=["-O2"], optional=True)],
+    cmdclass={"build_ext": OptionalBuildExt},
+)

@@ -1,0 +1,92 @@
+"""The compiled kernels (tanktool/_kernels.c) against the numpy code they replace:
+identical heightfields, links, clearances and grids on generated levels and on
+Recast's dungeon, and on random span graphs."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tanktool.geometry import kernels
+from tanktool.geometry.kernels import use_kernels
+from tanktool.nav.walkable import WalkableParams, chamfer_clearance, grid_from_surface, link_spans, walkable_surface
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+
+needs_kernels = pytest.mark.skipif(not kernels.available(), reason="tanktool._kernels not built (no C compiler)")
+PARAMS = WalkableParams(0.3, 0.2, 45.0, 0.9, 2.0)
+
+
+def _build(V, F, on: bool):
+    with use_kernels(on):
+        s = walkable_surface(V, F, PARAMS, 0.6)
+        g = grid_from_surface(s, 0.6, s.hf.origin[[0, 2]])
+    return s, g
+
+
+def _levels():
+    import make_levels
+    import trimesh
+
+    out = [(n, make_levels.level(n)) for n in ("rolling_terrain", "bridge", "two_storeys", "ramps_and_decks")]
+    d = trimesh.load(ROOT / "tests" / "data" / "arenas_obj" / "dungeon.obj", force="mesh", process=False)
+    out.append(("dungeon", d))
+    return [(n, np.asarray(m.vertices, np.float64), np.asarray(m.faces, np.int64)) for n, m in out]
+
+
+@needs_kernels
+@pytest.mark.parametrize("name,V,F", _levels(), ids=lambda x: x if isinstance(x, str) else "")
+def test_compiled_and_numpy_surfaces_are_identical(name, V, F):
+    a, ga = _build(V, F, True)
+    b, gb = _build(V, F, False)
+    assert a.hf.walkable.sum() > 100
+    for key in ("walkable", "smin", "smax", "col", "flat", "low_headroom"):
+        assert np.array_equal(getattr(a.hf, key), getattr(b.hf, key)), key
+    assert a.hf.counts == b.hf.counts
+    for key in ("col", "floor", "ceil", "link", "clearance", "region", "main", "level", "height"):
+        assert np.array_equal(getattr(a, key), getattr(b, key)), key
+    for key in ("valid", "row_index", "row_total", "col_index", "col_total", "reachable", "link"):
+        assert np.array_equal(getattr(ga, key), getattr(gb, key)), key
+    assert np.array_equal(ga.height, gb.height, equal_nan=True)
+
+
+def _random_spans(rng, nz=23, nx=31):
+    """Columns of 0-3 spans with random floors and ceilings (sorted per column)."""
+    counts = rng.integers(0, 4, nz * nx)
+    col = np.repeat(np.arange(nz * nx), counts)
+    floor = rng.integers(0, 40, len(col))
+    order = np.lexsort((floor, col))
+    col, floor = col[order], floor[order]
+    ceil = floor + rng.integers(3, 30, len(col))
+    return col, floor, ceil, (nz, nx)
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(6))
+def test_random_span_graphs_give_the_same_links_and_distances(seed):
+    rng = np.random.default_rng(seed)
+    col, floor, ceil, shape = _random_spans(rng)
+    with use_kernels(True):
+        la = link_spans(col, floor, ceil, shape, 5, 4)
+    with use_kernels(False):
+        lb = link_spans(col, floor, ceil, shape, 5, 4)
+    assert np.array_equal(la, lb) and (la >= 0).sum() > 100
+    for limit in (3, 8, 40):
+        with use_kernels(True):
+            da = chamfer_clearance(la, limit)
+        with use_kernels(False):
+            db = chamfer_clearance(la, limit)
+        assert np.array_equal(da, db), limit
+
+
+def test_the_numpy_fallback_runs_without_the_kernels():
+    with use_kernels(False):
+        assert kernels.active() is None
+        col, floor, ceil, shape = _random_spans(np.random.default_rng(9))
+        link = link_spans(col, floor, ceil, shape, 5, 4)
+        d = chamfer_clearance(link, 12)
+    assert d.min() >= 1 and d.max() <= 12
