@@ -8,7 +8,11 @@
 // each stage and of the whole run, in milliseconds.  The eroded walkable spans of the last run go to OUT, one
 // (int32 x, int32 z, float32 y) record each, y the span's floor in world units.
 //
-// usage: recast_harness MESH OUT cs ch max_slope_deg headroom climb radius reps
+// With a tenth argument "full" it goes on as Sample_SoloMesh does to the end of Recast's build
+// (contours, polygon mesh, detail mesh, RecastDemo's defaults) and also prints those stages
+// and "full": the fastest whole build, what bench/import_arena.py sets a whole import against.
+//
+// usage: recast_harness MESH OUT cs ch max_slope_deg headroom climb radius reps [full]
 // MESH: int32 nverts, int32 ntris, float32 verts[3 nverts], int32 tris[3 ntris].
 
 #include <Recast.h>
@@ -17,6 +21,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
+#include <string>
 #include <vector>
 
 namespace {
@@ -25,6 +31,10 @@ double now_ms() {
     using clock = std::chrono::steady_clock;
     return std::chrono::duration<double, std::milli>(clock::now().time_since_epoch()).count();
 }
+
+// this process's CPU time: what a loaded machine does not inflate (the bench compares
+// it with its own process time beside the wall-clock figures)
+double cpu_ms() { return 1000.0 * double(std::clock()) / CLOCKS_PER_SEC; }
 
 bool read_mesh(const char* path, std::vector<float>& verts, std::vector<int>& tris) {
     FILE* f = std::fopen(path, "rb");
@@ -44,8 +54,8 @@ bool read_mesh(const char* path, std::vector<float>& verts, std::vector<int>& tr
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 10) {
-        std::fprintf(stderr, "usage: %s MESH OUT cs ch slope headroom climb radius reps\n", argv[0]);
+    if (argc != 10 && argc != 11) {
+        std::fprintf(stderr, "usage: %s MESH OUT cs ch slope headroom climb radius reps [full]\n", argv[0]);
         return 2;
     }
     std::vector<float> verts;
@@ -60,6 +70,7 @@ int main(int argc, char** argv) {
     const int walkableClimb = int(std::floor(std::atof(argv[7]) / ch));
     const int walkableRadius = int(std::ceil(std::atof(argv[8]) / cs));
     const int reps = std::atoi(argv[9]);
+    const bool full = argc == 11 && std::string(argv[10]) == "full";
     const int nv = int(verts.size() / 3), nt = int(tris.size() / 3);
 
     float bmin[3], bmax[3];
@@ -69,8 +80,15 @@ int main(int argc, char** argv) {
     // RecastDemo's defaults for the region stage
     const int minRegionArea = 8 * 8, mergeRegionArea = 20 * 20;
 
-    const char* names[] = {"rasterize", "filters", "compact", "erode", "distance", "regions"};
-    double best[6];
+    // RecastDemo's defaults for the rest of the build: edges up to 12 m and 1.3 cells off,
+    // six vertices a polygon, detail samples every 6 cells within one cell height
+    const int maxEdgeLen = int(12.0f / cs), vertsPerPoly = 6;
+    const float maxError = 1.3f, sampleDist = 6.0f * cs, sampleMaxError = 1.0f * ch;
+
+    const char* names[] = {"rasterize", "filters", "compact", "erode", "distance", "regions", "contours",
+                           "polymesh", "detail"};
+    double best[9];
+    double best_full = 1e30, best_cpu = 1e30, best_cpu_full = 1e30;
     for (double& b : best) b = 1e30;
     double best_total = 1e30;
     rcContext ctx(false);
@@ -78,6 +96,7 @@ int main(int argc, char** argv) {
     std::vector<unsigned char> areas(nt);
     for (int r = 0; r < reps; ++r) {
         double t[7];
+        const double c0 = cpu_ms();
         t[0] = now_ms();
         rcHeightfield* solid = rcAllocHeightfield();
         rcCreateHeightfield(&ctx, *solid, w, h, bmin, bmax, cs, ch);
@@ -101,6 +120,26 @@ int main(int argc, char** argv) {
         t[6] = now_ms();
         for (int k = 0; k < 6; ++k) best[k] = std::fmin(best[k], t[k + 1] - t[k]);
         best_total = std::fmin(best_total, t[6] - t[0]);
+        best_cpu = std::fmin(best_cpu, cpu_ms() - c0);
+        if (full) {
+            double u[4];
+            u[0] = now_ms();
+            rcContourSet* cset = rcAllocContourSet();
+            rcBuildContours(&ctx, *chf, maxError, maxEdgeLen, *cset);
+            u[1] = now_ms();
+            rcPolyMesh* pmesh = rcAllocPolyMesh();
+            rcBuildPolyMesh(&ctx, *cset, vertsPerPoly, *pmesh);
+            u[2] = now_ms();
+            rcPolyMeshDetail* dmesh = rcAllocPolyMeshDetail();
+            rcBuildPolyMeshDetail(&ctx, *pmesh, *chf, sampleDist, sampleMaxError, *dmesh);
+            u[3] = now_ms();
+            for (int k = 0; k < 3; ++k) best[6 + k] = std::fmin(best[6 + k], u[k + 1] - u[k]);
+            best_full = std::fmin(best_full, u[3] - t[0]);
+            best_cpu_full = std::fmin(best_cpu_full, cpu_ms() - c0);
+            rcFreeContourSet(cset);
+            rcFreePolyMesh(pmesh);
+            rcFreePolyMeshDetail(dmesh);
+        }
         if (keep) rcFreeCompactHeightfield(keep);
         keep = chf;
     }
@@ -124,9 +163,11 @@ int main(int argc, char** argv) {
     }
     std::printf("{\"width\": %d, \"height\": %d, \"bmin\": [%g, %g, %g], \"spans\": %ld", w, h, bmin[0], bmin[1],
                 bmin[2], count);
-    for (int k = 0; k < 6; ++k) {
+    for (int k = 0; k < (full ? 9 : 6); ++k) {
         std::printf(", \"%s\": %.4f", names[k], best[k]);
     }
+    if (full) std::printf(", \"full\": %.4f, \"cpu_full\": %.4f", best_full, best_cpu_full);
+    std::printf(", \"cpu_total\": %.4f", best_cpu);
     std::printf(", \"total\": %.4f}\n", best_total);
     if (keep) rcFreeCompactHeightfield(keep);
     return 0;
