@@ -38,7 +38,7 @@ def test_headless_match_with_a_bot_from_a_file_records_and_plays_back(tmp_path):
 @pytest.mark.parametrize("args, message", [
     (["--bot", "nosuch"], "no such built-in bot"),
     (["--bot", "easy", "--bot", "hard", "--bots", "1"], "--bots 1 leaves no tank"),
-    (["--bot", "easy", "--host", "127.0.0.1:0"], "network matches do not take bots"),
+    (["--bot", "easy", "--join", "127.0.0.1:9"], "computer opponents run on the host"),
 ])
 def test_bad_bot_options_are_one_error_line(args, message):
     r = CliRunner().invoke(cli, ["play", "--headless", "--seconds", "1", *args])
@@ -69,3 +69,29 @@ def test_a_window_match_with_the_docs_bot(make_app):
         assert app.session.world.names[1] == "Hunter" and app.session.world.steps == 0
     finally:
         app.stop()
+
+
+def test_a_network_match_hosts_the_docs_bot():
+    from net_helpers import match_kw
+    from tanktool.net.peer import Peer
+    from tanktool.net.session import NetMatch
+    from tanktool.sim.bots import BotDriver
+    from tanktool.sim.match import load_match_arena, load_tank_spec
+
+    peer = Peer.host(("127.0.0.1", 0), "host", **match_kw("box", "light"))
+    try:
+        match = NetMatch(peer, load_match_arena("box"), load_tank_spec("light"), seed=4, bots=2,
+                         bot_specs=(HUNTER,))
+        report = match.run(2.0)
+    finally:
+        peer.close()
+    n = next(k for k, name in match.names.items() if name == "Hunter")
+    driver = match.drivers[n]
+    assert isinstance(driver, BotDriver) and driver.stats.calls > 0 and driver.stats.errors == 0
+    assert match.world.tanks[n - 1].distance > 1.0                  # it drove
+    assert {p["name"] for p in report["peers"]} >= {"host", "Hunter", "bot2"}
+
+
+def test_play_hosts_bots_headless_only():
+    r = CliRunner().invoke(cli, ["play", "--bot", "easy", "--host", "127.0.0.1:0", "--seconds", "1"])
+    assert r.exit_code == 2 and "--headless" in r.output

@@ -97,9 +97,11 @@ def run_network_window(host: str | None, join: str | None, player_name: str | No
 
 def run_network(host: str | None, join: str | None, player_name: str | None, password: str | None,
                 arena: str | None, vehicle: str | None, seconds: float | None, seed: int,
-                report_path: Path | None, echo: Callable[[str], None], bots: int | None = None) -> dict[str, Any]:
+                report_path: Path | None, echo: Callable[[str], None], bots: int | None = None,
+                bot_specs: tuple[str, ...] = ()) -> dict[str, Any]:
     """Host or join a session, play it, print a summary, write the report.  ``bots``
-    (default: ``play``'s own ``--bots``) computer opponents run on the host."""
+    (default: ``play``'s own ``--bots``) computer opponents run on the host, the first
+    of them driven by ``bot_specs`` (``play --bot``)."""
     from ..net.peer import Peer, parse_address
     from ..net.names import name_problem
     from ..net.protocol import name_bytes
@@ -112,7 +114,7 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
         # --bots belongs to `play`; read it from there rather than widen play's call
         ctx = click.get_current_context(silent=True)
         bots = ctx.params.get("bots") if ctx is not None else None
-    bots = bots or 0
+    bots = max(bots or 0, len(bot_specs))
     if bots and join is not None:
         raise click.UsageError("computer opponents run on the host: --bots goes with --host")
     if bots > 7:
@@ -169,7 +171,7 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
         old[signal.SIGUSR1] = signal.signal(signal.SIGUSR1, restart_stats)
     try:
         try:
-            match = NetMatch(peer, info, spec, seed=seed, log=echo, bots=bots)
+            match = NetMatch(peer, info, spec, seed=seed, log=echo, bots=bots, bot_specs=tuple(bot_specs))
             report = match.run(seconds)
         finally:
             peer.close()

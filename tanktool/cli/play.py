@@ -206,9 +206,8 @@ def _check_bots(o: _Options, network: bool) -> None:
     """--bot: where it applies, and every bot loaded once (a bad one is one error line)."""
     from ..sim.bots.lineup import lineup
 
-    if network:
-        raise click.UsageError("--bot: network matches do not take bots from files yet; play them headless or "
-                               "in the window")
+    if network and not o.headless:
+        raise click.UsageError("--bot in a network match: host it with --headless (the bots run on the host)")
     if o.frames is not None or o.screenshot is not None:
         raise click.UsageError("--bot plays a match; --frames/--screenshot render a picture (use --picture)")
     if o.replay_path is not None:
@@ -236,7 +235,8 @@ def _play_network(o: _Options, host: str | None, join: str | None, player_name: 
     if not o.headless and run_network_window(host, join, player_name, password, o.arena, o.vehicle, o.bots,
                                              o.seed, o.view, o.size, o.fullscreen, echo):
         return
-    run_network(host, join, player_name, password, o.arena, o.vehicle, o.seconds, o.seed, o.report_path, echo)
+    run_network(host, join, player_name, password, o.arena, o.vehicle, o.seconds, o.seed, o.report_path, echo,
+                bot_specs=o.bot_specs)
 
 
 def _replay_setup(o: _Options) -> bool:

@@ -76,6 +76,8 @@ class NetMatch:
     seed: int = 0
     driver: Callable[[World, Any], Command] | None = None
     bots: int = 0
+    #: bots (``play --bot``: names or FILE.py:Class) driving the first computer opponents
+    bot_specs: tuple[str, ...] = ()
     state_hz: float = STATE_HZ
     log: Callable[[str], None] = lambda line: None
     world: World = field(init=False)
@@ -102,10 +104,17 @@ class NetMatch:
         self.drivers: dict[int, Callable[[World, Any], Command]] = {}
         if self.driver is not None:
             self.drivers[self.peer.number] = self.driver
-        for k in range(self.bots):
-            n = self.peer.add_bot(f"bot{k + 1}")
+        listed: list = []
+        if self.bot_specs:
+            from ..sim.bots.lineup import lineup
+
+            listed = lineup(self.bot_specs)
+        for k in range(max(self.bots, len(listed))):
+            n = self.peer.add_bot(listed[k][0] if k < len(listed) else f"bot{k + 1}")
             if n is None:
                 break
+            if k < len(listed):     # a bot from a file runs here only: a new host adopts it as a scripted bot
+                self.drivers[n] = listed[k][1].driver(self.seed * 1009 + n)
             self._adopt(n, fresh=True)
         for e in self.peer.players():
             self.names[e.number] = e.name
