@@ -189,6 +189,8 @@ class Peer:
         #: links whose send failed: dropped after the current message is handled, so a
         #: failure never pulls a player out of the table while a handler is using it
         self._failed: list[tuple[Link, str]] = []
+        #: sockets of kicked players, half-closed, closed after their deadline
+        self._linger: list[tuple[socket.socket, float]] = []
         self.password = password or None
         self.clock = clock
         self.silence = silence
@@ -709,6 +711,11 @@ class Peer:
         if isinstance(m.body, P.Refuse) and link.initiated:
             link.refused = True                # a duplicate link lost the tie-break
             return
+        if isinstance(m.body, P.Refuse) and m.sender == self.host_number and not self.is_host:
+            # the host disconnected us (a kick): leave, rather than elect ourselves
+            self.events.append(NetEvent("kicked", m.sender, reason=m.body.text))
+            self.close(send_exit=False)
+            return
         self.counters["received"] += 1
         self.last_heard[link.number] = now
         body = m.body
@@ -734,8 +741,8 @@ class Peer:
                 return
             self.events.append(NetEvent("shot", m.sender, body))
         elif isinstance(body, P.Hit):
-            if not self._may_speak(m.sender, body.victim):   # only the victim's peer decides a hit
-                self.dropped["impostor"] += 1
+            if m.sender != self.host_number:     # only the host decides a hit
+                self.dropped["not_host"] += 1
                 return
             self.events.append(NetEvent("hit", m.sender, body))
         elif isinstance(body, P.Exit):
@@ -991,6 +998,8 @@ class Peer:
     # ------------------------------------------------------------------ leaving
     def _check_timeouts(self) -> None:
         now = self.clock()
+        while self._linger and (self._linger[0][1] <= now or self.closed):
+            self._linger.pop(0)[0].close()
         for link in list(self.pending):
             if now - link.opened > (HELLO_WAIT if link.hello is not None else PENDING_TIMEOUT):
                 self.dropped.source = link.addr[0]
@@ -1077,6 +1086,29 @@ class Peer:
                 if not link.outgoing:
                     self._queue(link, table)
 
+    def kick(self, n: int, reason: str) -> None:
+        """The host disconnects player ``n``: a refusal saying why, then it leaves
+        every table (TABLE), and its (number, epoch) is never let back in."""
+        if not self.is_host or n == self.number or n not in self.table:
+            return
+        link = self.links.pop(n, None)
+        if link is not None:
+            self._queue(link, self._pack(P.Refuse(P.RefuseCode.BAD_REQUEST, reason)))
+            self._flush(link)
+            try:
+                self.sel.unregister(link.sock)
+            except (KeyError, ValueError):
+                pass
+            # half-close and hold the socket a moment: closing it with the peer's unread
+            # messages in our buffer would reset the connection and lose the refusal
+            try:
+                link.sock.shutdown(socket.SHUT_WR)
+            except OSError:
+                pass
+            self._linger.append((link.sock, self.clock() + 1.0))
+        self._remove(n, "disconnected: " + reason)
+        self._reap()
+
     def close(self, send_exit: bool = True) -> None:
         """Leave: tell everyone (TCP), close every socket."""
         if self.closed:
@@ -1093,6 +1125,9 @@ class Peer:
                         pass
         for link in list(self.links.values()) + list(self.pending):
             self._close_link(link)
+        for sock, _ in self._linger:
+            sock.close()
+        self._linger.clear()
         for s in (self.tcp, self.udp):
             if s is not None:
                 try:

@@ -6,14 +6,21 @@ Every peer runs a World with one tank slot per player number (tank ``n - 1`` is 
 - **movement**: each peer simulates its own tank (driven by Commands, like any other
   driver) and sends its state by UDP at ``state_hz``; remote tanks are placed from their
   buffered states, ``INTERP_DELAY`` in the past (:mod:`.remote`).
+- **every peer judges** the states and shots it receives (:mod:`.judge`): a state its
+  vehicle could not have reached is corrected to the last valid pose, a shot faster
+  than the reload, from afar or while dead is not launched; the view of a cheating peer
+  never leaves what its vehicle could have done.
 - **shots**: the shooter's peer fires and sends SHOT (TCP) with the pose it fired from;
   every other peer launches the same shell from that pose in its own world.
-- **hits: the victim's peer decides.**  Its world flies every shell against its own
-  tank, which it knows exactly; when one hits, it takes the damage (and dies if it must)
-  and sends HIT to everyone.  A hit a peer's world sees on a *remote* tank is not
-  scored: that tank's own peer is the judge, and its next state carries its hit points.
-  So nobody can be killed by a peer that merely claims it, and no two peers ever score a
-  hit differently.
+- **hits: the host decides.**  Its world flies every shell against every tank (its own
+  exactly, the others where their judged states put them); when one hits, the host
+  sends HIT (the victim's hit points after it, and whether it died) to everyone.  A hit
+  another peer's world sees is not scored, on its own tank neither: it waits for the
+  host's HIT.  Hit points come from the vehicle and the host's HITs, never from a
+  peer's state; HITs from anyone but the host are dropped.  So nobody is killed by a
+  peer that merely claims it, a cheater cannot refuse to be hit, and no two peers
+  score a hit differently.  The host disconnects a member corrected more than 3 times
+  a second for 5 seconds.
 
 Computer opponents (``bots``) run on the host like its own tank: they have numbers in the
 table (owned by the host), their states and shots go out from the host, and the host
@@ -38,6 +45,7 @@ from ..sim.rules import DEFAULT as DEFAULT_RULES
 from ..sim.weapons import fire
 from ..sim.world import World
 from . import protocol as P
+from .judge import Judge
 from .names import visible
 from .peer import Peer, percentile
 from .remote import INTERP_DELAY, RemoteTank
@@ -97,6 +105,8 @@ class NetMatch:
                            names=names, bounds=self.arena.bounds, ground=getattr(self.arena, "ground", None),
                            rules=NET_RULES)
         self.me = self.world.tanks[self.peer.number - 1]
+        self.judge = Judge(self.world)
+        self.kicked: list[dict[str, Any]] = []
         self.world.t = self.peer.session_time()
         for t in self.world.tanks:
             if t is not self.me:
@@ -165,8 +175,9 @@ class NetMatch:
             # on a ground: height, level and tilt from where it now is, on the level
             # nearest its last height (states carry no height: the path is continuous)
             self.world.stand(tank, tank.y)
-            tank.hp = s.hp
-            tank.alive = s.alive
+            # hit points and life as the host decided them, never as the peer says
+            tank.hp = self.judge.hp(n)
+            tank.alive = s.alive and self.judge.alive(n)
             tank.respawn_at = math.inf
 
     def _remote_shot(self, shot: P.Shot) -> None:
@@ -182,21 +193,29 @@ class NetMatch:
          tank.roll) = saved
 
     def _on_net(self, events: list) -> None:
+        now = self.peer.session_time()
         for ev in events:
             if ev.kind == "state":
-                self.remotes.setdefault(ev.body.tank, RemoteTank()).push(ev.body)
+                shown = self.judge.state(ev.body, now)
+                if shown is not None:
+                    self.remotes.setdefault(ev.body.tank, RemoteTank()).push(shown)
             elif ev.kind == "shot":
-                self._score(ev.body.tank).shots += 1
-                self._remote_shot(ev.body)
+                if self.judge.shot(ev.body, now) is None:
+                    self._score(ev.body.tank).shots += 1
+                    self._remote_shot(ev.body)
             elif ev.kind == "hit":
-                h: P.Hit = ev.body
-                self._count_hit(h.shooter, h.victim, h.killed)
+                self._host_hit(ev.body)
+            elif ev.kind == "kicked":
+                self.log(f"the host disconnected us: {visible(ev.reason)}")
+                self.stop = True
             elif ev.kind == "joined":
                 self.names[ev.number] = ev.body.name
                 self.remotes.pop(ev.number, None)
+                self.judge.forget(ev.number)
                 self.log(f"player {ev.number} ({visible(ev.body.name)}) joined")
             elif ev.kind == "left":
                 self.remotes.pop(ev.number, None)
+                self.judge.forget(ev.number)
                 self._absent(self.world.tanks[ev.number - 1])
                 self.left.append({"time": round(self.peer.session_time(), 3), "number": ev.number,
                                   "name": ev.body.name, "reason": ev.reason})
@@ -206,6 +225,18 @@ class NetMatch:
             elif ev.kind == "adopt":
                 self._adopt(ev.number)
                 self.log(f"running computer opponent {ev.number} ({visible(ev.body.name)})")
+
+    def _host_hit(self, h: P.Hit) -> None:
+        """The host's HIT: the judge notes the victim's hit points and death; a tank of
+        ours takes them (and, killed, respawns after the delay)."""
+        self.judge.hit(h.victim, h.hp, h.killed, h.t)
+        self._count_hit(h.shooter, h.victim, h.killed)
+        if h.victim in self._local():
+            t = self.world.tanks[h.victim - 1]
+            t.hp = max(0.0, min(h.hp, t.spec.hit_points))
+            if h.killed and t.alive:
+                t.alive = False
+                t.respawn_at = self.world.t + self.world.respawn_delay
 
     def _count_hit(self, shooter: int, victim: int, killed: bool) -> None:
         self._score(shooter).hits += 1
@@ -233,22 +264,30 @@ class NetMatch:
         self._place_remotes(w.t + w.dt - INTERP_DELAY)
         commands: list[Command | None] = [None] * len(w.tanks)
         poses = {}
+        before = {}
         for n in local:
             t = w.tanks[n - 1]
             commands[n - 1] = self._driver(n)(w, t) if t.alive else IDLE
             poses[n] = (t.x, t.z, t.heading, t.vx, t.vz)
+            before[n] = (t.hp, t.alive, t.respawn_at)
         events = w.step(None, commands)
+        host = self.peer.is_host
         for ev in events:
             if ev.kind == "shot" and ev.tank + 1 in poses:
                 self._score(ev.tank + 1).shots += 1
                 self.peer.send_event(P.Shot(ev.tank + 1, w.t, *poses[ev.tank + 1]))
-            elif ev.kind == "hit" and ev.other + 1 in poses:
-                # the victim's peer decides: this hit is real, tell everyone
+            elif ev.kind == "hit" and host:
+                # the host decides: this hit is real, tell everyone
                 victim = w.tanks[ev.other]
                 killed = not victim.alive
+                self.judge.hit(ev.other + 1, max(victim.hp, 0.0), killed, w.t)
                 self._count_hit(ev.tank + 1, ev.other + 1, killed)
                 self.peer.send_event(P.Hit(ev.tank + 1, ev.other + 1, w.t, ev.value, max(victim.hp, 0.0), killed,
                                            ev.x, ev.z))
+            elif ev.kind == "hit" and ev.other + 1 in before:
+                # not the host: our own tank waits for the host's HIT
+                t = w.tanks[ev.other]
+                t.hp, t.alive, t.respawn_at = before[ev.other + 1]
         for t in w.tanks:     # a remote tank "killed" in our world waits for its own peer
             if t.index + 1 not in poses and not t.alive:
                 t.respawn_at = math.inf
@@ -300,9 +339,23 @@ class NetMatch:
             self.next_state += 1.0 / self.state_hz
             if now - self.next_state > MAX_LAG:
                 self.next_state = now
+        if peer.is_host:
+            self._kick_cheaters()
         if peer.dropped.grown and now - self.drop_log_at >= DROP_LOG_INTERVAL:
             self.log_drops()
         return events
+
+    def _kick_cheaters(self) -> None:
+        """The host disconnects a member the judge corrected too often for too long."""
+        now = self.peer.session_time()
+        for e in self.peer.players():
+            n = e.number
+            if n == self.peer.number or e.is_bot or not self.judge.to_kick(n, now):
+                continue
+            why = "corrected more than 3 times a second for 5 seconds"
+            self.kicked.append({"time": round(now, 3), "number": n, "name": e.name, "reason": why})
+            self.log(f"disconnecting player {n} ({visible(e.name)}): {why}")
+            self.peer.kick(n, why)
 
     def log_drops(self) -> None:
         """Log (INFO, shown at ``-v``) one line per kind of message the peer dropped or
@@ -358,6 +411,7 @@ class NetMatch:
             "left": self.left,
             "host_changes": [{"time": round(t, 3), "host": h} for t, h in peer.host_changes],
             "network": peer.network_report(),
+            "judge": dict(self.judge.report(), kicked=self.kicked),
             "latency_ms": {"samples": len(lat), "p50": _ms(percentile(lat, 50)), "p99": _ms(percentile(lat, 99))},
             "views": self.views,
             "timing": {"wall_clock_s": round(wall, 3), "steps": self.world.steps, "skipped_steps": skipped},
