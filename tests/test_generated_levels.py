@@ -26,7 +26,7 @@ WALL_CODES = {"A101", "A102", "A103", "A104", "A105", "A201", "A202", "A203", "A
 QUICK = ["town", "junkyard", "living_room", "stacked_floors"]
 #: terrains, big grids and the levels other tests import already: a minute together
 SLOW = ["terraces", "big_terrain", "rolling_terrain", "hills", "bumpy_floor", "narrow_deck", "fort", "bridge",
-        "two_storeys", "ramps_and_decks", "corridor", "islands"]
+        "two_storeys", "ramps_and_decks", "corridor", "islands", "fence_field"]
 
 
 def _import(src: Path, out: Path) -> Path:

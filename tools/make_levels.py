@@ -19,6 +19,7 @@ height-field grids, seeded, so a seed gives the same file:
 * ``town``, ``junkyard``, ``living_room``: what exporters and careless modelling write --
   objects pasted twice, overlapping boxes, faces wound inside out, zero-thickness fences
   a hair apart, rooms of single faces seen from inside, furniture on legs
+* ``fence_field``: 1,500 fences and 400 pillars in a 200 m yard (thin walls' stress test)
 * ``stacked_floors`` (a car park of two decks), ``terraces`` (terrain cut into steps by
   retaining walls, a footbridge), ``big_terrain`` (a 300 m smooth hillside)
 """
@@ -227,6 +228,24 @@ def junkyard(seed: int = 0) -> list:
     return parts
 
 
+def fence_field(seed: int = 3, fences: int = 1500, pillars: int = 400, size: float = 200.0) -> list:
+    """A ``size`` m walled yard strewn with ``fences`` seeded zero-thickness fences 0.5 -
+    4 m long at any angle and ``pillars`` square pillars: thousands of one-sided cut
+    chains over a free space of thousands of vertices, as in a Sauerbraten map (the
+    thin walls' stress test of bench/walls.py)."""
+    rng = np.random.default_rng(seed)
+    parts = walled_yard(size, size)
+    for _ in range(fences):
+        x, z = rng.uniform(3, size - 3, 2)
+        a, n = rng.uniform(0, math.pi), rng.uniform(0.5, 4)
+        parts.append(("wall", fence(x, z, x + n * math.cos(a), z + n * math.sin(a), 0, 2)))
+    for _ in range(pillars):
+        x, z = rng.uniform(3, size - 3, 2)
+        w = rng.uniform(0.3, 1.5)
+        parts.append(("rock", box(x, z, x + w, z + w, 0, 3)))
+    return parts
+
+
 def living_room(seed: int = 5) -> list:
     """A living room at the scale of toy tanks (60 x 48 m, 24 m high) made of single
     faces seen from inside, furnished: a sofa of overlapping boxes, a table and chairs
@@ -310,7 +329,7 @@ LEVELS = {
     "rolling_terrain": rolling_terrain, "ramps_and_decks": ramps_and_decks, "bridge": bridge,
     "bumpy_floor": bumpy_floor, "tiny_room": tiny_room, "two_storeys": two_storeys, "hills": hills, "fort": fort,
     "corridor": corridor, "islands": islands, "narrow_deck": narrow_deck,
-    "town": town, "junkyard": junkyard, "living_room": living_room, "stacked_floors": stacked_floors, "terraces": terraces,
+    "town": town, "junkyard": junkyard, "fence_field": fence_field, "living_room": living_room, "stacked_floors": stacked_floors, "terraces": terraces,
     "big_terrain": big_terrain,
 }
 

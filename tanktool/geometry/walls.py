@@ -53,6 +53,7 @@ import shapely
 
 from ..errors import ArenaError
 from ..formats.walls_txt import WallList, aux_rectangle
+from .thin_walls import line_segments, thin_walls, thin_walls_reference  # noqa: F401
 
 #: an upward face has a normal within ~25 degrees of +y
 UP_NORMAL_MIN = 0.9
@@ -495,30 +496,6 @@ def outline_walls(free, tolerance: float) -> np.ndarray:
     if not out:
         return np.zeros((0, 2, 2))
     return np.concatenate(out)
-
-
-def thin_walls(chains: list, free, tolerance: float) -> np.ndarray:
-    """Open cut chains where they cross free space, as (n, 2, 2) segments."""
-    if not chains or free.is_empty:
-        return np.zeros((0, 2, 2))
-    lines = shapely.simplify(np.array(chains, dtype=object), tolerance)
-    inside = shapely.intersection(lines, free)
-    # a chain lying on the free space's outline is already a wall there
-    inside = shapely.difference(inside, shapely.buffer(shapely.boundary(free), tolerance, cap_style="flat"))
-    return line_segments(shapely.get_parts(shapely.line_merge(shapely.union_all(inside))), tolerance)
-
-
-def line_segments(parts: np.ndarray, tolerance: float) -> np.ndarray:
-    """The (n, 2, 2) segments of the line strings among ``parts`` (other geometries
-    left out), those shorter than ``tolerance`` dropped."""
-    parts = parts[shapely.get_type_id(parts) == 1]
-    if len(parts) == 0:
-        return np.zeros((0, 2, 2))
-    coords, index = shapely.get_coordinates(parts, return_index=True)
-    same = index[1:] == index[:-1]
-    seg = np.stack([coords[:-1][same], coords[1:][same]], axis=1)
-    length = np.hypot(*(seg[:, 1] - seg[:, 0]).T)
-    return seg[length >= tolerance]
 
 
 #: gap between the walls' extent and the auxiliary rectangle (m)
