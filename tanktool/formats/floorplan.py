@@ -38,6 +38,10 @@ from .limits import MAX_MODEL_BYTES, MAX_OBJECTS
 
 #: points of all the drawing's lines and sampled curves together
 MAX_PLAN_POINTS = 2_000_000
+#: pairs of segments with overlapping boxes a plan may hold (the cost of noding the
+#: lines where they cross): a base plus a share for each segment
+MAX_OVERLAPS_BASE = 1_000_000
+MAX_OVERLAPS_PER_SEGMENT = 16
 #: how many wall thicknesses a drawing may be across
 MAX_THICKNESSES = 1e6
 
@@ -211,6 +215,7 @@ def plan_walls(lines: list[np.ndarray], thickness: float):
             seen.add(key)
             unique.append(ln)
     lines = unique
+    check_overlaps(lines)
     geoms = [shapely.LineString(ln) for ln in lines]
     # noding splits lines where they cross; merging joins pieces that meet end to end,
     # so separate LINE entities around a corner are mitred like one polyline
@@ -227,6 +232,38 @@ def plan_walls(lines: list[np.ndarray], thickness: float):
     if not polys:
         raise FormatError("the drawing's lines make no wall area")
     return shapely.multipolygons(polys) if len(polys) > 1 else polys[0]
+
+
+def overlap_budget(segments: int) -> int:
+    """Pairs of segments whose boxes overlap that a plan of ``segments`` may hold."""
+    return MAX_OVERLAPS_BASE + MAX_OVERLAPS_PER_SEGMENT * segments
+
+
+def check_overlaps(lines: list[np.ndarray]) -> int:
+    """Count the pairs of segments whose bounding boxes overlap (the work GEOS does to
+    node the lines where they cross), stopping as soon as there are more than
+    :func:`overlap_budget`: FormatError then.  A drawn plan's walls meet at their ends
+    (a few pairs a segment); 30,000 random lines across a page overlap 10^8 times and
+    kept GEOS busy for minutes.  The count runs in slices of the segments small
+    enough that one slice's answer stays under 8 M pairs (128 MB)."""
+    import shapely
+
+    a = np.concatenate([ln[:-1, :2] for ln in lines])
+    b = np.concatenate([ln[1:, :2] for ln in lines])
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    boxes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
+    n = len(boxes)
+    budget = overlap_budget(n)
+    tree = shapely.STRtree(boxes)
+    step = max(1, min(4096, 8_000_000 // max(n, 1)))
+    total = 0
+    for start in range(0, n, step):
+        total += len(tree.query(boxes[start:start + step])[0])
+        if total > budget:
+            raise FormatError(f"the drawing's {n:,} segments cross or overlap more than {budget:,} times "
+                              f"(the limit: {MAX_OVERLAPS_BASE:,} + {MAX_OVERLAPS_PER_SEGMENT} a segment): "
+                              f"not a floor plan? draw walls that meet at their ends")
+    return total
 
 
 def solid_shapes(lines: list[np.ndarray], geoms: list, thickness: float) -> list:
