@@ -26,6 +26,8 @@ class OptionalBuildExt(build_ext):
 
 
 setup(
-    ext_modules=[Extension("tanktool._kernels", ["tanktool/_kernels.c"], extra_compile_args=["-O2"], optional=True)],
+    # -ffp-contract=off: no fused multiply-adds, the rasteriser's sums are numpy's
+    ext_modules=[Extension("tanktool._kernels", ["tanktool/_kernels.c"], extra_compile_args=["-O2", "-ffp-contract=off"],
+                           optional=True)],
     cmdclass={"build_ext": OptionalBuildExt},
 )

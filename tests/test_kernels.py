@@ -90,3 +90,28 @@ def test_the_numpy_fallback_runs_without_the_kernels():
         link = link_spans(col, floor, ceil, shape, 5, 4)
         d = chamfer_clearance(link, 12)
     assert d.min() >= 1 and d.max() <= 12
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(4))
+def test_a_random_triangle_soup_cropped_by_the_grid_rasterises_the_same(seed):
+    """Triangles of every slope and size, some beyond the grid's edges (a grid given by
+    origin and shape smaller than the soup), some flat in z or in y."""
+    from tanktool.geometry.heightfield import build_heightfield
+
+    rng = np.random.default_rng(seed)
+    n = 400
+    centre = rng.uniform(-5, 25, (n, 1, 3))
+    tri = centre + rng.normal(0, 1.5, (n, 3, 3)) * rng.uniform(0.05, 2.0, (n, 1, 1))
+    tri[: n // 8, :, 1] = tri[: n // 8, :1, 1]            # horizontal
+    tri[n // 8: n // 4, :, 2] = tri[n // 8: n // 4, :1, 2]  # in one z line
+    V = tri.reshape(-1, 3)
+    F = np.arange(len(V)).reshape(-1, 3)
+    for cell in (0.3, 0.5):
+        with use_kernels(True):
+            a = build_heightfield(V, F, cell, 0.1, 40.0, 2.0, 0.9, origin_xz=(0.0, 0.0), shape=(50, 60))
+        with use_kernels(False):
+            b = build_heightfield(V, F, cell, 0.1, 40.0, 2.0, 0.9, origin_xz=(0.0, 0.0), shape=(50, 60))
+        assert len(a.col) > 1000 and a.counts == b.counts
+        for key in ("col", "smin", "smax", "walkable", "flat", "top_walkable"):
+            assert np.array_equal(getattr(a, key), getattr(b, key)), key

@@ -450,6 +450,8 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
     Returns sorted (col, smin, smax, walkable, flat) arrays and the number of
     (triangle, cell) pairs.
     """
+    from .kernels import active
+
     nz, nx = shape
     V = np.asarray(vertices, dtype=np.float64)
     gx = (V[:, 0] - origin[0]) / cs  # grid units: cell j covers [j, j + 1)
@@ -468,16 +470,26 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
     # |n_y| / |n| in world units (the grid scales x and z by 1 / cs)
     gentle = np.abs(n_y) >= GENTLE_NY * np.sqrt((n_x * cs) ** 2 + (n_z * cs) ** 2 + n_y * n_y)
     out = []
+    kern = active()
     for group in (np.flatnonzero(gentle), np.flatnonzero(~gentle)):
         if len(group) == 0:
             continue
         Xg, Zg, Yg = ([a[group] for a in arr] for arr in (X, Z, Y))
-        rows = _rows(Xg, Zg, Yg, nz, nx)
         if gentle[group[0]]:
             ny_ = n_y[group]
             B, C = -n_x[group] / ny_, -n_z[group] / ny_
-            p, j, smin, smax = _cells_plane(rows, Yg[0] - B * Xg[0] - C * Zg[0], B, C, ch)
+            A = Yg[0] - B * Xg[0] - C * Zg[0]
+            if kern is not None:  # the same spans in one pass over the triangles
+                res = kern.raster_gentle(np.ascontiguousarray(np.column_stack(Xg + Zg + Yg)),
+                                         np.ascontiguousarray(np.column_stack([A, B, C])), nz, nx, float(ch),
+                                         MAX_HEIGHT_STEPS)
+                c_col, c_tri, smin, smax = (np.frombuffer(b, dtype=np.int64) for b in res)
+                out.append((c_col, group[c_tri], smin, smax))
+                continue
+            rows = _rows(Xg, Zg, Yg, nz, nx)
+            p, j, smin, smax = _cells_plane(rows, A, B, C, ch)
         else:
+            rows = _rows(Xg, Zg, Yg, nz, nx)
             p, j, smin, smax = _cells_exact(rows, Xg, Zg, Yg, ch)
         out.append((rows.row[p] * nx + j, group[rows.tri[p]], smin, smax))
     if not out:
