@@ -90,3 +90,27 @@ def test_the_example_runs_both_policies_and_plots(tmp_path):
     out = tmp_path / "returns.png"
     assert main(["--episodes", "1", "--seconds", "2", "--out", str(out)]) == 0
     assert out.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_the_feelers_agree_with_the_walls_first_hit():
+    import math
+
+    from tanktool.env.observe import _FEELER_DIRS, FEELER, feelers
+    from tanktool.sim.match import load_match_arena, load_tank_spec
+    from tanktool.sim.world import World
+
+    rng = np.random.default_rng(0)
+    for name in ("box", "fort"):
+        info = load_match_arena(name)
+        world = World(info.walls, [load_tank_spec("light")], info.spawns, bounds=info.bounds, ground=info.ground)
+        for walls in [world.walls, *world.level_walls]:
+            (x0, z0), (x1, z1) = world.bounds.tolist()
+            for _ in range(60):
+                x, z, h = rng.uniform(x0, x1), rng.uniform(z0, z1), rng.uniform(-math.pi, math.pi)
+                c, s = math.cos(h), math.sin(h)
+                want = []
+                for dc, ds in _FEELER_DIRS:
+                    fx, fz = c * dc - s * ds, s * dc + c * ds
+                    hit = walls.first_hit(x, z, x + FEELER * fx, z + FEELER * fz)
+                    want.append(1.0 if hit is None else max(hit[0], 0.0))
+                assert feelers(walls, x, z, c, s) == pytest.approx(want, abs=1e-9)
