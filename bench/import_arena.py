@@ -1,6 +1,6 @@
 """The whole import-arena per stage, beside Recast's whole build of the same mesh.
 
-Three parts, each a table (or one JSON object with ``--json``):
+Four parts, each a table (or one JSON object with ``--json``):
 
 * **stages** (default): per level, the whole import as a match needs it --
   ``tanktool.arena.import_arena`` and then, when the import did not write the grid,
@@ -20,10 +20,13 @@ Three parts, each a table (or one JSON object with ``--json``):
   ``--plot PNG`` draws it (docs/scale_series.png).
 * **walls** (``--walls``): the wall extraction beside trimesh's bare cross-section of
   the same model (dungeon, the maze, a 1.3-million-face arena), best of ``--repeat``.
+* **one step** (``--one-step``, bench/one_step.py): the one-step import (all outputs)
+  against import + build-navgrid in the same process, CPU time, best of ``--repeat``.
 
     python bench/import_arena.py [MODEL ...] [--quick] [--no-kernels] [--json]
     python bench/import_arena.py --scale [--sizes 100,300,1000,2000] [--plot docs/scale_series.png] [--json]
     python bench/import_arena.py --walls [--repeat N] [--quick] [--json]
+    python bench/import_arena.py --one-step [--repeat N] [--json]
 """
 
 from __future__ import annotations
@@ -460,6 +463,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sizes", default="100,300,1000,2000", help="--scale: terrain sizes in metres")
     ap.add_argument("--plot", type=Path, default=None, help="--scale: draw the series into this PNG")
     ap.add_argument("--walls", action="store_true", help="the wall extraction beside trimesh's bare cut")
+    ap.add_argument("--one-step", action="store_true",
+                    help="the one-step import against import + build-navgrid (bench/one_step.py)")
     ap.add_argument("--no-kernels", action="store_true", help="force the numpy code (no tanktool._kernels)")
     ap.add_argument("--child", help=argparse.SUPPRESS)
     ap.add_argument("--work", type=Path, help=argparse.SUPPRESS)
@@ -468,6 +473,13 @@ def main(argv: list[str] | None = None) -> int:
         row = profile_one(a.child, a.work)
         row["peak_mb"] = peak_mb()
         print(json.dumps(row))
+        return 0
+    if a.one_step:
+        import one_step
+
+        out = one_step.report(one_step.run(a.repeat), a.json)
+        if out is not None:
+            print(json.dumps(out, indent=1))
         return 0
     if a.walls:
         rows = walls_part(a.repeat, a.quick)

@@ -173,6 +173,7 @@ class ImportResult:
     levels: Any = None  # nav.arena_levels.ArenaLevels: levels, what was left out, the tank grid
     params: Any = None  # the WalkableParams used
     defaults: dict[str, str] = field(default_factory=dict)  # where each default came from
+    grid: Any = None    # grid_files.BuiltGrid: the navigation grid written with the bundle (None: not built)
 
 
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
@@ -239,13 +240,16 @@ def import_arena(
     cell: float | None = None,
     walkable: dict[str, Any] | None = None,
     max_cells: int | None = None,
+    grid: bool = True,
 ) -> ImportResult:
     """Read ``model``, find its walkable levels, walls and spawns and write the arena
     bundle ``out``.
 
     ``out`` defaults to ``./<name>``; ``name`` to the model's file stem.  ``navgrid``
     overrides the [navgrid] defaults and ``walkable`` the [walkable] ones (used when
-    rebuilding a bundled arena); ``max_slope``, ``climb``, ``headroom`` and ``cell``
+    rebuilding a bundled arena); ``grid`` (default) also builds the navigation files
+    build-navgrid writes (navgrid.npz, quadtree.npz, navgrid.png: ``grid_files``) with
+    the default clearance, so the bundle is ready to play; ``max_slope``, ``climb``, ``headroom`` and ``cell``
     are the command's options.  ``warn`` also receives the non-fatal remarks collected
     in ``ImportResult.warnings``.  ``wall_height`` / ``wall_thickness`` shape a .dxf/.svg
     floor plan's walls.  Everything is written into a temporary folder renamed into
@@ -324,6 +328,7 @@ def import_arena(
     nav["cell"] = float(params.cell)
     bounds = walls.bounds
     with_y = spawn_y_needed(result)
+    built = None
     companions = _companion_files(model)
     with staged_dir(target, force=force, manifest=MANIFEST) as tmp:
         copied = [model, *companions]
@@ -363,8 +368,16 @@ def import_arena(
             "derived": {f: sha256_file(tmp / f) for f in ("walls.txt", "model.glb", "preview.png")},
         }
         write_toml(tmp / MANIFEST, doc)
+        if grid:  # the same files, built the same way, as build-navgrid on the bundle
+            from .grid_files import build_grid, open_target, render_picture, stage_grid_files
+
+            staged = open_target(tmp)
+            built = build_grid(staged, warn=remark, fleet=fits)
+            write_toml(tmp / MANIFEST, stage_grid_files(tmp, staged, built, render_picture(built, staged)))
+            if progress:
+                progress("navgrid")
     return ImportResult(target, name, walls, spawns, result.floor_y, len(mesh.faces), result.walls.thin_walls,
-                        time.perf_counter() - t0, warnings, result, params, where)
+                        time.perf_counter() - t0, warnings, result, params, where, built)
 
 
 def _plan_source(fmt: str, wall_height: float | None, wall_thickness: float | None) -> dict[str, float]:

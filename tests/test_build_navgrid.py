@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from tanktool import grid_files
 from tanktool.cli import build_navgrid as cmd
 from tanktool.cli.main import cli
 from tanktool.formats.bundle import read_toml, sha256_file, write_toml
@@ -19,7 +20,7 @@ def _two_rooms():
 
 @pytest.fixture
 def bundle(tmp_path, monkeypatch):
-    monkeypatch.setattr(cmd, "VEHICLES_DIR", tmp_path / "no-vehicles")
+    monkeypatch.setattr(grid_files, "VEHICLES_DIR", tmp_path / "no-vehicles")
     d = tmp_path / "arenas" / "rooms"
     d.mkdir(parents=True)
     walls = _two_rooms()
@@ -70,7 +71,7 @@ def test_defaults_come_from_the_bundle_and_vehicles(bundle, tmp_path, monkeypatc
     for name, radius in (("small", 0.9), ("big", 2.25)):
         (vehicles / name).mkdir(parents=True)
         write_toml(vehicles / name / "vehicle.toml", {"name": name, "footprint_radius": radius})
-    monkeypatch.setattr(cmd, "VEHICLES_DIR", vehicles)
+    monkeypatch.setattr(grid_files, "VEHICLES_DIR", vehicles)
     r = run(bundle, "--quadtree-depth", 2, "--annotate", "none")
     assert r.exit_code == 0, r.output
     assert "clearance 2.25 m (footprint radius of vehicle 'big')" in r.output
@@ -80,7 +81,7 @@ def test_defaults_come_from_the_bundle_and_vehicles(bundle, tmp_path, monkeypatc
 
 
 def test_bare_walls_file_svg_table_and_region(tmp_path, monkeypatch):
-    monkeypatch.setattr(cmd, "VEHICLES_DIR", tmp_path / "none")
+    monkeypatch.setattr(grid_files, "VEHICLES_DIR", tmp_path / "none")
     w = random_arena(2, size=20.0)
     write_walls(tmp_path / "yard.txt", w)
     r = run(tmp_path / "yard.txt", "--cell", 0.5, "--clearance", 0.6, "--plot", tmp_path / "yard.svg",

@@ -41,13 +41,20 @@ def test_import_writes_a_complete_bundle(tmp_path):
     r = run("import-arena", str(model), "-o", str(out))
     assert r.exit_code == 0, r.output
     assert "1 level, 8 walls" in r.output and "level 0: " in r.output and "left out:" in r.output
-    for f in ("arena.toml", "room.obj", "model.glb", "walls.txt", "preview.png"):
+    for f in ("arena.toml", "room.obj", "model.glb", "walls.txt", "preview.png", "navgrid.npz", "quadtree.npz",
+              "navgrid.png"):
         assert (out / f).is_file(), f
+    assert "navgrid: " in r.output
     doc = read_toml(out / "arena.toml")
     assert doc["name"] == "room"
     assert doc["source"] == {"file": "room.obj", "sha256": sha256_file(model), "up": "y", "scale": 1.0}
     assert doc["walls"]["count"] == 8 and doc["walls"]["height"] == 1.0
-    assert doc["navgrid"] == {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
+    from tanktool.fleet import bundled_fleet
+
+    # one step: the grid is built for the largest bundled vehicle, as build-navgrid does
+    assert doc["navgrid"] == {"cell": 0.5, "clearance": pytest.approx(bundled_fleet().radius, abs=1e-4),
+                              "quadtree_depth": 3}
+    assert {"navgrid.npz", "quadtree.npz", "navgrid.png"} <= set(doc["derived"])
     for f, digest in doc["derived"].items():
         assert sha256_file(out / f) == digest
     assert doc["walkable"]["headroom"] > 0 and doc["levels"][0]["level"] == 0
@@ -69,6 +76,21 @@ def test_import_writes_a_complete_bundle(tmp_path):
     scene = trimesh.load(out / "model.glb", force="scene")
     assert scene.bounds[1][1] == pytest.approx(3.0)
     assert (out / "preview.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_one_step_import_writes_what_build_navgrid_writes(tmp_path):
+    # import-arena alone makes the bundle play needs; build-navgrid afterwards, with
+    # the same settings, rewrites the same bytes
+    model = write_room(tmp_path / "room.obj", 40)
+    out = tmp_path / "room"
+    assert run("-q", "import-arena", str(model), "-o", str(out)).exit_code == 0
+    before = {f: (out / f).read_bytes() for f in ("navgrid.npz", "quadtree.npz", "navgrid.png", "arena.toml")}
+    r = run("-q", "build-navgrid", str(out))
+    assert r.exit_code == 0, r.output
+    for f, data in before.items():
+        assert (out / f).read_bytes() == data, f
+    r = run("check", str(out))
+    assert r.exit_code == 0 and "0 errors" in r.output, r.output
 
 
 def test_load_arena_reads_the_bundle(tmp_path):

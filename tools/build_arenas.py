@@ -5,15 +5,13 @@
 For each ``arenas/<name>/arena.toml`` the source model named in its ``[source]``
 table is run through import-arena again with the parameters the manifest records
 (up axis, scale, wall height, tolerance, the [walkable] and [navgrid] tables), replacing the bundle
-atomically; then, when the ``build-navgrid`` command exists, it is run on the
-bundle so that ``navgrid.npz`` and ``quadtree.npz`` follow the new walls.
+atomically; import-arena writes the navigation files too (navgrid.npz, quadtree.npz,
+navgrid.png), as build-navgrid would, so they follow the new walls.
 tools/make_arena_models.py authors the source models themselves.
 """
 
 from __future__ import annotations
 
-import importlib.util
-import subprocess
 import sys
 from pathlib import Path
 
@@ -22,7 +20,8 @@ sys.path.insert(0, str(ROOT))
 
 
 def rebuild(folder: Path, out: Path | None = None, navgrid: bool = True) -> None:
-    """Re-import ``folder``'s source into ``out`` (default: the folder itself)."""
+    """Re-import ``folder``'s source into ``out`` (default: the folder itself); without
+    ``navgrid``, leave out the navigation files (quicker, for tests of the walls)."""
     from tanktool.arena import import_arena
     from tanktool.formats.bundle import read_toml
 
@@ -34,10 +33,8 @@ def rebuild(folder: Path, out: Path | None = None, navgrid: bool = True) -> None
                      scale=float(src.get("scale", 1.0)), height=float(walls.get("height", 1.0)),
                      tolerance=float(walls.get("tolerance", 0.01)), force=True, navgrid=doc.get("navgrid"),
                      wall_height=src.get("wall_height"), wall_thickness=src.get("wall_thickness"),
-                     walkable=doc.get("walkable"))
+                     walkable=doc.get("walkable"), grid=navgrid)
     print(f"{folder.name}: {len(r.walls)} walls, {len(r.spawns)} spawns ({r.seconds:.2f} s)")
-    if navgrid and importlib.util.find_spec("tanktool.cli.build_navgrid") is not None:
-        subprocess.run([sys.executable, "-m", "tanktool", "build-navgrid", str(target)], check=True)
 
 
 def main(argv: list[str] | None = None) -> int:

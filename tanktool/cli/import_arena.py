@@ -14,7 +14,7 @@ PROGRESS_FACES = 100_000
 PROGRESS_PLAN_BYTES = 16_000
 #: the stages import_arena reports (floor plans report PLAN_STAGES while being read),
 #: then nav.arena_levels.STAGES, then the files
-STAGES = ("read", "surface", "walls", "grid", "spawns", "report", "files")
+STAGES = ("read", "surface", "walls", "grid", "spawns", "report", "files", "navgrid")
 
 
 def _face_count_guess(model: Path) -> int:
@@ -76,8 +76,12 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
     floors) and places spawns where the largest bundled tank fits.  Prints each
     level's area and height range and what was left out and why.
 
+    Writes everything a match needs, so `tanktool play --arena OUT` follows at once:
+    build-navgrid is only for rebuilding the grid with other settings.
+
     \b
-    Writes arena.toml, the model, model.glb, walls.txt, preview.png:
+    Writes arena.toml, the model, model.glb, walls.txt, preview.png, navgrid.npz,
+    quadtree.npz, navgrid.png:
       tanktool import-arena castle.3ds -o arenas/castle --height 1.2
       tanktool import-arena hills.obj --max-slope 30 --climb 0.5
       tanktool import-arena plan.dxf --wall-height 3 --wall-thickness 0.4
@@ -110,6 +114,11 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
     echo(f"  walkable: {_describe_params(result.params, result.defaults)}")
     echo(f"  bounds x {x0:g}..{x1:g}, z {z0:g}..{z1:g} m ({x1 - x0:.1f} x {z1 - z0:.1f} m), "
          f"floor y={result.floor_y:.3f}, {result.faces} faces")
+    if result.grid is not None:
+        g = result.grid
+        valid = int(g.grid.valid.sum())
+        echo(f"  navgrid: {g.grid.nz} x {g.grid.nx} nodes{f' on {g.grid.levels} levels' if g.grid.levels > 1 else ''} "
+             f"at {g.cell:g} m, clearance {g.clearance:g} m ({g.clearance_source}): {valid:,} valid")
     echo(f"  wrote {result.path} in {result.seconds:.2f} s")
 
 

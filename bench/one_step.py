@@ -1,0 +1,95 @@
+"""The one-step import against the two steps it replaced (issue 25), in one process.
+
+One step: ``tanktool.arena.import_arena`` writing every file a match needs (walls,
+surface, layered navigation grid, quadtree, pictures, hashes).  Two steps: the same
+import without the grid (``grid=False``), then the ``build-navgrid`` command on the
+bundle.  Best of ``--repeat`` each, CPU time of this process (every thread; the
+machine is shared, so wall time is shown too but not judged) and the ratio one / two.
+Levels: the bundled arenas' sources (their recorded settings), Recast's dungeon and a
+300 m rolling terrain (bench/import_arena.py's helpers).  Goal: the one step is not
+slower than the two together (ratio <= 1, with 5 % for noise).
+
+    python bench/import_arena.py --one-step [--repeat N] [--json]
+"""
+
+from __future__ import annotations
+
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+#: a bit of slack for "not slower": two runs of the same work differ by a few per cent
+NOISE = 1.05
+
+
+def best_both(fn: Callable[[], Any], repeat: int) -> tuple[float, float, Any]:
+    """Best wall-clock and best CPU time of ``repeat`` runs, and the last result."""
+    t_best = c_best = float("inf")
+    result = None
+    for _ in range(repeat):
+        t0, c0 = time.perf_counter(), time.process_time()
+        result = fn()
+        t_best = min(t_best, time.perf_counter() - t0)
+        c_best = min(c_best, time.process_time() - c0)
+    return t_best, c_best, result
+
+
+def cases(work: Path) -> list[tuple[str, Path, dict]]:
+    """(label, model, import_arena keyword arguments) of the levels compared."""
+    import import_arena as bench
+
+    out = []
+    for name in bench.BUNDLED:
+        if (bench.ROOT / "arenas" / name / "arena.toml").is_file():
+            model, kw = bench.bundled_kwargs(name)
+            out.append((f"arenas/{name}", model, {**kw, "name": name}))
+    if bench.DUNGEON.is_file():
+        out.append(("dungeon.obj", bench.DUNGEON, {}))
+    out.append(("terrain 300 m", bench.terrain(300.0, work), {}))
+    return out
+
+
+def run(repeat: int) -> list[dict]:
+    """One row per level: CPU and wall seconds of each way, their ratios, the grid."""
+    import import_arena as bench
+
+    from tanktool.arena import import_arena
+
+    bench.import_cli()
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="one-step-bench-") as d:
+        work = Path(d)
+        for label, model, kw in cases(work):
+            out = work / "bundle"
+
+            def one() -> Any:
+                return import_arena(model, out, force=True, **kw)
+
+            def two() -> None:
+                import_arena(model, out, force=True, grid=False, **kw)
+                bench.run_build_navgrid(out)
+
+            t_two, c_two, _ = best_both(two, repeat)
+            t_one, c_one, res = best_both(one, repeat)
+            g = res.grid.grid
+            rows.append({"model": label, "one_step_cpu_s": round(c_one, 3), "two_steps_cpu_s": round(c_two, 3),
+                         "ratio": round(c_one / c_two, 3), "one_step_wall_s": round(t_one, 3),
+                         "two_steps_wall_s": round(t_two, 3), "wall_ratio": round(t_one / t_two, 3),
+                         "levels": int(g.levels), "valid": int(g.valid.sum())})
+    return rows
+
+
+def report(rows: list[dict], as_json: bool) -> dict | None:
+    """Print the table (or return the JSON object)."""
+    goal = all(r["ratio"] <= NOISE for r in rows)
+    if as_json:
+        return {"part": "one_step", "rows": rows, "noise": NOISE, "goals": {"one_step_not_slower": goal}}
+    print(f"{'one step vs import + build-navgrid':<24} {'CPU s: one':>10} {'two':>6} {'ratio':>6} "
+          f"{'wall s: one':>11} {'two':>6} {'ratio':>6} {'levels':>6} {'valid nodes':>11}")
+    for r in rows:
+        print(f"{r['model']:<24} {r['one_step_cpu_s']:>10.2f} {r['two_steps_cpu_s']:>6.2f} {r['ratio']:>6.2f} "
+              f"{r['one_step_wall_s']:>11.2f} {r['two_steps_wall_s']:>6.2f} {r['wall_ratio']:>6.2f} "
+              f"{r['levels']:>6} {r['valid']:>11,}")
+    print(f"goal: one step not slower than the two (CPU ratio <= {NOISE}): {goal}")
+    return None
