@@ -180,10 +180,18 @@ _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
 
 
 def _companion_files(model: Path) -> list[Path]:
-    """Files a model needs beside it: an .obj's material libraries."""
-    from .formats.materials import mtl_libraries
+    """Files a model needs beside it: an .obj's material libraries, a .gltf's buffers."""
+    from .formats.materials import companion_files
 
-    return mtl_libraries(model)
+    return companion_files(model)
+
+
+def _beside(f: Path, model: Path) -> str:
+    """``f``'s name relative to the model's folder (posix), as the model names it."""
+    try:
+        return f.relative_to(model.parent).as_posix()
+    except ValueError:
+        return f.name
 
 
 def walkable_params(cell: float | None = None, max_slope: float | None = None, climb: float | None = None,
@@ -332,8 +340,9 @@ def import_arena(
     companions = _companion_files(model)
     with staged_dir(target, force=force, manifest=MANIFEST) as tmp:
         copied = [model, *companions]
-        for f in copied:
-            shutil.copyfile(f, tmp / f.name)
+        for f in copied:  # where the model looks for it: a .gltf's "data/scene.bin" stays there
+            (tmp / _beside(f, model)).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(f, tmp / _beside(f, model))
         glb, textures = export_glb(model, scene, tmp, extra=[target], warn=remark)   # textures copied in
         (tmp / "model.glb").write_bytes(glb)
         header = (f"arena {name}: walls of {model.name}, the boundaries of its walkable surface "
@@ -355,7 +364,7 @@ def import_arena(
                        for x, z, h, y in spawns],
             "source": {"file": model.name, "sha256": sha256_file(tmp / model.name), "up": src_up,
                        "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness),
-                       **({"companions": [f.name for f in companions]} if companions else {})},
+                       **({"companions": [_beside(f, model) for f in companions]} if companions else {})},
             "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
             "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
                       "count": len(walls)},

@@ -287,3 +287,47 @@ def test_a_plan_of_crossing_lines_is_refused_in_overlaps_and_a_town_is_not(tmp_p
     town = read_plan(_town_dxf(tmp_path / "town.dxf"))
     segments = sum(len(ln) - 1 for ln in town)
     assert check_overlaps(town) < overlap_budget(segments) / 4
+
+
+# ----------------------------------------------------------------- glTF from the wild
+
+def _gltf_with_external_files(folder: Path) -> Path:
+    """The box arena's model.glb as a .gltf with its buffer in data/my scene.bin and its
+    first image in textures/brick one.png, both named by percent-encoded URIs."""
+    import json
+    import struct
+
+    data = (ROOT / "arenas" / "box" / "model.glb").read_bytes()
+    jlen = struct.unpack_from("<I", data, 12)[0]
+    doc = json.loads(data[20:20 + jlen])
+    blen = struct.unpack_from("<I", data, 20 + jlen)[0]
+    binary = data[28 + jlen:28 + jlen + blen]
+    (folder / "data").mkdir(parents=True)
+    (folder / "data" / "my scene.bin").write_bytes(binary)
+    doc["buffers"][0]["uri"] = "data/my%20scene.bin"
+    image = doc["images"][0]
+    view = doc["bufferViews"][image.pop("bufferView")]
+    (folder / "textures").mkdir()
+    start = view.get("byteOffset", 0)
+    (folder / "textures" / "brick one.png").write_bytes(binary[start:start + view["byteLength"]])
+    image["uri"] = "textures%2Fbrick%20one.png"
+    model = folder / "scene.gltf"
+    model.write_text(json.dumps(doc))
+    return model
+
+
+def test_a_gltf_with_percent_encoded_uris_imports_and_its_bundle_imports_again(tmp_path):
+    from tanktool.formats.materials import model_textures
+
+    model = _gltf_with_external_files(tmp_path / "src")
+    found = model_textures(model)
+    assert not found.missing and len(found.found) >= 1
+    res = run("import-arena", str(model), "-o", str(tmp_path / "bundle"), "-q")
+    assert res.exit_code == 0, res.output
+    copied = tmp_path / "bundle" / "data" / "my scene.bin"
+    assert copied.read_bytes() == (tmp_path / "src" / "data" / "my scene.bin").read_bytes()
+    res = run("import-arena", str(tmp_path / "bundle" / "scene.gltf"), "-o", str(tmp_path / "again"), "-q")
+    assert res.exit_code == 0, res.output
+    # the bundle is one tanktool wrote: --force may replace it (its data/ is accounted for)
+    res = run("import-arena", str(model), "-o", str(tmp_path / "bundle"), "-q", "--force")
+    assert res.exit_code == 0, res.output

@@ -398,7 +398,7 @@ def bundle_files(folder: Path, doc: dict[str, Any], manifest: str) -> set[str]:
     if isinstance(src, dict):
         comp = src.get("companions")
         if isinstance(comp, list):
-            names.update(c for c in comp if isinstance(c, str))
+            names.update(c.split("/")[0] for c in comp if isinstance(c, str))   # "data/scene.bin": data/
         f = src.get("file")
         if isinstance(f, str) and f.lower().endswith(".obj") and "/" not in f:
             names |= _obj_materials(folder / f)

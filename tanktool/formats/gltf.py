@@ -44,6 +44,7 @@ import struct
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+from urllib.parse import unquote
 
 import numpy as np
 
@@ -209,7 +210,7 @@ def _buffers(d: _Doc, doc: dict, binary: bytes | None, folder: Path | None) -> l
         else:
             if folder is None:
                 raise d.fail(f"{where}.uri", f"names an external file ({uri[:60]!r}); a .glb must hold its buffers")
-            f = bundle_file(folder, uri, f"{d.label}: {where}.uri")
+            f = bundle_file(folder, unquote(uri), f"{d.label}: {where}.uri")   # a URI: %20 is a space
             data = read_input(f, "a glTF buffer", label=f"{d.label}: {where}.uri {uri!r}")
         if len(data) < length:
             raise d.fail(f"{where}.byteLength", f"says {length} bytes but the buffer holds {len(data)}")

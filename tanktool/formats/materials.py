@@ -26,6 +26,7 @@ source model still finds them.
 from __future__ import annotations
 
 import json
+from urllib.parse import unquote
 import os
 import shutil
 from dataclasses import dataclass, field
@@ -248,8 +249,42 @@ def gltf_textures(model: Path) -> list[tuple[str, str]]:
     for i, im in enumerate(images):
         uri = im.get("uri") if isinstance(im, dict) else None
         if isinstance(uri, str) and uri and not uri.startswith("data:"):
-            out.append((f"image {i}", uri))
+            out.append((f"image {i}", unquote(uri)))   # a URI: "textures%2Fgrass.webp" is textures/grass.webp
     return out
+
+
+def gltf_buffers(model: Path) -> list[Path]:
+    """The external buffer files (``.bin``) a .gltf names by a relative URI: regular
+    files inside the model's folder (a .glb holds its own)."""
+    from ..errors import FormatError
+    from .bundle import bundle_file
+
+    if model.suffix.lower() != ".gltf":
+        return []
+    try:
+        doc = json.loads(model.read_text(encoding="utf-8-sig"))
+    except (OSError, ValueError):
+        return []
+    out: list[Path] = []
+    buffers = doc.get("buffers") if isinstance(doc, dict) else None
+    for b in buffers if isinstance(buffers, list) else []:
+        uri = b.get("uri") if isinstance(b, dict) else None
+        if not isinstance(uri, str) or not uri or uri.startswith("data:"):
+            continue
+        try:
+            p = bundle_file(model.parent, unquote(uri), "buffer")
+        except FormatError:
+            continue
+        if p.is_file() and not p.is_symlink() and p not in out:
+            out.append(p)
+    return out
+
+
+def companion_files(model: Path) -> list[Path]:
+    """Files a model needs beside it to be read again: an .obj's material libraries,
+    a .gltf's buffers.  Paths inside the model's folder (a bundle copies them to the
+    same place relative to the model)."""
+    return mtl_libraries(model) + gltf_buffers(model)
 
 
 def _format(model: Path) -> str:
