@@ -146,9 +146,16 @@ def main(argv: list[str] | None = None) -> int:
     if args.json:
         print(json.dumps(out))
         return 0
-    print(f"ladder: {spec.name} tanks, duels of {args.seconds:g} s, {args.duels} per pair and arena; "
-          f"W-L-D of the first player of the pair")
-    names = [a.name for a in arenas]
+    _print_tables(out, players)
+    return 0
+
+
+def _print_tables(out: dict, players: list[str]) -> None:
+    """W-L-D per pair and arena, the Elo table and the goals."""
+    cells, ratings, goals = out["cells"], out["elo"], out["goals"]
+    print(f"ladder: {out['vehicle']} tanks, duels of {out['seconds_per_duel']:g} s, {out['duels_per_cell']} per "
+          f"pair and arena; W-L-D of the first player of the pair")
+    names = out["arenas"]
     head = f"{'pair':<18}" + "".join(f"{n:>16}" for n in names) + f"{'all':>16}"
     print(head)
     print("-" * len(head))
@@ -169,7 +176,6 @@ def main(argv: list[str] | None = None) -> int:
     for g in goals:
         print(f"{'met' if g['met'] else 'NOT MET':<8} {g['goal']}: {g['value']}")
     print(f"wall clock {out['wall_clock_s']:.0f} s")
-    return 0
 
 
 def _goals(cells: list[dict], ratings: list[dict], players: list[str], arenas: list[str]) -> list[dict]:
