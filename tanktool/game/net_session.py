@@ -99,6 +99,8 @@ class NetGameSession:
             return []
         self.command = command
         events = self.match.pump(before_step=self._before_step)
+        if self.peer.number:          # a stale host that rejoined has a new number
+            self.player = self.peer.number - 1
         w = self.world_all
         self.effects = update_effects(self.effects, events, w)
         self.feed = update_feed(self.feed, events, w.t)
@@ -170,7 +172,7 @@ class NetGameSession:
 
     def scoreboard(self) -> list[tuple[str, int, int, float, bool]]:
         """(name, kills, deaths, hit points, alive) best first, with the match's scores
-        (each hit is decided by its victim's peer)."""
+        (each hit is decided by the host)."""
         rows = []
         for t in self.world.tanks:
             sc = self.match._score(t.index + 1)

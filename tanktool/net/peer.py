@@ -41,6 +41,7 @@ from . import protocol as P
 from .auth import TAG_SIZE, datagram_key, hello_mac, join_mac, seal, unseal
 from .guard import Bucket, Buckets, DropLog, JoinLimiter, SeqWindow
 from .names import name_problem, visible
+from .terms import TermsMixin
 
 __all__ = ["Peer", "NetEvent", "Link", "Bucket", "parse_address", "free_port", "join_mac", "hello_mac",
            "percentile"]
@@ -151,6 +152,7 @@ class Link:
     refused: bool = False             # the other end refused this link: its closing is no exit
     failed: bool = False              # a send failed: dropped at the end of the current handler
     proven: bool = False              # it answered the password challenge right (a HELLO waiting)
+    probe: bool = False               # we dialled a lost player's address to read its term (terms.py)
 
 
 @dataclass(frozen=True)
@@ -163,7 +165,7 @@ class NetEvent:
     reason: str = ""
 
 
-class Peer:
+class Peer(TermsMixin):
     """One player's end of a session.  Build with :meth:`host` or :meth:`join`, then
     call :meth:`poll` often (it never blocks longer than its timeout)."""
 
@@ -191,6 +193,7 @@ class Peer:
         self._failed: list[tuple[Link, str]] = []
         #: sockets of kicked players, half-closed, closed after their deadline
         self._linger: list[tuple[socket.socket, float]] = []
+        self._init_terms()
         self.password = password or None
         self.clock = clock
         self.silence = silence
@@ -285,28 +288,31 @@ class Peer:
         reached or refuses.
         """
         peer = cls(name, password, **kw)
-        busy_until = time.monotonic() + timeout
         try:
-            redirects = 0
-            while True:
-                try:
-                    redirect = peer._join_once(address, timeout, port)
-                except _Busy as e:
-                    if time.monotonic() + JOIN_BUSY_WAIT > busy_until:
-                        raise NetError(str(e)) from None
-                    time.sleep(JOIN_BUSY_WAIT)
-                    continue
-                if redirect is None:
-                    break
-                redirects += 1       # a member that is not the host names it: follow
-                if redirects >= 3:
-                    raise NetError(f"cannot join: redirected too many times (last {redirect[0]}:{redirect[1]})")
-                address = redirect
+            peer._join_loop(address, timeout, port, time.monotonic() + timeout)
             peer._settle(link_wait)
             return peer
         except BaseException:
             peer.close(send_exit=False)
             raise
+
+    def _join_loop(self, address: tuple[str, int], timeout: float, port: int, busy_until: float) -> None:
+        """Ask ``address`` to join, following redirects and waiting out "busy"."""
+        redirects = 0
+        while True:
+            try:
+                redirect = self._join_once(address, timeout, port)
+            except _Busy as e:
+                if time.monotonic() + JOIN_BUSY_WAIT > busy_until:
+                    raise NetError(str(e)) from None
+                time.sleep(JOIN_BUSY_WAIT)
+                continue
+            if redirect is None:
+                return
+            redirects += 1       # a member that is not the host names it: follow
+            if redirects >= 3:
+                raise NetError(f"cannot join: redirected too many times (last {redirect[0]}:{redirect[1]})")
+            address = redirect
 
     def _settle(self, seconds: float) -> None:
         """Poll until every mesh link this joiner opened has had its challenge answered
@@ -359,6 +365,7 @@ class Peer:
         now = self.clock()
         self.number = body.number
         self.host_number = body.table.host
+        self.term = body.term
         # the session clock: the host's, plus half the round trip
         self.session_offset = now - (body.session_t + 0.5 * (now - sent_at))
         for e in body.table.entries:
@@ -504,7 +511,7 @@ class Peer:
             name = f"{base}-{k}"
         self.table[n] = P.Entry(n, epoch, me.ip, me.tcp_port, me.udp_port, name, owner=self.number)
         self._saw(self.table[n])
-        news = self._pack(P.Assign(n, self.session_time(), self._table()), P.MessageType.NEW_PLAYER)
+        news = self._pack(P.Assign(n, self.session_time(), self._table(), self.term), P.MessageType.NEW_PLAYER)
         for link in list(self.links.values()):
             if not link.outgoing:
                 self._queue(link, news)
@@ -612,6 +619,7 @@ class Peer:
             self._accept()
             self._reap()
         self._check_timeouts()
+        self._probe_tick(self.clock())
         self._reap()
 
     def _accept(self) -> None:
@@ -636,7 +644,9 @@ class Peer:
                         nonce=os.urandom(P.NONCE_SIZE))
             self.pending.append(link)
             self.sel.register(sock, selectors.EVENT_READ, link)
-            self._queue(link, self._pack_control(P.Challenge(link.nonce, self.password is not None)))
+            challenge = P.Challenge(link.nonce, self.password is not None, self.term, self.host_number,
+                                    len(self._others()) + (1 if self.number else 0))
+            self._queue(link, self._pack_control(challenge))
 
     def _make_room(self, ip: str) -> bool:
         """Room in the pending list for a connection from ``ip``: over the per-address
@@ -687,6 +697,9 @@ class Peer:
 
     def _on_tcp(self, link: Link, m: P.Message) -> None:
         now = self.clock()
+        if link.probe:
+            self._on_probe(link, m)
+            return
         if link.closing:
             return
         if link.number == 0:
@@ -723,11 +736,13 @@ class Peer:
             if m.sender != self.host_number:
                 self.dropped["not_host"] += 1
                 return
+            self.term = max(self.term, body.term)
             self._merge_table(body.table, body.number)
         elif m.type == P.MessageType.TABLE:
             if m.sender != self.host_number:
                 self.dropped["not_host"] += 1
                 return
+            self.term = max(self.term, body.term)
             # the host's table is the reference: who is not in it has left (for
             # example a player whose EXIT reached only the host)
             keep = {e.number for e in body.table.entries}
@@ -772,9 +787,17 @@ class Peer:
                 return
             link.proven = True
         if isinstance(body, P.Join):
+            if self.step_down_to is not None:
+                # a newer session goes on there: we are stale, send the joiner on
+                self._refuse(link, P.RefuseCode.NOT_HOST, f"{self.step_down_to[0]}:{self.step_down_to[1]}")
+                return
             if not self.is_host:
                 h = self.table.get(self.host_number)
                 self._refuse(link, P.RefuseCode.NOT_HOST, f"{h.ip}:{h.tcp_port}" if h else "")
+                return
+            if self.probing():
+                # alone after losing everyone: maybe left behind by a newer session (terms.py)
+                self._refuse(link, P.RefuseCode.RATE, "checking whether the session goes on elsewhere: try again")
                 return
             if not self.joins.allow(ip, now):
                 # each join makes the host send every member the new table: a flood of
@@ -863,8 +886,8 @@ class Peer:
         self._bind_link(link, n, registered=True)
         table = self._table()
         t = self.session_time()
-        self._queue(link, self._pack(P.Assign(n, t, table), P.MessageType.NUMBER))
-        news = self._pack(P.Assign(n, t, table), P.MessageType.NEW_PLAYER)
+        self._queue(link, self._pack(P.Assign(n, t, table, self.term), P.MessageType.NUMBER))
+        news = self._pack(P.Assign(n, t, table, self.term), P.MessageType.NEW_PLAYER)
         for k, other in list(self.links.items()):
             if k != n:
                 self._queue(other, news)
@@ -1029,6 +1052,9 @@ class Peer:
             self._drop_link(link, reason)
 
     def _drop_link(self, link: Link, reason: str) -> None:
+        if link.probe:
+            self._end_probe(link)
+            return
         if link.outgoing or link.refused:
             # a mesh link that never opened says nothing about its peer: silence will
             self.dropped["link_failed"] += 1
@@ -1072,6 +1098,7 @@ class Peer:
         players = [k for k, x in self.table.items() if not x.is_bot]
         if n == self.host_number and players:
             self.host_number = min(players)
+            self.term += 1                    # every peer sees the same departures: same term
             self.host_changes.append((self.session_time(), self.host_number))
             self.events.append(NetEvent("host", self.host_number))
         # its computer opponents go on, run by the host (the new one if it was the host)
@@ -1081,10 +1108,12 @@ class Peer:
                 if self.host_number == self.number:
                     self.events.append(NetEvent("adopt", k, self.table[k]))
         if self.is_host and self.links and not self.closed:
-            table = self._pack(P.Assign(self.number, self.session_time(), self._table()), P.MessageType.TABLE)
+            table = self._pack(P.Assign(self.number, self.session_time(), self._table(), self.term),
+                               P.MessageType.TABLE)
             for link in list(self.links.values()):
                 if not link.outgoing:
                     self._queue(link, table)
+        self._lost_player(e, reason)
 
     def kick(self, n: int, reason: str) -> None:
         """The host disconnects player ``n``: a refusal saying why, then it leaves
@@ -1128,6 +1157,8 @@ class Peer:
         for sock, _ in self._linger:
             sock.close()
         self._linger.clear()
+        for link in list(self.probes):
+            self._end_probe(link)
         for s in (self.tcp, self.udp):
             if s is not None:
                 try:

@@ -30,8 +30,9 @@ from typing import Union
 
 MAGIC = b"TK"
 #: 2: the JOIN carries the digest of the arena and vehicle (peers on different ones
-#: refuse the match), control messages carry the game counter without advancing it
-VERSION = 2
+#: refuse the match), control messages carry the game counter without advancing it;
+#: 3: host terms (Raft-like) in CHALLENGE, NUMBER, NEW_PLAYER and TABLE
+VERSION = 3
 MAX_PLAYERS = 8
 MAX_NAME = 24                      # bytes of UTF-8
 MAX_PAYLOAD = 512
@@ -105,8 +106,15 @@ class Table:
 
 @dataclass(frozen=True, slots=True)
 class Challenge:
+    """A listener's greeting: the nonce to answer, and where its session stands (its
+    host term, host number and players), so a peer that lost its session can tell a
+    newer one when it calls."""
+
     nonce: bytes
     password: bool
+    term: int = 0
+    host: int = 0
+    players: int = 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -132,6 +140,7 @@ class Assign:
     number: int
     session_t: float
     table: Table
+    term: int = 1       # the host's term: +1 at every host change
 
 
 @dataclass(frozen=True, slots=True)
@@ -203,10 +212,10 @@ class BadMessage(Exception):
 
 
 # ---------------------------------------------------------------------- payloads
-_CHALLENGE = struct.Struct(f"!{NONCE_SIZE}sB")
+_CHALLENGE = struct.Struct(f"!{NONCE_SIZE}sBIBB")
 _JOIN = struct.Struct(f"!{MAC_SIZE}s{DIGEST_SIZE}sHHB")
 _HELLO = struct.Struct(f"!{MAC_SIZE}sI")
-_ASSIGN = struct.Struct("!BdBB")          # number, session t, table host, entry count
+_ASSIGN = struct.Struct("!BdIBB")         # number, session t, term, table host, entry count
 _ENTRY = struct.Struct("!BBI4sHHB")       # number, owner, epoch, ip, tcp, udp, name length
 #: tank, session time [ms], x, z, heading (f32), vx, vz, omega, hp (f16), alive: 26 bytes,
 #: so a state datagram is 45 bytes (73 on the wire) and 30 Hz to 7 peers is 15.3 KB/s
@@ -256,8 +265,8 @@ def _player(n: int) -> None:
         raise BadMessage("range")
 
 
-def _encode_table(number: int, session_t: float, table: Table) -> bytes:
-    out = [_ASSIGN.pack(number, session_t, table.host, len(table.entries))]
+def _encode_table(number: int, session_t: float, table: Table, term: int) -> bytes:
+    out = [_ASSIGN.pack(number, session_t, term, table.host, len(table.entries))]
     for e in table.entries:
         name = name_bytes(e.name)
         out.append(_ENTRY.pack(e.number, e.owner, e.epoch, _ip_bytes(e.ip), e.tcp_port, e.udp_port, len(name))
@@ -268,7 +277,7 @@ def _encode_table(number: int, session_t: float, table: Table) -> bytes:
 def _decode_table(p: bytes) -> Assign:
     if len(p) < _ASSIGN.size:
         raise BadMessage("length")
-    number, session_t, host, count = _ASSIGN.unpack_from(p)
+    number, session_t, term, host, count = _ASSIGN.unpack_from(p)
     _player(number)
     _finite(session_t)
     _in(session_t, 0.0, MAX_TIME)
@@ -298,13 +307,14 @@ def _decode_table(p: bytes) -> Assign:
     # the host is a player, and every computer opponent belongs to a player in the table
     if host not in players or number not in seen or any(e.owner and e.owner not in players for e in entries):
         raise BadMessage("range")
-    return Assign(number, session_t, Table(host, tuple(entries)))
+    return Assign(number, session_t, Table(host, tuple(entries)), term)
 
 
 def encode_body(body: Body) -> tuple[MessageType, bytes]:
     """The message type and payload bytes of a body."""
     if isinstance(body, Challenge):
-        return MessageType.CHALLENGE, _CHALLENGE.pack(body.nonce, int(body.password))
+        return MessageType.CHALLENGE, _CHALLENGE.pack(body.nonce, int(body.password), body.term, body.host,
+                                                      body.players)
     if isinstance(body, Join):
         name = name_bytes(body.name)
         return MessageType.JOIN, _JOIN.pack(body.mac, body.digest, body.tcp_port, body.udp_port, len(name)) + name
@@ -336,7 +346,7 @@ def encode(body: Body, sender: int, seq: int, timestamp: float, kind: MessageTyp
     if isinstance(body, Assign):
         if kind not in (MessageType.NUMBER, MessageType.NEW_PLAYER, MessageType.TABLE):
             raise TypeError("an Assign needs kind=NUMBER, NEW_PLAYER or TABLE")
-        mtype, payload = kind, _encode_table(body.number, body.session_t, body.table)
+        mtype, payload = kind, _encode_table(body.number, body.session_t, body.table, body.term)
     else:
         mtype, payload = encode_body(body)
     if len(payload) > MAX_PAYLOAD:
@@ -351,10 +361,10 @@ def _decode_payload(mtype: MessageType, p: bytes) -> Body:
         return s.unpack(p)
 
     if mtype == MessageType.CHALLENGE:
-        nonce, pw = exact(_CHALLENGE)
-        if pw > 1:
+        nonce, pw, term, host, players = exact(_CHALLENGE)
+        if pw > 1 or host > MAX_PLAYERS or players > MAX_PLAYERS:
             raise BadMessage("range")
-        return Challenge(nonce, bool(pw))
+        return Challenge(nonce, bool(pw), term, host, players)
     if mtype == MessageType.JOIN:
         if len(p) < _JOIN.size:
             raise BadMessage("length")

@@ -38,6 +38,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+from ..errors import NetError
 from ..sim.body import TankSpec
 from ..sim.commands import IDLE, Command
 from ..sim.driver import ScriptedDriver
@@ -107,6 +108,7 @@ class NetMatch:
         self.me = self.world.tanks[self.peer.number - 1]
         self.judge = Judge(self.world)
         self.kicked: list[dict[str, Any]] = []
+        self.rejoins: list[dict[str, Any]] = []
         self.world.t = self.peer.session_time()
         for t in self.world.tanks:
             if t is not self.me:
@@ -208,6 +210,9 @@ class NetMatch:
             elif ev.kind == "kicked":
                 self.log(f"the host disconnected us: {visible(ev.reason)}")
                 self.stop = True
+            elif ev.kind == "stepdown":
+                self._rejoin(ev.reason)
+                return                    # the rest of this batch was of the old session
             elif ev.kind == "joined":
                 self.names[ev.number] = ev.body.name
                 self.remotes.pop(ev.number, None)
@@ -225,6 +230,35 @@ class NetMatch:
             elif ev.kind == "adopt":
                 self._adopt(ev.number)
                 self.log(f"running computer opponent {ev.number} ({visible(ev.body.name)})")
+
+    def _rejoin(self, why: str) -> None:
+        """A newer session goes on without us (we were frozen, or cut off, longer than
+        the silence): drop our computer opponents (its host adopted them) and join it as
+        a member, our tank carried over to its new number (net/terms.py)."""
+        old = self.peer.number
+        self.log(f"the session went on without us ({why}): rejoining it")
+        self.rejoins.append({"time": round(self.peer.session_time(), 3), "old_number": old, "why": why})
+        try:
+            self.peer.rejoin()
+        except NetError as e:
+            self.log(f"could not rejoin: {e}")
+            self.stop = True
+            return
+        new = self.peer.number
+        self.rejoins[-1]["number"] = new
+        mine, tank = self.world.tanks[old - 1], self.world.tanks[new - 1]
+        (tank.x, tank.z, tank.heading, tank.c, tank.s, tank.vx, tank.vz, tank.omega) = (
+            mine.x, mine.z, mine.heading, mine.c, mine.s, mine.vx, mine.vz, mine.omega)
+        self.world.stand(tank, mine.y)
+        tank.hp, tank.alive, tank.reload, tank.respawn_at = mine.hp, mine.alive, mine.reload, mine.respawn_at
+        self._absent(mine)
+        self.me = tank
+        driver = self.drivers.get(old)
+        self.drivers = {new: driver} if driver is not None else {}
+        self.remotes.clear()
+        self.judge = Judge(self.world)
+        self.names = {e.number: e.name for e in self.peer.players()}
+        self.world.t = self.peer.session_time()
 
     def _host_hit(self, h: P.Hit) -> None:
         """The host's HIT: the judge notes the victim's hit points and death; a tank of
@@ -410,6 +444,8 @@ class NetMatch:
             "peers": peers,
             "left": self.left,
             "host_changes": [{"time": round(t, 3), "host": h} for t, h in peer.host_changes],
+            "term": peer.term,
+            "rejoined": self.rejoins,
             "network": peer.network_report(),
             "judge": dict(self.judge.report(), kicked=self.kicked),
             "latency_ms": {"samples": len(lat), "p50": _ms(percentile(lat, 50)), "p99": _ms(percentile(lat, 99))},
