@@ -322,6 +322,8 @@ def import_arena(
     except ArenaError as e:
         raise ArenaError(f"{model}: {e}") from None
     walls = result.walls.walls
+    for line in result.walls.repairs.remarks():   # repaired walls, and what check would still find
+        remark(f"{model}: {line}")
     spawns = result.spawns
     fits = result.fleet or fleet
     if result.too_big:

@@ -1,16 +1,15 @@
 """Rules on the walls themselves: A201-A205, and A301 (leaks) for a bare walls.txt.
 
-Pair rules (duplicates, overlaps, crossings) look only at pairs whose bounding boxes
-meet (shapely's STRtree), then classify all candidate pairs at once with numpy.
+Pair rules (duplicates, overlaps, crossings): geometry.wall_pairs.classify_pairs, the
+test import-arena also runs on the walls it writes.
 """
 
 from __future__ import annotations
 
 import numpy as np
-import shapely
-from shapely import STRtree
 
 from ..formats.walls_txt import WallList
+from ..geometry.wall_pairs import classify_pairs
 from .diagnostics import Diagnostic, diag, fmt_xz
 from .freespace import UNBOUNDED, FreeSpace, gaps, near_copies
 
@@ -46,55 +45,16 @@ def pair_rules(walls: WallList, grid: float) -> list[Diagnostic]:
     live = live[origin == live]
     if len(live) < 2:
         return repeats
-    lines = shapely.linestrings(seg[live])
-    # within the tolerance, not only touching: a copy moved off its wall by a hair
-    # (parallel, not meeting it) is a copy all the same
-    i, j = STRtree(lines).query(lines, predicate="dwithin", distance=tol)
-    keep = i < j
-    a, b = live[i[keep]], live[j[keep]]
-    if not len(a):
-        return repeats
-    P, Q = seg[a, 0], seg[a, 1]
-    R, S = seg[b, 0], seg[b, 1]
-    u = d[a] / length[a, None]
-    v = d[b] / length[b, None]
-
-    def side(o, t, p):  # signed distance of p from the line through o along unit t
-        return t[:, 0] * (p[:, 1] - o[:, 1]) - t[:, 1] * (p[:, 0] - o[:, 0])
-
-    with np.errstate(all="ignore"):
-        collinear = (np.abs(side(P, u, R)) <= tol) & (np.abs(side(P, u, S)) <= tol)
-        # overlap of b's projection onto a
-        r0 = np.einsum("ij,ij->i", R - P, u)
-        s0 = np.einsum("ij,ij->i", S - P, u)
-        overlap = np.minimum(np.maximum(r0, s0), length[a]) - np.maximum(np.minimum(r0, s0), 0.0)
-        normal_a = np.stack([-u[:, 1], u[:, 0]], axis=1) * walls.direction[a, None]
-        normal_b = np.stack([-v[:, 1], v[:, 0]], axis=1) * walls.direction[b, None]
-        same_side = np.einsum("ij,ij->i", normal_a, normal_b) > 0
-        same_ends = (((np.abs(P - R) <= tol).all(1) & (np.abs(Q - S) <= tol).all(1))
-                     | ((np.abs(P - S) <= tol).all(1) & (np.abs(Q - R) <= tol).all(1)))
-        # proper crossing: each wall's ends strictly on both sides of the other, away from its ends
-        ca1, ca2 = side(P, u, R), side(P, u, S)
-        cb1, cb2 = side(R, v, P), side(R, v, Q)
-        cross = ((ca1 > tol) & (ca2 < -tol) | (ca1 < -tol) & (ca2 > tol)) & \
-                ((cb1 > tol) & (cb2 < -tol) | (cb1 < -tol) & (cb2 > tol))
-
+    pairs = classify_pairs(seg, walls.direction, live, tol)
     out: list[Diagnostic] = repeats
-    # two coincident walls with opposite normals are the shared face of two touching
-    # solids (both normals point into solid, they cancel): legal, so only same-side pairs count
-    dup = collinear & same_ends & same_side
-    over = collinear & ~same_ends & same_side & (overlap > tol)
-    for k in np.flatnonzero(dup):
-        out.append(diag("A202", path, _line(walls, b[k]),
-                        f"this wall repeats the wall on line {_line(walls, a[k])}"))
-    for k in np.flatnonzero(over):
-        out.append(diag("A203", path, _line(walls, b[k]),
-                        f"this wall overlaps the wall on line {_line(walls, a[k])} along {overlap[k]:.3g} m"))
-    for k in np.flatnonzero(cross & ~collinear):
-        t = ca1[k] / (ca1[k] - ca2[k])
-        x = R[k] + t * (S[k] - R[k])
-        out.append(diag("A204", path, _line(walls, b[k]),
-                        f"this wall crosses the wall on line {_line(walls, a[k])} at {fmt_xz(x)}"))
+    for a, b in zip(*pairs.repeat):
+        out.append(diag("A202", path, _line(walls, b), f"this wall repeats the wall on line {_line(walls, a)}"))
+    for a, b, along in zip(*pairs.overlap):
+        out.append(diag("A203", path, _line(walls, b),
+                        f"this wall overlaps the wall on line {_line(walls, a)} along {along:.3g} m"))
+    for a, b, x in zip(*pairs.cross):
+        out.append(diag("A204", path, _line(walls, b),
+                        f"this wall crosses the wall on line {_line(walls, a)} at {fmt_xz(x)}"))
     return out
 
 

@@ -38,6 +38,7 @@ import shapely
 from ..formats.walls_txt import WallList, aux_rectangle
 from ..geometry import contours
 from ..geometry import walls as cut
+from ..geometry.wall_pairs import Repairs, pair_tolerance, repair_walls
 from ..geometry.heightfield import FLAT_GAP, flat_heights
 from .walkable import DIRS, Surface, surface_layers
 
@@ -76,6 +77,7 @@ class LevelWalls:
     regions: list[RegionWalls]
     thin_walls: int = 0
     portals: float = 0.0  # metres of region boundary left open to another level
+    repairs: Repairs = field(default_factory=Repairs)  # walls joined or turned, problems left
 
     def free(self, level: int | None = None):
         parts = [r.free for r in self.regions if level is None or r.level == level]
@@ -265,6 +267,8 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     regions: list[RegionWalls] = []
     thin_total = 0
     portal_len = 0.0
+    repairs = Repairs()
+    pair_tol = pair_tolerance(np.array([origin, origin + [nx * cell, nz * cell]]))
     rid = 0
     for level in range(L):
         labels, n = _region_labels(exists[level], same[level])
@@ -354,8 +358,9 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
             if len(ledges):
                 thin = np.concatenate([thin, ledges])
             thin = _split_crossings(_clip_crossings(thin, outline, R, tolerance), tolerance)
-            segs = np.concatenate([outline, thin, thin[:, ::-1]]) if len(thin) else outline
-            thin_total += 2 * len(thin)
+            # what check would find (repeats, overlaps, normals into solid) repaired here
+            segs, n_thin = repair_walls(outline, thin, R, pair_tol, repairs)
+            thin_total += n_thin
             out_seg.append(segs)
             out_dir.append(np.ones(len(segs), dtype=np.int8))
             out_lev.append(np.full(len(segs), level))
@@ -371,7 +376,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     lo = pts.min(axis=0) - AUX_MARGIN
     hi = pts.max(axis=0) + AUX_MARGIN
     walls.aux = aux_rectangle(lo[0], lo[1], hi[0], hi[1])
-    return LevelWalls(walls, regions, thin_total, portal_len)
+    return LevelWalls(walls, regions, thin_total, portal_len, repairs)
 
 
 #: thin walls cut where they cross the outline end this far inside it [m]
