@@ -139,7 +139,7 @@ def profile_one(spec: str, work: Path) -> dict:
         model, kw = Path(spec), {}
     out = work / "bundle"
     t_modules = preload()
-    with Profile(HOOKS) as prof:
+    with Profile(HOOKS, memory=True) as prof:
         c0 = time.process_time()
         t0 = time.perf_counter()
         r = import_arena(model, out, name="bench", force=True, **kw)
@@ -155,7 +155,8 @@ def profile_one(spec: str, work: Path) -> dict:
     return {"faces": int(r.faces), "walls": len(r.walls), "spawns": len(r.spawns),
             "levels": len(r.levels.levels), "nodes": int(r.levels.grid.valid.sum()),
             "seconds": total, "cpu_seconds": cpu, "import_seconds": t_import, "modules_seconds": t_modules, "two_step": two_step,
-            "stages": stages, "missing_hooks": prof.missing, "kernels": kernels_active(),
+            "stages": stages, "stage_peak_mb": {k: round(v, 1) for k, v in prof.peak_mb.items()},
+            "missing_hooks": prof.missing, "kernels": kernels_active(),
             "params": {"cell": p.cell, "cell_height": p.cell_height, "max_slope": p.max_slope,
                        "headroom": p.headroom, "climb": p.climb, "radius": float(r.levels.fleet.radius)
                        if r.levels.fleet is not None else None}}
@@ -328,11 +329,21 @@ def scale_part(sizes: list[float], timeout: float) -> list[dict]:
     rows = []
     with tempfile.TemporaryDirectory(prefix="import-bench-scale-") as tmp:
         for size in sizes:
+            ok = [r for r in rows if "error" not in r]
+            if ok:  # a size the machine cannot hold is skipped, not run into the OOM killer
+                need = ok[-1]["peak_mb"] * (size / ok[-1]["size_m"]) ** 2
+                have = available_mb()
+                if have is not None and need > 0.8 * have:
+                    rows.append({"size_m": size, "error": f"skipped: would need about {need / 1024:.1f} GB, "
+                                                          f"{have / 1024:.1f} GB available"})
+                    continue
             path = terrain(size, Path(tmp))
             row = {"size_m": size, **child(str(path), timeout)}
             if "error" not in row:
-                row = {k: row[k] for k in ("size_m", "faces", "seconds", "peak_mb", "stages", "nodes", "walls")}
+                row = {k: row[k] for k in ("size_m", "faces", "seconds", "cpu_seconds", "peak_mb", "stages",
+                                           "stage_peak_mb", "nodes", "walls", "kernels")}
                 row["seconds"] = round(row["seconds"], 3)
+                row["cpu_seconds"] = round(row["cpu_seconds"], 3)
                 row["stages"] = {k: round(v, 3) for k, v in row["stages"].items()}
             rows.append(row)
             path.unlink(missing_ok=True)
@@ -341,6 +352,16 @@ def scale_part(sizes: list[float], timeout: float) -> list[dict]:
         b["time_growth"] = round(b["seconds"] / a["seconds"], 2)
         b["area_growth"] = round((b["size_m"] / a["size_m"]) ** 2, 2)
     return rows
+
+
+def available_mb() -> float | None:
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return None
 
 
 def print_scale(rows: list[dict]) -> None:

@@ -13,13 +13,21 @@ and "other" is what no hook covers.  A hook whose module or name does not exist
     with Profile(HOOKS) as prof:
         run_the_import()
     prof.stages  # {"rasterise": seconds, ...}
+    prof.peak_mb  # {"rasterise": the largest resident size seen during it, ...}
+
+With ``memory=True`` a thread samples the process's resident size every 20 ms
+(/proc/self/statm) and charges it to the stage running then (the innermost hooked
+call): a stage's peak is approximate (it misses spikes shorter than a sample) but
+shows where the memory goes.
 """
 
 from __future__ import annotations
 
 import importlib
 import inspect
+import os
 import sys
+import threading
 import time
 from collections import defaultdict
 from typing import Any, Callable
@@ -28,23 +36,30 @@ from typing import Any, Callable
 class Profile:
     """Exclusive seconds per stage over the hooked functions (see the module docstring)."""
 
-    def __init__(self, hooks: list[tuple[str, str]]):
+    def __init__(self, hooks: list[tuple[str, str]], memory: bool = False):
         self.hooks = hooks
         self.stages: dict[str, float] = defaultdict(float)
         self.calls: dict[str, int] = defaultdict(int)
+        self.peak_mb: dict[str, float] = defaultdict(float)
+        self._memory = memory
+        self._names: list[str] = ["other"]
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
         self._stack: list[float] = []
         self._undo: list[tuple[Any, str, Any]] = []
         self.missing: list[str] = []
 
     def _wrap(self, stage: str, fn: Callable) -> Callable:
-        stack, stages, calls = self._stack, self.stages, self.calls
+        stack, stages, calls, names = self._stack, self.stages, self.calls, self._names
 
         def timed(*args, **kwargs):
             t0 = time.perf_counter()
             stack.append(0.0)
+            names.append(stage)
             try:
                 return fn(*args, **kwargs)
             finally:
+                names.pop()
                 inner = stack.pop()
                 dt = time.perf_counter() - t0
                 stages[stage] += dt - inner
@@ -56,7 +71,24 @@ class Profile:
         timed.__name__ = getattr(fn, "__name__", "timed")
         return timed
 
+    def _sample(self) -> None:
+        page = os.sysconf("SC_PAGE_SIZE") / 2 ** 20
+        try:
+            statm = open("/proc/self/statm")
+        except OSError:
+            return
+        with statm:
+            while not self._stop.wait(0.02):
+                statm.seek(0)
+                rss = int(statm.read().split()[1]) * page
+                stage = self._names[-1]
+                if rss > self.peak_mb[stage]:
+                    self.peak_mb[stage] = rss
+
     def __enter__(self) -> "Profile":
+        if self._memory:
+            self._thread = threading.Thread(target=self._sample, daemon=True)
+            self._thread.start()
         for stage, target in self.hooks:
             mod_name, _, attr = target.partition(":")
             try:
@@ -92,6 +124,9 @@ class Profile:
         return self
 
     def __exit__(self, *exc) -> None:
+        if self._thread is not None:
+            self._stop.set()
+            self._thread.join()
         for owner, name, raw in reversed(self._undo):
             setattr(owner, name, raw)
         self._undo.clear()
