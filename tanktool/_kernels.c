@@ -15,6 +15,10 @@
  *   raster_gentle(tri, abc, nz, nx, ch, max_steps) -> (col, tri, smin, smax) as int64 bytes
  *       tri: float64 (n, 9) x0 x1 x2 z0 z1 z2 y0 y1 y2 in grid units (y in metres);
  *       abc: float64 (n, 3) the plane y = A + B x + C z of each triangle
+ *   components(link, label)
+ *       link: int64 (n, 4); label: int64 (n,) written: the smallest span of each component
+ *   merge_spans(key, thr, col, smin, smax, walk, flat, top_walk) -> count
+ *       key: sorted int64 packed pieces; outputs int64 / bool arrays as long as key
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -389,11 +393,122 @@ done:
     return ret;
 }
 
+/* ------------------------------------------------------------------ components */
+
+static inline i64 find_root(i64 *parent, i64 a) {
+    while (parent[a] != a) {
+        parent[a] = parent[parent[a]];  /* path halving */
+        a = parent[a];
+    }
+    return a;
+}
+
+/* walkable.components: each span's label is the smallest span index of its component
+ * over the links (either way).  Union-find, the larger root always hung under the
+ * smaller, so a root is its set's smallest index: the labels need no second pass. */
+static PyObject *components(PyObject *self, PyObject *args) {
+    Py_buffer link, label;
+    if (!PyArg_ParseTuple(args, "y*w*", &link, &label)) return NULL;
+    const Py_ssize_t n = label.len / 8;
+    PyObject *ret = NULL;
+    if (!need(&link, 4 * n, 8, "link")) goto done;
+    {
+        const i64 *L = link.buf;
+        i64 *P = label.buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t s = 0; s < n; ++s) P[s] = s;
+        for (Py_ssize_t s = 0; s < n; ++s)
+            for (int d = 0; d < 4; ++d) {
+                const i64 t = L[4 * s + d];
+                if (t < 0) continue;
+                i64 a = find_root(P, s), b = find_root(P, t);
+                if (a == b) continue;
+                if (a < b) P[b] = a; else P[a] = b;
+            }
+        for (Py_ssize_t s = 0; s < n; ++s) P[s] = find_root(P, s);
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&link);
+    PyBuffer_Release(&label);
+    return ret;
+}
+
+/* ------------------------------------------------------------------ merging */
+
+/* heightfield._merge over the sorted packed keys (column << 34 | bottom << 18 | top << 2
+ * | walkable << 1 | flat): the overlapping or touching pieces of a column become one
+ * span; its flags are those of the pieces whose tops lie within thr of its top (and
+ * top_walk: of the pieces reaching its very top).  Writes the spans into the six
+ * output arrays (at most as long as the keys) and returns how many. */
+static PyObject *merge_spans(PyObject *self, PyObject *args) {
+    Py_buffer key, col, smin, smax, walk, flat, topw;
+    i64 thr;
+    if (!PyArg_ParseTuple(args, "y*Lw*w*w*w*w*w*", &key, &thr, &col, &smin, &smax, &walk, &flat, &topw))
+        return NULL;
+    const Py_ssize_t n = key.len / 8;
+    Py_ssize_t m = 0;
+    PyObject *ret = NULL;
+    if (!need(&col, n, 8, "col") || !need(&smin, n, 8, "smin") || !need(&smax, n, 8, "smax") ||
+        !need(&walk, n, 1, "walk") || !need(&flat, n, 1, "flat") || !need(&topw, n, 1, "top_walk"))
+        goto done;
+    {
+        const i64 *K = key.buf;
+        i64 *C = col.buf, *S0 = smin.buf, *S1 = smax.buf;
+        char *W = walk.buf, *F = flat.buf, *T = topw.buf;
+        Py_BEGIN_ALLOW_THREADS
+        Py_ssize_t a = 0;
+        while (a < n) {
+            const i64 c = K[a] >> 34;
+            i64 top = (K[a] >> 2) & 0xFFFF;
+            Py_ssize_t b = a + 1;
+            while (b < n && (K[b] >> 34) == c && ((K[b] >> 18) & 0xFFFF) <= top) {
+                const i64 t = (K[b] >> 2) & 0xFFFF;
+                if (t > top) top = t;
+                ++b;
+            }
+            char w = 0, f = 0, tw = 0;
+            for (Py_ssize_t k = a; k < b; ++k) {
+                const i64 t = (K[k] >> 2) & 0xFFFF;
+                const int kw = (K[k] & 2) != 0, kf = (K[k] & 1) != 0;
+                if (t >= top - thr) {
+                    w |= kw;
+                    f |= kf;
+                }
+                if (t == top) tw |= kw;
+            }
+            C[m] = c;
+            S0[m] = (K[a] >> 18) & 0xFFFF;
+            S1[m] = top;
+            W[m] = w;
+            F[m] = f;
+            T[m] = tw;
+            ++m;
+            a = b;
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = PyLong_FromSsize_t(m);
+done:
+    PyBuffer_Release(&key);
+    PyBuffer_Release(&col);
+    PyBuffer_Release(&smin);
+    PyBuffer_Release(&smax);
+    PyBuffer_Release(&walk);
+    PyBuffer_Release(&flat);
+    PyBuffer_Release(&topw);
+    return ret;
+}
+
 static PyMethodDef methods[] = {
     {"link_spans", link_spans, METH_VARARGS, "links between open spans (see nav/kernels.py)"},
     {"ledge_scan", ledge_scan, METH_VARARGS, "the ledge filter's scan of neighbour columns"},
     {"chamfer", chamfer, METH_VARARGS, "chamfer distance relaxed to its fixed point, in place"},
     {"raster_gentle", raster_gentle, METH_VARARGS, "spans of gentle triangles, as heightfield._cells_plane"},
+    {"components", components, METH_VARARGS, "component labels (smallest span index), in place"},
+    {"merge_spans", merge_spans, METH_VARARGS, "the merged spans of sorted packed keys"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -12,7 +12,8 @@ import pytest
 
 from tanktool.geometry import kernels
 from tanktool.geometry.kernels import use_kernels
-from tanktool.nav.walkable import WalkableParams, chamfer_clearance, grid_from_surface, link_spans, walkable_surface
+from tanktool.nav.walkable import (WalkableParams, chamfer_clearance, components, grid_from_surface, link_spans,
+                                   walkable_surface)
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
@@ -81,6 +82,11 @@ def test_random_span_graphs_give_the_same_links_and_distances(seed):
         with use_kernels(False):
             db = chamfer_clearance(la, limit)
         assert np.array_equal(da, db), limit
+    with use_kernels(True):
+        ca = components(la)
+    with use_kernels(False):
+        cb = components(la)
+    assert np.array_equal(ca, cb) and len(np.unique(ca)) > 10
 
 
 def test_the_numpy_fallback_runs_without_the_kernels():

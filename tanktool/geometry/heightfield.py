@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ArenaError
+from .kernels import active, i64
 
 #: tops of columns with nothing above them (Recast's 0xffff in its filters)
 OPEN = 1 << 15
@@ -450,8 +451,6 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
     Returns sorted (col, smin, smax, walkable, flat) arrays and the number of
     (triangle, cell) pairs.
     """
-    from .kernels import active
-
     nz, nx = shape
     V = np.asarray(vertices, dtype=np.float64)
     gx = (V[:, 0] - origin[0]) / cs  # grid units: cell j covers [j, j + 1)
@@ -512,6 +511,13 @@ def _merge(col, smin, smax, walk, flat, thr):
         return e, e, e, b, b, b
     key = (col.astype(np.int64) << 34) | (smin << 18) | (smax << 2) | (walk.astype(np.int64) << 1) | flat
     key.sort()
+    kern = active()
+    if kern is not None:  # one pass over the sorted keys
+        n = len(key)
+        col, smin, smax = (np.empty(n, dtype=np.int64) for _ in range(3))
+        walk, flat, top_walk = (np.empty(n, dtype=bool) for _ in range(3))
+        m = kern.merge_spans(key, int(thr), col, smin, smax, walk, flat, top_walk)
+        return col[:m], smin[:m], smax[:m], walk[:m], flat[:m], top_walk[:m]
     col = key >> 34
     smin = (key >> 18) & 0xFFFF
     smax = (key >> 2) & 0xFFFF
@@ -591,8 +597,6 @@ def _ledge_scan(hf_col, smin, smax, ceil, s_idx, shape, headroom: int, climb: in
     counting as a floor at -climb (a drop to the bottom of the world).  The compiled
     kernel when built (one pass), else numpy, neighbour spans visited k-th by k-th (the
     k-th pass only sees columns with more than k spans: few beyond two)."""
-    from .kernels import active, i64
-
     nz, nx = shape
     start = column_starts(hf_col, nz * nx)
     bot = smax[s_idx]

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ArenaError
+from ..geometry.kernels import active, i64
 from ..geometry.heightfield import OPEN, Heightfield, build_heightfield, column_starts, neighbour_columns
 
 #: the four link directions as (di, dj) on the grid: +x, +z, -x, -z (navgrid.STEPS order)
@@ -133,8 +134,6 @@ def link_spans(col: np.ndarray, floor: np.ndarray, ceil: np.ndarray, shape: tupl
     The spans of each neighbour column are tried k-th by k-th, lowest first; a span's
     link is the first that fits.
     """
-    from ..geometry.kernels import active, i64
-
     nz, nx = shape
     n = len(col)
     start = column_starts(col, nz * nx)
@@ -173,8 +172,6 @@ def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
     present).  Values stop growing at ``limit``: only whether a span is that far
     matters, and the relaxation needs about limit / 2 rounds.
     """
-    from ..geometry.kernels import active, i64
-
     n = len(link)
     dist = np.where((link < 0).any(axis=1), 1, limit).astype(np.int32)
     if n == 0:
@@ -215,6 +212,11 @@ def components(link: np.ndarray) -> np.ndarray:
     n = len(link)
     if n == 0:
         return np.arange(0, dtype=np.int64)
+    kern = active()
+    if kern is not None:  # union-find, the smaller index the root: the same labels
+        label = np.empty(n, dtype=np.int64)
+        kern.components(i64(link), label)
+        return label
     ok = link >= 0
     dst = link[ok]                                   # row by row: the rows come sorted
     indptr = np.zeros(n + 1, dtype=np.int64)
