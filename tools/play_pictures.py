@@ -126,15 +126,42 @@ def controls_shot(only: list[str] | None) -> None:
         r.release()
 
 
+def slope_shot(only: list[str] | None) -> None:
+    """The chase camera on a hillside: the steepest moment of a bot's drive in the hills."""
+    if only and "play-slope" not in only:
+        return
+    from tanktool.game.hud import save_png, surface_from_rgb
+    from tanktool.game.render3d import Renderer3D
+    from tanktool.game.session import GameSession
+
+    def drive() -> GameSession:
+        return GameSession("hills", bots=3, seed=5, player=False)
+
+    s = drive()
+    steepest = max(range(120 * 40), key=lambda k: (s.step(), abs(s.world.tanks[0].pitch))[1])
+    s = drive()                                      # again, to that moment
+    s.follow = 0
+    r = Renderer3D(s, SIZE)
+    try:
+        for k in range(steepest + 1):
+            s.step()
+            if k % 4 == 0 and k > steepest - 240:
+                r.matrices(1.0)                      # the camera eases as in the window
+        print(save_png(surface_from_rgb(r.render(1.0, fps=0.0)), DOCS / "play-slope.png"))
+    finally:
+        r.release()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", action="append",
-                    help="arena-box, play-3d, play-top, play-menu, play-settings, play-destroyed, play-controls")
+                    help="arena-box, play-3d, play-top, play-menu, play-settings, play-destroyed, play-controls, play-slope")
     args = ap.parse_args(argv)
     arena_shots(args.only)
     menu_shots(args.only)
     destroyed_shot(args.only)
     controls_shot(args.only)
+    slope_shot(args.only)
     return 0
 
 

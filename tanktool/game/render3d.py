@@ -23,8 +23,8 @@ vehicle frame) with their textures and material colours (game/meshes.py).  A fra
 
 Tanks are placed at ``(x, y, z)`` with heading, pitch and roll when the simulation has
 them (``y``, ``pitch``, ``roll`` of a tank; 0 before), so the same code draws flat and
-terraced arenas.  Cameras: chase (pulled in when a wall would hide the tank), first
-person, overview.  With no window (``ctx=None``) the renderer makes an EGL standalone
+terraced arenas.  Cameras: chase and first person (game/camera.py: along the slope,
+rising over or pulled in before what would hide the tank, smoothed), overview.  With no window (``ctx=None``) the renderer makes an EGL standalone
 context and draws into its own framebuffer, so screenshots work without any display.
 """
 
@@ -198,6 +198,7 @@ class Renderer3D:
         self._hud_rects: list[Any] = []
         self._placed: dict[tuple, np.ndarray] = {}       # tank matrices of this frame (shadow and scene)
         self._eye = None
+        self._camera: Any = None          # game/camera.py's, made at the first chase frame
         (x0, z0), (x1, z1) = session.world.bounds.tolist()
         self.centre = ((x0 + x1) / 2, (z0 + z1) / 2)
         self.span = max(x1 - x0, z1 - z0, 1.0)
@@ -424,6 +425,8 @@ class Renderer3D:
     def toggle_camera(self) -> str:
         self.camera = CAMERAS[(CAMERAS.index(self.camera) + 1) % len(CAMERAS)]
         self._eye = None
+        if self._camera is not None:
+            self._camera.reset()
         return self.camera
 
     def _tank_model_matrix(self, t: Any, alpha: float) -> np.ndarray:
@@ -444,28 +447,16 @@ class Renderer3D:
         return tank_matrix(x, z, h, y, pitch, roll)
 
     def camera_pose(self, alpha: float) -> tuple[np.ndarray, np.ndarray]:
-        s = self.session
-        t = s.focus_tank()
-        x, y, z, h, pitch, _ = pose3d(s, t.index, alpha)
-        if not hasattr(t, "y"):
-            y = self.floor_y
-        f = np.array([math.cos(h), 0.0, math.sin(h)])
-        p = np.array([x, y, z])
-        size = max(t.spec.radius, 1.0)
-        if self.camera == "first-person":
-            eye = p + np.array([0.0, t.spec.height + 0.4, 0.0]) + f * 0.3 * size
-            look = f * math.cos(pitch) + np.array([0.0, math.sin(pitch), 0.0])
-            return eye, eye + look * 10.0 + np.array([0.0, -0.6, 0.0])
+        """(eye, target): the overview's, or the chase and first-person cameras of
+        game/camera.py (slope, collision with the arena's model, smoothing)."""
         if self.camera == "overview":
             c = np.array([self.centre[0], self.floor_y, self.centre[1]])
             return c + np.array([0.0, 0.95 * self.span, 0.45 * self.span]), c
-        eye = p - f * 4.5 * size + np.array([0.0, 2.2 * size, 0.0])
-        # a wall between the tank and the camera would hide the tank: pull the camera in
-        hit = s.world.walls.first_hit(x, z, float(eye[0]), float(eye[2]))
-        if hit is not None:
-            k = max(hit[0] - 0.6 / (4.5 * size), 0.05)
-            eye = np.array([x + k * (eye[0] - x), eye[1], z + k * (eye[2] - z)])
-        return eye, p + f * 2.5 * size + np.array([0.0, 1.0, 0.0])
+        if self._camera is None:
+            from .camera import Camera, arena_mesh
+
+            self._camera = Camera(arena_mesh(self.arena_model))       # what is drawn hides the tank
+        return self._camera.pose(self.session, alpha, self.camera, self.floor_y)
 
     def matrices(self, alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         eye, target = self.camera_pose(alpha)
@@ -571,6 +562,8 @@ class Renderer3D:
 
     def _lod(self, t: Any, model: np.ndarray, eye: np.ndarray) -> list[GpuBatch]:
         """A tank's batches: without its small parts when it is under LOD_PIXELS tall on screen."""
+        if t.index == self.session.focus() and self.camera == "chase":
+            return self.tanks[t.spec.name]            # the followed tank: always in full
         d = float(np.linalg.norm(model[:3, 3] - eye))
         tall = t.spec.height / max(2.0 * d * math.tan(FOV_Y / 2), 1e-6) * self.size[1]
         return self.tanks[t.spec.name] if tall >= LOD_PIXELS else self.tanks_far[t.spec.name]
