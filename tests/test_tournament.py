@@ -130,3 +130,29 @@ def test_the_scripted_baseline_plays_as_a_player():
     config = TournamentConfig(bots=("scripted", "novice"), matches=1, seconds=3.0, boot=0)
     rep = run_tournament(config, run="serial").report
     assert [b["name"] for b in rep["bots"]] == ["scripted", "novice"] and len(rep["matches"]) == 1
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_a_bot_that_cannot_be_made_is_one_error_line(tmp_path, workers):
+    (tmp_path / "bad.py").write_text(
+        "from tanktool.bots import Bot, Command\n"
+        "class Never(Bot):\n"
+        "    def __init__(self):\n"
+        "        raise ValueError('no bot today')\n"
+        "    def act(self, view):\n"
+        "        return Command()\n"
+        "class Later(Bot):\n"
+        "    made = 0\n"
+        "    def __init__(self):\n"
+        "        type(self).made += 1\n"
+        "        if type(self).made > 1:\n"
+        "            raise ValueError('only once')\n"
+        "    def act(self, view):\n"
+        "        return Command()\n")
+    for cls, message in (("Never", "making one raised ValueError: no bot today"),
+                         ("Later", "making one raised ValueError: only once")):
+        r = CliRunner().invoke(cli, ["tournament", "--bot", f"{tmp_path / 'bad.py'}:{cls}", "--bot", "novice",
+                                     "--matches", "2", "--seconds", "1", "--no-replays", "--workers", workers])
+        assert r.exit_code == 2 and message in r.output, r.output
+    r = CliRunner().invoke(cli, ["play", "--headless", "--bot", f"{tmp_path / 'bad.py'}:Never", "--seconds", "1"])
+    assert r.exit_code == 2 and "no bot today" in r.output

@@ -95,7 +95,11 @@ def play_match(task: MatchTask) -> dict[str, Any]:
     def wrap(world: Any, _made: list) -> list:
         seeds = [world.rng.getrandbits(64) for _ in world.tanks]
         for tank, who in enumerate(order):
-            drivers.append(makers[who].driver(seeds[tank], budget=task.budget))
+            try:
+                drivers.append(makers[who].driver(seeds[tank], budget=task.budget))
+            except Exception as e:      # a constructor that fails only sometimes, or only there
+                raise TanktoolError(f"bot {task.players[who].spec!r}: making one raised "
+                                    f"{type(e).__name__}: {e}") from None
             world.tanks[tank].name = task.players[who].name[:64]
         return rec.wrap(world, drivers) if task.record else drivers
 

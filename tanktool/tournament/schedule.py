@@ -12,7 +12,8 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..bots import BUILTIN, DEFAULT_BUDGET, load_bot
+from ..bots import BUILTIN, DEFAULT_BUDGET
+from ..sim.bots.lineup import load_checked
 from ..errors import TanktoolError
 
 #: a bot file shipped to workers may be at most this large [bytes]
@@ -92,7 +93,7 @@ def resolve_players(specs: list[str] | tuple[str, ...]) -> list[Player]:
             seen[SCRIPTED] = seen.get(SCRIPTED, 0) + 1
             players.append(Player(SCRIPTED if seen[SCRIPTED] == 1 else f"{SCRIPTED}#{seen[SCRIPTED]}", SCRIPTED))
             continue
-        maker = load_bot(spec)
+        maker = load_checked(spec)
         name = maker.name
         seen[name] = seen.get(name, 0) + 1
         if seen[name] > 1:
