@@ -174,6 +174,7 @@ class ImportResult:
     params: Any = None  # the WalkableParams used
     defaults: dict[str, str] = field(default_factory=dict)  # where each default came from
     grid: Any = None    # grid_files.BuiltGrid: the navigation grid written with the bundle (None: not built)
+    model_left_out: list[str] = field(default_factory=list)  # what the model file held but was not built (.bzw)
 
 
 _NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
@@ -388,7 +389,8 @@ def import_arena(
             if progress:
                 progress("navgrid")
     return ImportResult(target, name, walls, spawns, result.floor_y, len(mesh.faces), result.walls.thin_walls,
-                        time.perf_counter() - t0, warnings, result, params, where, built)
+                        time.perf_counter() - t0, warnings, result, params, where, built,
+                        list(scene.metadata.get("left_out", [])))
 
 
 def _plan_source(fmt: str, wall_height: float | None, wall_thickness: float | None) -> dict[str, float]:

@@ -331,3 +331,31 @@ def test_a_gltf_with_percent_encoded_uris_imports_and_its_bundle_imports_again(t
     # the bundle is one tanktool wrote: --force may replace it (its data/ is accounted for)
     res = run("import-arena", str(model), "-o", str(tmp_path / "bundle"), "-q", "--force")
     assert res.exit_code == 0, res.output
+
+
+# ----------------------------------------------------------------- BZFlag worlds from the wild
+
+def test_a_bzflag_world_as_bzflag_reads_it():
+    """_wallHeight 0 and a teleporter of border 0 are valid BZFlag; a mesh is built; a
+    group, its definition and a sphere are counted by name in what is left out."""
+    from tanktool.formats.bzw import load_scene, parse_bzw
+
+    path = ROOT / "tests" / "data" / "bzw" / "wild_world.bzw"
+    world = parse_bzw(path)
+    assert world.walls is False and world.wall_height == 0
+    assert [o.kind for o in world.objects] == ["box"]          # the frameless teleporter has nothing solid
+    assert len(world.meshes) == 1 and len(world.meshes[0][1]) == 10   # 5 quads
+    assert world.meshes[0][0][:, 1].min() == 40.0                      # shifted by 100 in y
+    assert sorted(world.left_out) == ["group (instance of a definition)", "group definition", "sphere"]
+    assert load_scene(path).metadata["left_out"] == [
+        "1 group (instance of a definition) (line 54)", "1 group definition (line 49)", "1 sphere (line 57)"]
+
+
+def test_import_never_says_left_out_nothing_when_objects_were_skipped(tmp_path):
+    world = tmp_path / "w.bzw"
+    world.write_text("world\n  size 60\nend\nwall\n  position 0 0 0\n  size 0 10 4\nend\n"
+                     "cone\n  position 30 30 0\n  size 4 4 8\nend\n")
+    res = run("import-arena", str(world), "-o", str(tmp_path / "out"))
+    assert res.exit_code == 0, res.output
+    left = [ln for ln in res.output.splitlines() if ln.strip().startswith("left out:")]
+    assert left == ["  left out: 1 cone (line 8) of w.bzw not built"], res.output

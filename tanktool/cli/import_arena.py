@@ -110,6 +110,10 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
     echo(f"arena {result.name!r}: {nlev} level{'s' if nlev != 1 else ''}, {len(result.walls)} walls{thin} "
          f"+ 4 auxiliary, {len(result.spawns)} spawns")
     for line in describe_levels(result.levels):
+        if line.startswith("  left out: ") and result.model_left_out:
+            # what the model file held but was not built is left out too: never "nothing" then
+            model = "; ".join(result.model_left_out) + f" of {model.name} not built"
+            line = f"  left out: {model}" if line == "  left out: nothing" else f"{line}; {model}"
         echo(line)
     echo(f"  walkable: {_describe_params(result.params, result.defaults)}")
     echo(f"  bounds x {x0:g}..{x1:g}, z {z0:g}..{z1:g} m ({x1 - x0:.1f} x {z1 - z0:.1f} m), "

@@ -33,10 +33,17 @@ counter-clockwise seen from above):
   (default 1.12) at y = +-(size y + 1.5 border), size z high, and a crossbar
   ``border`` thick on top (default size 0.5 4.48 20.16), as BZFlag builds it.
 
+- ``mesh``: its vertices and polygon faces, shifted, scaled and spun as it says
+  (formats/bzw_mesh.py).
+
 Objects with ``drivethrough`` are left out (tanks pass through them).  Any other
-object (``link``, ``mesh``, ``arc``, ``cone``, ``sphere``, ``group``, ``zone``, ...,
+object (``link``, ``arc``, ``cone``, ``sphere``, ``group``, ``zone``, ...,
 ``define``...``enddef``) is skipped with a warning naming its line, and so is an
-unknown property of a known object.  Malformed numbers, a missing ``end`` or an
+unknown property of a known object; the solid ones (``arc``, ``cone``, ``sphere``,
+``tetra``, ``group``, ``define``, drivethrough objects) are also counted, by kind
+with their lines, in what the import leaves out (``scene.metadata["left_out"]``).
+``options -set _wallHeight 0`` means no outer walls and a teleporter of ``border 0``
+has no frame (nothing solid), as in BZFlag.  Malformed numbers, a missing ``end`` or an
 ``end`` without an object raise :class:`FormatError` with the file and line.
 """
 
@@ -52,6 +59,7 @@ import numpy as np
 
 from ..errors import FormatError
 from .bundle import read_input
+from .bzw_mesh import BzwMesh, _mesh_line
 from .limits import MAX_MODEL_BYTES, MAX_OBJECTS
 
 #: warnings passed on per file (a file of a million unknown lines says so once)
@@ -130,7 +138,22 @@ class BzwWorld:
     wall_height: float = OUTER_WALL_HEIGHT   # the outer walls' height (options -set _wallHeight)
     size_from: str = ""            # what set ``size`` last ("line 3: world size 60"), for warnings
     objects: list[BzwObject] = field(default_factory=list)
+    meshes: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)   # placed ``mesh`` objects
     warnings: list[str] = field(default_factory=list)
+    #: what the file holds but the arena does not: kind -> lines ("group": [40, 52])
+    left_out: dict[str, list[int]] = field(default_factory=dict)
+
+    def leave_out(self, kind: str, line: int) -> None:
+        self.left_out.setdefault(kind, []).append(line)
+
+    def left_out_text(self) -> list[str]:
+        """One phrase per kind: "41 mesh objects (lines 12, 40, ...)"."""
+        out = []
+        for kind, lines in sorted(self.left_out.items()):
+            where = ", ".join(map(str, lines[:4])) + (", ..." if len(lines) > 4 else "")
+            out.append(f"{len(lines)} {kind}{'s' if len(lines) != 1 else ''} (line{'s' if len(lines) != 1 else ''} "
+                       f"{where})")
+        return out
 
     def counts(self) -> dict[str, int]:
         """Objects per kind (meshbox counted as box, meshpyr as pyramid)."""
@@ -181,6 +204,7 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
     in_define: int | None = None
     options: list[tuple[int, str]] | None = None   # tokens of an open ``options`` block, with lines
     options_line = 0
+    mesh: BzwMesh | None = None            # an open ``mesh`` block
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = _strip(raw)
         if not line:
@@ -191,6 +215,10 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
         if in_define is not None:
             if key == "enddef":
                 in_define = None
+            continue
+        if mesh is not None:
+            if _mesh_line(path, lineno, key, args, mesh, world):
+                mesh = None
             continue
         if options is not None:
             if key == "end" and not args:
@@ -221,14 +249,22 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
                     raise FormatError(f"{path}:{lineno}: more than {MAX_OBJECTS:,} objects (a world this tool reads "
                                       f"has fewer)")
                 current = BzwObject(key, lineno, size=DEFAULT_SIZE[key])
+            elif key == "mesh":
+                if len(world.meshes) >= MAX_OBJECTS:
+                    raise FormatError(f"{path}:{lineno}: more than {MAX_OBJECTS:,} meshes (a world this tool reads "
+                                      f"has fewer)")
+                mesh = BzwMesh(lineno)
             elif key == "define":
                 in_define = lineno
+                world.leave_out("group definition", lineno)
                 warn(f"{path}:{lineno}: 'define' blocks (group definitions) are skipped")
             elif key in ("enddef",):
                 raise FormatError(f"{path}:{lineno}: 'enddef' without 'define'")
             else:
                 skipping = (key, lineno)
                 skip_stack = []
+                if key in _SOLID_UNSUPPORTED:
+                    world.leave_out(key if key != "group" else "group (instance of a definition)", lineno)
                 warn(f"{path}:{lineno}: unknown or unsupported object '{words[0]}' skipped")
             continue
         if key == "end":
@@ -271,12 +307,17 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
             warn(f"{path}:{lineno}: {current.kind} property '{words[0]}' ignored")
     for open_line, what in ((current.line if current else None, current.kind if current else ""),
                             (in_world, "world"), (skipping[1] if skipping else None, skipping[0] if skipping else ""),
-                            (in_define, "define"), (options_line if options is not None else None, "options")):
+                            (in_define, "define"), (options_line if options is not None else None, "options"),
+                            (mesh.line if mesh is not None else None, "mesh")):
         if open_line is not None:
             closer = "enddef" if what == "define" else "end"
             raise FormatError(f"{path}:{open_line}: '{what}' is never closed (expected '{closer}' "
                               f"before the end of the file)")
     return world
+
+
+#: solid objects this reader does not build: counted in what the import leaves out
+_SOLID_UNSUPPORTED = {"arc", "cone", "sphere", "tetra", "group"}
 
 
 def _set_size(world: BzwWorld, half: float, line: int, said: str) -> None:
@@ -304,13 +345,15 @@ def _apply_options(path: Path, line: int, tokens: list[tuple[int, str]], world: 
                 v = float(value)
             except ValueError:
                 v = math.nan
-            if not math.isfinite(v) or v <= 0:
-                raise FormatError(f"{path}:{tokens[i + 2][0]}: options -set {name} expects a positive number "
-                                  f"(metres), got {value!r}")
+            wall = name.lower() == "_wallheight"   # 0: no outer walls, as bzfs builds them
+            if not math.isfinite(v) or v < 0 or (v == 0 and not wall):
+                raise FormatError(f"{path}:{tokens[i + 2][0]}: options -set {name} expects a "
+                                  f"{'number >= 0' if wall else 'positive number'} (metres), got {value!r}")
             if name.lower() == "_worldsize":
                 _set_size(world, v / 2, at, f"options -set {name} {value}")
             else:
                 world.wall_height = v
+                world.walls = world.walls and v > 0
             i += 3
             continue
         if tok.lower() == "-set" and i + 2 < len(tokens):
@@ -330,9 +373,12 @@ def _finish(path: Path, obj: BzwObject, world: BzwWorld) -> None:
     sx, sy, sz = obj.size
     if obj.kind in ("box", "meshbox", "base", "teleporter") and (sx < 0 or sy < 0 or sz < 0):
         raise FormatError(f"{path}:{obj.line}: {obj.kind} 'size' must not be negative, got {sx:g} {sy:g} {sz:g}")
-    if obj.kind == "teleporter" and obj.border <= 0:
-        raise FormatError(f"{path}:{obj.line}: teleporter 'border' must be positive, got {obj.border:g}")
+    if obj.kind == "teleporter" and obj.border < 0:
+        raise FormatError(f"{path}:{obj.line}: teleporter 'border' must not be negative, got {obj.border:g}")
+    if obj.kind == "teleporter" and obj.border == 0:
+        return   # no frame: nothing solid (tanks drive through the field), as in BZFlag
     if obj.drivethrough:
+        world.leave_out(f"drivethrough {obj.kind}", obj.line)
         world.warnings.append(f"{path}:{obj.line}: {obj.kind} is drivethrough: left out (tanks pass through it)")
         return
     flat = (sy == 0 or sz == 0) if obj.kind == "wall" else (sx == 0 or sy == 0 or sz == 0)
@@ -456,6 +502,8 @@ def world_meshes(world: BzwWorld) -> dict[str, tuple[np.ndarray, np.ndarray, tup
         groups.setdefault(kind, []).append(object_mesh(obj))
     for kind, parts in groups.items():
         out[kind + "es" if kind == "box" else kind + "s"] = (*_join(parts), COLOURS[kind])
+    if world.meshes:
+        out["meshes"] = (*_join(world.meshes), COLOURS["box"])
     for team, parts in sorted(bases.items()):
         out[f"bases_team{team}"] = (*_join(parts), TEAM_COLOURS.get(team, COLOURS["base"]))
     return out
@@ -480,4 +528,5 @@ def load_scene(path: str | os.PathLike, warn: Callable[[str], None] | None = Non
         mesh = trimesh.Trimesh(vertices=v, faces=f, process=False)
         mesh.visual.face_colors = np.tile(np.array(rgba, dtype=np.uint8), (len(f), 1))
         scene.add_geometry(mesh, geom_name=name, node_name=name)
+    scene.metadata["left_out"] = world.left_out_text()   # the import's "left out" line says them
     return scene

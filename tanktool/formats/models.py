@@ -188,7 +188,9 @@ def _read_scene(path: Path, fmt: str, warn, wall_height, wall_thickness, progres
             scene = _load_gltf(path)
         else:
             scene = _load_with_trimesh(path, fmt)
+        left_out = list(scene.metadata.get("left_out", []))   # what a built format did not build
         scene = flat_scene(scene, str(path))
+        scene.metadata["left_out"] = left_out
     except FormatError:
         raise
     except MemoryError:
