@@ -49,9 +49,15 @@ def simplify_contour(poly, max_error: float, max_edge_len: float | None = None):
         if len(raw_rings) != len(s_rings):
             out.append(s)
             continue
-        rings = [split_long_edges(np.asarray(r.coords), np.asarray(q.coords), max_edge_len)
-                 for r, q in zip(raw_rings, s_rings)]
-        p = shapely.Polygon(rings[0], rings[1:])
+        rings, changed = [], False
+        for r, q in zip(raw_rings, s_rings):
+            qc = np.asarray(q.coords)
+            # most rings (a pillar's square, a short contour) have no edge to split
+            if len(qc) < len(r.coords) and np.hypot(*np.diff(qc, axis=0).T).max() > max_edge_len:
+                qc = split_long_edges(np.asarray(r.coords), qc, max_edge_len)
+                changed = True
+            rings.append(qc)
+        p = shapely.Polygon(rings[0], rings[1:]) if changed else s
         out.append(p if p.is_valid else s)
     return shapely.union_all(out) if len(out) > 1 else out[0]
 
