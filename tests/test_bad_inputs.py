@@ -359,3 +359,28 @@ def test_import_never_says_left_out_nothing_when_objects_were_skipped(tmp_path):
     assert res.exit_code == 0, res.output
     left = [ln for ln in res.output.splitlines() if ln.strip().startswith("left out:")]
     assert left == ["  left out: 1 cone (line 8) of w.bzw not built"], res.output
+
+
+def test_zero_area_faces_raise_no_numpy_warning(tmp_path):
+    """Degenerate triangles (13 of 24 third-party models had some) gave 'invalid value
+    in divide' from the heightfield: now the import is silent."""
+    import warnings
+
+    from tanktool.arena import import_arena
+
+    obj = tmp_path / "floor.obj"
+    obj.write_text("v 0 0 0\nv 40 0 0\nv 40 0 40\nv 0 0 40\nv 20 0 20\nv 20 3 20\nv 20 0 0\n"
+                   "f 1 3 2\nf 1 4 3\nf 5 5 5\nf 1 5 3\nf 5 6 6\nf 1 7 2\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        result = import_arena(obj, tmp_path / "out")
+    assert len(result.walls) >= 4
+    # a vehicle model with the same kind of faces
+    tank = tmp_path / "tank.obj"
+    tank.write_text("v -3 0 -2\nv 3 0 -2\nv 3 0 2\nv -3 0 2\nv -3 2 -2\nv 3 2 -2\nv 3 2 2\nv -3 2 2\nv 0 2 0\n"
+                    "f 1 2 3\nf 1 3 4\nf 5 7 6\nf 5 8 7\nf 1 5 6\nf 1 6 2\nf 2 6 7\nf 2 7 3\n"
+                    "f 3 7 8\nf 3 8 4\nf 4 8 5\nf 4 5 1\nf 9 9 9\nf 5 9 7\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        res = run("import-vehicle", str(tank), "-o", str(tmp_path / "tank"), "-q")
+    assert res.exit_code == 0, res.output

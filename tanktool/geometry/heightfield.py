@@ -467,7 +467,8 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
     n_z = e1[2] * e2[0] - e1[0] * e2[2]
     n_y = e1[0] * e2[1] - e1[1] * e2[0]
     # |n_y| / |n| in world units (the grid scales x and z by 1 / cs)
-    gentle = np.abs(n_y) >= GENTLE_NY * np.sqrt((n_x * cs) ** 2 + (n_z * cs) ** 2 + n_y * n_y)
+    # (a zero-area triangle, n = 0, is not gentle: its plane would divide 0 by 0)
+    gentle = (n_y != 0) & (np.abs(n_y) >= GENTLE_NY * np.sqrt((n_x * cs) ** 2 + (n_z * cs) ** 2 + n_y * n_y))
     out = []
     kern = active()
     for group in (np.flatnonzero(gentle), np.flatnonzero(~gentle)):
