@@ -61,7 +61,7 @@ def test_the_agents_table_names_real_states_and_guards_and_every_state_is_reacha
     assert {r.when for r in TRANSITIONS} - {"done"} == set(GUARDS)
     assert all(r.why for r in TRANSITIONS)
     assert table_text(TRANSITIONS, STATES) == transition_table()
-    assert transition_table().splitlines()[1].startswith("any but evade ")
+    assert transition_table().splitlines()[1].startswith("any but evade, return_fire ")
 
 
 def test_the_docs_show_the_table_the_code_runs():

@@ -302,6 +302,30 @@ def test_hit_by_a_tank_it_cannot_see_it_turns_to_face_the_shot():
     assert d2.bot.state != "return_fire"
 
 
+def test_an_engine_heard_close_behind_in_the_open_is_faced_once_not_behind_a_wall():
+    # the enemy drives 20 m behind us in the open: out of the cone, its engine heard
+    w = box_world([(75.0, 82.0), (55.0, 82.0)], headings=[0.0, 0.0])
+    me, other = w.tanks
+    drv = driver(Agent("hard", watch=False), 3)
+    states = []
+    for _ in range(int(2.0 / w.dt)):
+        other.vx = 6.0 * math.cos(w.t)
+        other.vz = 6.0 * math.sin(w.t)
+        w.step(None, [drv(w, me), IDLE])
+        states.append(drv.bot.state)
+    assert "return_fire" in states and math.isfinite(drv.bot.memory.faced_at)
+    # once: turned to it, not again within FACED s
+    starts = [k for k in range(len(states)) if states[k] == "return_fire" != (states[k - 1] if k else None)]
+    assert len(starts) == 1
+    # behind the thin wall x = 60 (z 20-50): not turned to
+    w2 = box_world([(70.0, 35.0), (50.0, 35.0)], headings=[0.0, 0.0])
+    d2 = driver(Agent("hard", watch=False), 3)
+    for _ in range(int(2.0 / w2.dt)):
+        w2.tanks[1].vx = 6.0
+        w2.step(None, [d2(w2, w2.tanks[0]), IDLE])
+        assert d2.bot.state != "return_fire"
+
+
 def test_only_a_level_that_scoots_goes_back_to_cover_while_reloading(monkeypatch):
     """Normal shuttles behind the corner it came round while its gun reloads; hard
     (``scoot`` False) keeps strafing in the fight."""

@@ -47,16 +47,24 @@ STATES = _ALL
 _ROAM = ("wander", "watch")
 
 
+#: a noise heard within NEAR m is turned to, at most once in FACED s [m, s]
+NEAR = 30.0
+FACED = 3.0
+
+
 def _but(*names: str) -> tuple[str, ...]:
     return tuple(n for n in _ALL if n not in names)
 
 
 TRANSITIONS = tuple(Transition(*row) for row in (
-    (_but("evade"), "ambushed", "evade", "hit twice in 4 s, nobody in sight"),
-    (("attack",), "losing", "evade", "out-traded (levels with cover)"),
+    (_but("evade", "return_fire"), "ambushed", "evade", "hit twice in 4 s, nobody in sight, shot from cover"),
+    (("attack",), "losing", "evade", "out-traded (levels that break off)"),
     (("evade",), "done", "search", "in cover or 5 s: from the threat"),
-    (_but("evade", "attack"), "shot_from_open", "return_fire", "hit, the shot heard from a place in sight"),
+    (_but("evade", "attack", "return_fire"), "shot_from_open", "return_fire",
+     "hit, the shot heard from a place in sight"),
     (_but("evade", "attack"), "enemy_acquired", "attack", "in sight, reaction time over"),
+    (_but("evade", "attack", "return_fire"), "heard_near", "return_fire",
+     "a shot or engine heard within 30 m from a place in sight: face it"),
     (("return_fire",), "done", "search", "facing the shot: from there"),
     (("wander", "watch", "search"), "camp_known", "hunt", "an enemy seen standing (cover levels)"),
     (("hunt",), "done", "wander", "it was not there"),
@@ -234,21 +242,37 @@ class Agent(Pilot):
 
 # ------------------------------------------------------------------ the guards
 def _ambushed(a: Agent, view: "View", p: "Percept") -> Any:
-    if p.sight is None and len(p.hits) >= 2 and p.t >= a.memory.evade_cooldown:
+    # a shot from a place in sight is better answered by turning on it (return_fire)
+    # than by driving off with it hitting our back
+    if p.sight is None and len(p.hits) >= 2 and p.t >= a.memory.evade_cooldown and not _in_open(view, p.shot):
         return a.memory.estimate(p.t)
     return None
 
 
+def _in_open(view: "View", h: Any) -> bool:
+    """Whether a heard shot came from a place in our line of sight."""
+    me = view.me
+    return h is not None and not view.map.line_blocked(me.x, me.z, h.x, h.z, me.eye,
+                                                        None if h.y is None else h.y + me.vehicle.eye)
+
+
 def _losing(a: Agent, view: "View", p: "Percept") -> Any:
-    if a.level.cover and p.sight is not None and p.t >= a.memory.evade_cooldown and a.memory.losing(view, p.sight):
+    if a.level.cover and a.level.break_off and p.sight is not None and p.t >= a.memory.evade_cooldown and a.memory.losing(view, p.sight):
         return (p.sight.x, p.sight.z)
     return None
 
 
 def _shot_from_open(a: Agent, view: "View", p: "Percept") -> Any:
-    h, me = p.shot, view.me
-    if p.sight is None and p.hit and h is not None and not view.map.line_blocked(
-            me.x, me.z, h.x, h.z, me.eye, None if h.y is None else h.y + me.vehicle.eye):
+    return p.shot if p.sight is None and p.hit and _in_open(view, p.shot) else None
+
+
+def _heard_near(a: Agent, view: "View", p: "Percept") -> Any:
+    """A shot or engine heard within ``NEAR`` m from a place in our line of sight,
+    since the last one it turned to (and not within ``FACED`` s of that): someone is
+    close, out of its cone.  (One behind a wall is searched for, or lain in wait for.)"""
+    h, me = p.heard, view.me
+    if p.sight is None and h is not None and h.t > a.memory.faced_t and p.t - a.memory.faced_at > FACED \
+            and math.hypot(h.x - me.x, h.z - me.z) < NEAR and _in_open(view, h):
         return h
     return None
 
@@ -300,7 +324,7 @@ def _vantage(a: Agent, view: "View", p: "Percept") -> Any:
     return True
 
 
-GUARDS = {"ambushed": _ambushed, "losing": _losing, "shot_from_open": _shot_from_open,
+GUARDS = {"ambushed": _ambushed, "losing": _losing, "shot_from_open": _shot_from_open, "heard_near": _heard_near,
           "enemy_acquired": _enemy_acquired, "camp_known": _camp_known, "enemy_killed": _enemy_killed,
           "enemy_lost": _enemy_lost, "heard": _heard, "hit_unseen": _hit_unseen, "heard_again": _heard_again,
           "leading": _leading, "vantage": _vantage}

@@ -13,7 +13,7 @@
   distance, with room to strafe and out of the cone it faced, the gun on it where the
   way comes into its sight.  Done when it is not there.
 * **ReturnFire** (hit by a tank it cannot see whose shot it heard from a place in its
-  line of sight): turn on the spot to face there, until facing it or for at most
+  line of sight, or a shot or engine heard close by): turn on the spot to face there, until facing it or for at most
   ``RETURN_FIRE`` s; then it searches from there.
 """
 
@@ -26,6 +26,7 @@ import numpy as np
 
 from ..commands import Command
 from . import aim as gun
+from . import relief
 from .dodge import half_extent_at
 from .driving import trim
 from .machine import State
@@ -55,6 +56,8 @@ CAMP_SPEED = 7.0
 #: evading lasts at most this long [s]; then no new evasion for EVADE_COOLDOWN s
 EVADE_TIME = 5.0
 EVADE_COOLDOWN = 8.0
+#: on relief, the place to shoot from is looked for again after this long [s]
+SPOT_AGAIN = 1.0
 #: a shot on relief may pass this far over or under the enemy's body [m] (its
 #: sphere tree is rounder than the box the test assumes)
 HEIGHT_TOLERANCE = 0.25
@@ -75,17 +78,32 @@ class Attack(State["Agent"]):
     def __init__(self) -> None:
         self.side = 1.0
         self.flip_at = 0.0
+        self.spot: tuple[float, float] | None = None      # where to shoot from on relief
+        self.spot_at = -math.inf
+
+    def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
+        self.spot, self.spot_at = None, -math.inf
 
     def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
         """Turn onto the intercept point, fire when the shot would hit, hold the level's
         fighting distance, strafe at speed, flipping side every ``FLIP`` s and away from
-        walls: a tank that strafes can dodge by stopping (``Agent.evade_shells``)."""
+        walls: a tank that strafes can dodge by stopping (``Agent.evade_shells``).  On
+        relief, where the hull's pitch will not carry a shot onto the enemy, to a place
+        that will (``relief.firing_spot``), the gun on the enemy."""
         s = p.sight
         if s is None:
             return None
         lv, me = agent.level, view.me
         rotate, fire, err = aim_and_fire(agent, view, s)
         top = me.vehicle.top_speed
+        spot = self.firing_spot(agent, view, s) if lv.relief and view.map.relief else None
+        if spot is not None:
+            # through it, not to a stop on it: a tank standing still is the easiest shot
+            ux, uz = spot[0] - me.x, spot[1] - me.z
+            n = max(math.hypot(ux, uz), 1e-6)
+            k = 0.7 * top / n
+            fwd, lat = k * (ux * me.c + uz * me.s), k * (-ux * me.s + uz * me.c)
+            return agent.drive(view, fwd, max(-0.5 * top, min(0.5 * top, lat)), rotate, fire)
         cover = cover_behind(agent, view, s) if lv.cover and lv.scoot and me.reload > SCOOT else None
         if cover is not None:
             # just fired: back behind the corner while the gun reloads, gun on the enemy
@@ -102,6 +120,22 @@ class Attack(State["Agent"]):
             forward = 0.5 * top * aligned       # boxed in across the line of fire: out, forwards
         lateral = side * 0.5 * top * (0.4 + 0.6 * aligned)
         return agent.drive(view, forward, lateral, rotate, fire)
+
+    def firing_spot(self, agent: "Agent", view: "View", s: Sighting) -> tuple[float, float] | None:
+        """None while a shot from here would pass through the enemy's height; else the
+        place to shoot from (``relief.firing_spot``, looked for again every
+        ``SPOT_AGAIN`` s or when reached)."""
+        me = view.me
+        ev = s.vehicle if s.vehicle is not None else me.vehicle
+        if relief.miss_from(view, me.x, me.z, me.eye, me.pitch, s, ev) < relief.TOLERANCE:
+            self.spot = None
+            return None
+        near = self.spot is not None and math.hypot(self.spot[0] - me.x, self.spot[1] - me.z) < 1.0
+        if view.t - self.spot_at >= SPOT_AGAIN or near:
+            grid = agent.nav.grid  # type: ignore[union-attr]
+            self.spot = relief.firing_spot(view, s, lambda x, z: grid.is_valid(grid.node_of(x, z)))
+            self.spot_at = view.t
+        return self.spot
 
     def strafe_side(self, agent: "Agent", view: "View") -> tuple[float, float]:
         """The side to strafe to (+1 right, -1 left) and the room [m] there: the same
@@ -159,9 +193,10 @@ def aim_and_fire(agent: "Agent", view: "View", s: Sighting) -> tuple[float, bool
         fire = miss < lv.fire_tolerance * half_extent_at(ev, s.heading, heading)
         if fire and view.map.relief:
             # on relief the hull's pitch aims the gun up or down: hold fire when the
-            # shell would pass over or under the enemy
+            # shell would pass over or under the enemy, or meet a crest on the way
             fire = gun.height_miss(me.eye, me.pitch, v, view.rules.shell_gravity, d, s.y,
-                                   ev.height) < HEIGHT_TOLERANCE
+                                   ev.height) < HEIGHT_TOLERANCE and relief.shell_clear(view, me.x, me.z, me.eye,
+                                                                                       me.pitch, s)
     if fire:
         agent.aim_error = agent.rng.gauss(0.0, lv.aim_noise)
         agent.fired_at = t
@@ -257,6 +292,7 @@ class ReturnFire(State["Agent"]):
         me = view.me
         self.face = math.atan2(arg.z - me.z, arg.x - me.x)
         self.until = view.t + RETURN_FIRE
+        agent.memory.faced_t, agent.memory.faced_at = arg.t, view.t
         self.handoff = (arg.x, arg.z, arg.y)
 
     def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:

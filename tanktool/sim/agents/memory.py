@@ -49,6 +49,7 @@ class AgentMemory:
         self.trail: deque[tuple[float, float, float, float]] = deque()    # (t, x, z, eye height)
         self.seen_at: dict[int, float] = {}        # when each enemy was last in sight (before this think)
         self.evade_cooldown = -math.inf
+        self.faced_t = self.faced_at = -math.inf     # the noise it last turned to: heard at, turned at
         self.last_seen: dict[int, Sighting] = {}   # the view's memory (the same dict)
         self.heard: Heard | None = None
 
