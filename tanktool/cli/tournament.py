@@ -87,18 +87,24 @@ def tournament(bots: tuple[str, ...], arenas: tuple[str, ...], vehicles: tuple[s
     for out in (json_path, chart):          # where the results go exists before the matches run
         if out is not None:
             out.parent.mkdir(parents=True, exist_ok=True)
+    if replays is not None:
+        replays.mkdir(parents=True, exist_ok=True)
+    written = []
+
+    def keep(name: str, data: bytes) -> None:        # each replay written as its match ends
+        atomic_write_bytes(replays / name, data)    # type: ignore[operator]
+        written.append(name)
+
     run = "ray" if ray_address else ("serial" if workers == 1 else "pool")
     n = workers or default_workers()
     with progress(length=len(tasks), label=f"{len(tasks)} matches ({run}, {n if run != 'serial' else 1} "
                   f"worker{'s' if n > 1 and run != 'serial' else ''})") as bar:
         result = run_tournament(config, run=run, workers=n, ray_address=ray_address or "local",
-                                record=replays is not None, on_match=lambda r: bar.update(1))
+                                record=replays is not None, on_match=lambda r: bar.update(1),
+                                on_replay=keep if replays is not None else None)
     echo(table(result.report))
     if replays is not None:
-        replays.mkdir(parents=True, exist_ok=True)
-        for name, data in result.replays:
-            atomic_write_bytes(replays / name, data)
-        echo(f"wrote {len(result.replays)} replays to {replays}/ (tanktool play --headless --replay FILE)")
+        echo(f"wrote {len(written)} replays to {replays}/ (tanktool play --headless --replay FILE)")
     if json_path is not None:
         atomic_write_text(json_path, json.dumps(result.report, indent=1) + "\n")
         echo(f"wrote {json_path}")

@@ -31,10 +31,13 @@ class Tournament:
 
 def run_tournament(config: TournamentConfig, *, run: str = "pool", workers: int | None = None,
                    ray_address: str = "local", record: bool = True,
-                   on_match: Callable[[dict[str, Any]], None] | None = None) -> Tournament:
+                   on_match: Callable[[dict[str, Any]], None] | None = None,
+                   on_replay: Callable[[str, bytes], None] | None = None) -> Tournament:
     """Play ``config``'s round robin with runner ``run`` (``serial``, ``pool`` or
     ``ray``) on ``workers`` processes (default: the local cores); ``on_match`` is
-    called with each result as it comes in."""
+    called with each result as it comes in.  With ``on_replay(name, data)`` each
+    replay is handed over as its match finishes (and not kept: a long tournament's
+    replays need not fit in memory); else they are in ``Tournament.replays``."""
     config.check()
     players = resolve_players(config.bots)
     tasks = schedule(config, players, record=record)
@@ -44,6 +47,9 @@ def run_tournament(config: TournamentConfig, *, run: str = "pool", workers: int 
     results = []
     it = go(tasks, workers, ray_address) if run == "ray" else go(tasks, workers)
     for r in it:
+        if on_replay is not None and "replay" in r:
+            on_replay(tasks[r["index"]].replay_name(), r.pop("replay"))
+            r["replay"] = b""            # recorded, handed over
         results.append(r)
         if on_match is not None:
             on_match(r)
@@ -55,7 +61,7 @@ def run_tournament(config: TournamentConfig, *, run: str = "pool", workers: int 
     if replays:
         for m, (name, _) in zip(report["matches"], replays):
             m["replay"] = name
-    return Tournament(report, replays)
+    return Tournament(report, [] if on_replay is not None else replays)
 
 
 __all__ = ["FORMAT", "MatchTask", "Player", "RUNNERS", "Tournament", "TournamentConfig", "default_workers",
