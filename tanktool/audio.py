@@ -5,8 +5,13 @@ the geometry of one source and the listener into a stereo buffer:
 
 - distance rolloff, OpenAL's inverse-distance-clamped model:
   ``gain = min_dist / (min_dist + rolloff * (clamp(d, min_dist, max_dist) - min_dist))``;
-- interaural intensity difference: equal-power pan by azimuth,
-  ``L = cos((p + 1) π/4)``, ``R = sin((p + 1) π/4)`` with ``p = sin(azimuth)``;
+- interaural level difference from the head's shadow, Brown & Duda's spherical-head
+  filter per ear (IEEE Trans. Speech Audio Proc. 6(5), 1998):
+  ``H(ω, θ) = (1 + j α(θ) ω / 2ω0) / (1 + j ω / 2ω0)``, ``ω0 = c / a``,
+  ``α(θ) = (1 + α_min/2) + (1 − α_min/2) cos(θ / θ_min · 180°)``, α_min = 0.1,
+  θ_min = 150°, θ the angle between the ear's axis and the source: a source at 90° is
+  about 0.6 dB louder in the near ear at 250 Hz, 5 dB at 1 kHz and 14 dB at 4 kHz,
+  never silent in the far one (bilinear transform, pre-warped at the corner);
 - interaural time difference, Woodworth's spherical head (radius 8.75 cm):
   ``itd = a/c · (θ + sin θ)`` for the lateral angle θ, 0.656 ms at 90°; the far ear is late;
 - sources behind the listener are muffled by a one-pole low-pass whose cut-off falls
@@ -111,6 +116,29 @@ def _lowpass(x: np.ndarray, rate: int, cutoff: float) -> np.ndarray:
     return lfilter([a], [1.0, a - 1.0], x)
 
 
+#: Brown & Duda's head-shadow constants: the far ear's high-frequency gain and where it is least
+ALPHA_MIN = 0.1
+THETA_MIN = math.radians(150.0)
+
+
+def shadow_alpha(theta: float) -> float:
+    """Brown & Duda's α(θ): an ear's high-frequency gain for a source ``theta`` radians
+    off its axis (2 facing it, ``ALPHA_MIN`` at ``THETA_MIN``)."""
+    return (1.0 + ALPHA_MIN / 2.0) + (1.0 - ALPHA_MIN / 2.0) * math.cos(theta / THETA_MIN * math.pi)
+
+
+def head_shadow(x: np.ndarray, rate: int, theta: float) -> np.ndarray:
+    """``x`` as heard by an ear whose axis is ``theta`` radians from the source: the
+    one-pole, one-zero head-shadow filter ``(α s + β) / (s + β)``, β = 2c/a, made
+    digital by the bilinear transform pre-warped at β."""
+    alpha = shadow_alpha(theta)
+    beta = 2.0 * SPEED_OF_SOUND / HEAD_RADIUS
+    k = beta / math.tan(beta / (2.0 * rate))         # pre-warp: the corner lands where it should
+    b = np.array([alpha * k + beta, beta - alpha * k]) / (k + beta)
+    a = np.array([1.0, (beta - k) / (k + beta)])
+    return lfilter(b, a, x)
+
+
 def spatialize(samples: np.ndarray, rate: int, source_pos, source_vel, listener_pos, listener_facing,
                listener_vel, *, min_dist: float = 1.0, max_dist: float = 100.0, rolloff: float = 1.0,
                pitch: float = 1.0) -> np.ndarray:
@@ -140,8 +168,9 @@ def spatialize(samples: np.ndarray, rate: int, source_pos, source_vel, listener_
         cutoff = OPEN_CUTOFF * (BEHIND_CUTOFF / OPEN_CUTOFF) ** (-fwd)
         x = _lowpass(x, rate, cutoff)
     g = rolloff_gain(dist, min_dist, max_dist, rolloff)
-    angle = (math.sin(az) + 1.0) * math.pi / 4.0
-    left, right = g * math.cos(angle) * x, g * math.sin(angle) * x
+    # each ear's angle to the source: the right ear's axis points at +90 degrees
+    left = g * head_shadow(x, rate, abs(math.remainder(az + math.pi / 2.0, 2.0 * math.pi)))
+    right = g * head_shadow(x, rate, abs(math.remainder(az - math.pi / 2.0, 2.0 * math.pi)))
     itd = itd_seconds(az) * rate
     if itd > 0:
         left = _delay(left, itd)
