@@ -32,8 +32,10 @@ sounding right.  Without a sound device every method still works and nothing is 
 from __future__ import annotations
 
 import math
+import os
+from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Sequence
+from typing import Iterator, Sequence
 
 import numpy as np
 from scipy.signal import lfilter
@@ -47,6 +49,24 @@ BEHIND_CUTOFF = 1200.0
 RATE = 22050
 #: seconds of a looping voice spatialised at a time
 CHUNK = 0.2
+
+
+@contextmanager
+def _quiet_stderr() -> Iterator[None]:
+    """Silence the process's stderr (file descriptor 2) for a moment: C libraries under
+    SDL (ALSA above all) print a line per failed device; the caller says it once."""
+    try:
+        saved = os.dup(2)
+    except OSError:
+        yield
+        return
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 2)
+            yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
 
 
 def _vec(v: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -236,6 +256,50 @@ def synth_explosion(rate: int = RATE) -> np.ndarray:
     return 0.95 * x / np.abs(x).max()
 
 
+def synth_music(rate: int = RATE, bpm: float = 96.0, bars: int = 8) -> np.ndarray:
+    """A loop of generated music, (n, 2) stereo: a minor progression (Am F C G) as soft
+    detuned pads, a plucked bass on the beats, a kick and a hat; whole bars, so it loops
+    without a seam.  Made here, so there is no licence to track."""
+    beat = 60.0 / bpm
+    n = int(round(bars * 4 * beat * rate))
+    t = np.arange(n) / rate
+    chords = ((57, 60, 64), (53, 57, 60), (48, 52, 55), (55, 59, 62))     # MIDI: Am F C G
+    pad = np.zeros(n)
+    bass = np.zeros(n)
+    bar_n = int(round(4 * beat * rate))
+    for b in range(bars):
+        chord = chords[b % len(chords)]
+        lo, hi = b * bar_n, min((b + 1) * bar_n, n)
+        tb = t[lo:hi] - t[lo]
+        swell = np.minimum(tb / 0.4, 1.0) * np.minimum((tb[-1] - tb + 1e-3) / 0.3, 1.0)
+        for note in chord:
+            f = 440.0 * 2.0 ** ((note - 69) / 12.0)
+            for detune in (0.997, 1.003):
+                pad[lo:hi] += swell * np.sin(2 * np.pi * f * detune * tb + note)
+        root = 440.0 * 2.0 ** ((chord[0] - 12 - 69) / 12.0)
+        for k in range(4):
+            s0 = lo + int(round(k * beat * rate))
+            m = min(int(beat * rate), n - s0)
+            tt = np.arange(m) / rate
+            bass[s0:s0 + m] += np.sin(2 * np.pi * root * tt) * np.exp(-tt / 0.25)
+    pad = _lowpass(pad, rate, 1800.0)
+    drums = np.zeros(n)
+    rng = np.random.default_rng(5)
+    for k in range(bars * 4):
+        s0 = int(round(k * beat * rate))
+        m = min(int(0.3 * rate), n - s0)
+        tt = np.arange(m) / rate
+        drums[s0:s0 + m] += np.sin(2 * np.pi * (50.0 + 80.0 * np.exp(-tt / 0.03)) * tt) * np.exp(-tt / 0.12)
+        h0 = int(round((k + 0.5) * beat * rate))
+        if h0 < n:
+            hm = min(int(0.05 * rate), n - h0)
+            drums[h0:h0 + hm] += 0.15 * rng.standard_normal(hm) * np.exp(-np.arange(hm) / rate / 0.015)
+    mono = 0.5 * pad / (np.abs(pad).max() + 1e-9) + 0.45 * bass / (np.abs(bass).max() + 1e-9) + 0.35 * drums
+    wide = _lowpass(pad, rate, 900.0) / (np.abs(pad).max() + 1e-9)
+    stereo = np.stack([mono + 0.15 * wide, mono - 0.15 * wide], axis=1)
+    return 0.5 * stereo / np.abs(stereo).max()
+
+
 SYNTHS = {"engine": synth_engine, "shot": synth_shot, "impact": synth_impact, "explosion": synth_explosion}
 
 
@@ -276,6 +340,10 @@ class Sound:
         self.enabled = False
         self.reason = "disabled by the caller"
         self._mixer = None
+        #: the effects' volume (every voice) and the music's, 0..1 (the settings' master times each)
+        self.volume = 1.0
+        self.music_volume = 1.0
+        self._music = None
         if device:
             self._open(channels)
 
@@ -284,12 +352,14 @@ class Sound:
             import pygame
 
             if not pygame.mixer.get_init():
-                pygame.mixer.init(frequency=self.rate, size=-16, channels=2, buffer=1024)
+                with _quiet_stderr():     # ALSA and friends write their own lines on failure
+                    pygame.mixer.init(frequency=self.rate, size=-16, channels=2, buffer=1024)
             freq, _, nch = pygame.mixer.get_init()
             self.rate, self._nch = int(freq), int(nch)
             if self.rate != RATE:
                 self.samples = {name: make(self.rate) for name, make in SYNTHS.items()}
             pygame.mixer.set_num_channels(channels)
+            pygame.mixer.set_reserved(1)          # channel 0: the music, never taken by a voice
             self._mixer = pygame.mixer
             self.enabled = True
             self.reason = ""
@@ -348,7 +418,31 @@ class Sound:
         out = spatialize(samples, self.rate, voice.position, voice.velocity, self.listener_pos,
                          self.listener_facing, self.listener_vel, min_dist=voice.min_dist,
                          max_dist=voice.max_dist, pitch=voice.pitch)
-        return out * voice.gain if voice.gain != 1.0 else out
+        g = voice.gain * self.volume
+        return out * g if g != 1.0 else out
+
+    def set_volumes(self, effects: float, music: float) -> None:
+        """The effects' and the music's volume, 0..1 (the music's at once, the effects'
+        from their next chunk)."""
+        self.volume = min(max(float(effects), 0.0), 1.0)
+        self.music_volume = min(max(float(music), 0.0), 1.0)
+        if self._music is not None:
+            self._music.set_volume(self.music_volume)
+
+    def play_music(self, stereo: np.ndarray) -> None:
+        """Loop ``stereo`` ((n, 2) in [-1, 1]) as music, not placed in 3D, on its own channel."""
+        if not self.enabled:
+            return
+        self.stop_music()
+        channel = self._mixer.Channel(0)
+        channel.play(self._buffer(np.asarray(stereo, dtype=np.float64)), loops=-1)
+        channel.set_volume(self.music_volume)
+        self._music = channel
+
+    def stop_music(self) -> None:
+        if self._music is not None:
+            self._music.stop()
+            self._music = None
 
     def update(self) -> None:
         """Apply every change since the last call: start new voices, feed looping ones
@@ -394,6 +488,7 @@ class Sound:
         return self._buffer(stereo).play()
 
     def shutdown(self) -> None:
+        self.stop_music()
         for vid in list(self.voices):
             self.stop(vid)
         if self._mixer is not None:

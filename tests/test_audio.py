@@ -174,3 +174,13 @@ def test_head_shadow_level_difference_follows_frequency(rate):
     assert 10.0 <= tone_ild(4000, 90, rate) <= 20.0
     assert tone_ild(1000, 30, rate) < tone_ild(1000, 90, rate)
     assert abs(tone_ild(1000, 0, rate)) < 0.01                 # straight ahead: both ears alike
+
+
+def test_generated_music_is_a_stereo_loop():
+    from tanktool.audio import synth_music
+
+    m = synth_music(22050, bpm=96.0, bars=8)
+    assert m.ndim == 2 and m.shape[1] == 2 and np.isfinite(m).all() and np.abs(m).max() <= 0.5 + 1e-9
+    assert abs(len(m) / 22050 - 8 * 4 * 60 / 96) < 1e-3          # whole bars: it loops in time
+    assert np.sqrt(np.mean(m ** 2)) > 0.05                        # heard
+    assert not np.allclose(m[:, 0], m[:, 1])                      # some width

@@ -68,7 +68,9 @@ def test_settings_page_changes_quality_and_saves(make_app):
     assert saved.quality == "high" and saved.shadows == "off"
     app.frame(0.016)
     # the mouse on the settings page: "back"
-    app.handle(mouse(pygame.MOUSEBUTTONDOWN, dict(app.menu.hits)[5].center))
+    from tanktool.game.menu import SETTINGS_ITEMS
+
+    app.handle(mouse(pygame.MOUSEBUTTONDOWN, dict(app.menu.hits)[SETTINGS_ITEMS.index("back")].center))
     assert app.state == "menu"
     # a later start reads them
     again = type(app)(app.presenter, match_config(bots=1, size=(480, 320)))
@@ -114,3 +116,33 @@ def test_end_screen_plays_again(make_app):
     press(app, pygame.K_r)
     assert app.state == "playing" and app.session.world.steps == 0
     np.testing.assert_equal(len(app.session.world.tanks), 2)
+
+
+def test_sound_settings_on_the_page_saved_and_heard(make_app):
+    """Master, effects and music volumes and mute: on the settings page, in
+    settings.toml, and applied to the playing sound at once."""
+    from tanktool.game.menu import SETTINGS_ITEMS
+
+    app = make_app((640, 360), bots=1, sound=True)
+    goto(app, "start")
+    press(app, pygame.K_RETURN)                       # a match with sound on the dummy device
+    assert app.audio is not None and app.audio.sound.enabled
+    assert app.audio.sound.music_volume == pytest.approx(0.8 * 0.5)     # the defaults: master 80 %, music 50 %
+    press(app, pygame.K_ESCAPE)
+    press(app, pygame.K_m)                            # the menu (the audio stops with the match)
+    app.state = "settings"                            # reached from the menu; the page only is tested here
+    for item, presses in (("master_volume", -3), ("music_volume", 2), ("effects_volume", -10)):
+        app.menu.settings_cursor = SETTINGS_ITEMS.index(item)
+        for _ in range(abs(presses)):
+            press(app, pygame.K_RIGHT if presses > 0 else pygame.K_LEFT)
+    app.frame(0.016)
+    s = load_settings()
+    assert (s.master_volume, s.music_volume, s.effects_volume, s.mute) == (0.5, 0.7, 0.0, False)
+    assert app.settings.volumes() == pytest.approx((0.0, 0.35))
+    app.menu.settings_cursor = SETTINGS_ITEMS.index("mute")
+    press(app, pygame.K_RETURN)
+    assert load_settings().mute and app.settings.volumes() == (0.0, 0.0)
+    press(app, pygame.K_ESCAPE)
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    assert app.audio.sound.volume == 0.0 and app.audio.sound.music_volume == 0.0

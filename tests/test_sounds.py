@@ -49,3 +49,33 @@ def test_engines_play_on_the_dummy_device():
         assert snd.voices[audio.engines[0]].gain == 0.0       # a wreck's engine is muted
     finally:
         audio.close()
+
+
+def test_no_audio_device_is_one_line_and_the_game_goes_on_silent(make_app, monkeypatch, capfd):
+    """The mixer cannot open a device (as on a machine without sound, where ALSA prints
+    a line per device it tries): the library lines are swallowed, the game says one
+    line, once a run, and plays on silent."""
+    import os
+
+    import pygame
+    from app_helpers import goto, press
+
+    def no_device(*a, **kw):
+        os.write(2, b"ALSA lib confmisc.c:855:(parse_card) cannot find card '0'\n")
+        raise pygame.error("ALSA: Couldn't open audio device: No such file or directory")
+
+    monkeypatch.setattr(pygame.mixer, "get_init", lambda: None)
+    monkeypatch.setattr(pygame.mixer, "init", no_device)
+    app = make_app((320, 240), bots=1, sound=True)
+    for _ in range(2):                                   # two matches, one line
+        goto(app, "start")
+        press(app, pygame.K_RETURN)
+        assert app.state == "playing" and not app.audio.sound.enabled
+        app.frame(0.05)
+        assert app.advance(0.1) > 0                      # the match goes on
+        press(app, pygame.K_ESCAPE)
+        press(app, pygame.K_m)
+    err = capfd.readouterr().err
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert lines == [lines[0]] and lines[0].startswith("sound: off, no sound device (ALSA: Couldn't open")
+    assert "goes on silent" in lines[0] and "ALSA lib" not in err

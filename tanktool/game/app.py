@@ -16,6 +16,7 @@ display).  What to play comes in one :class:`~tanktool.game.config.MatchConfig`.
 from __future__ import annotations
 
 import os
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -25,12 +26,11 @@ os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")   # the command's outpu
 import pygame  # noqa: E402
 
 from ..errors import TanktoolError  # noqa: E402
-from .config import DEFAULT_SIZE, MatchConfig  # noqa: E402
+from .config import MatchConfig  # noqa: E402
 from .controls import controls_rows  # noqa: E402
 from .display import (DisplayError, NoDisplay, Presenter, display_problem, stale_display,  # noqa: E402,F401
                       x_display_socket)
-from .input import PAUSE_KEYS, Bindings, InputState, load_bindings, save_bindings, screen_action  # noqa: E402
-from .menu import Choice, Menu  # noqa: E402
+from .input import END_KEYS, PAUSE_KEYS, Bindings, InputState, load_bindings, save_bindings, screen_action  # noqa: E402
 from .remap import Remap  # noqa: E402
 from .session import GameSession  # noqa: E402
 
@@ -64,7 +64,9 @@ class App:
         self.settings = load_settings(settings_file)
         if cfg.view.quality is not None:   # --quality: this run's preset, as it is (saved only from the settings page)
             self.settings.quality, self.settings.shadows, self.settings.particles = cfg.view.quality, None, None
-        self.menu = self._make_menu(cfg)
+        from .menu import menu_for
+
+        self.menu = menu_for(cfg, self.settings, bundled("arenas"), bundled("vehicles"))
         self.quality = self.settings.graphics()
         self._asked: set[tuple] = set()
         #: why the last match ended (the end-of-match screen)
@@ -93,37 +95,7 @@ class App:
         self.saved: list[str] = []
         self.replay_done = False
         self._notice_seen, self._notice_t, self._notice_text = ("", ""), 0.0, ""
-        if cfg.network is not None:
-            self.player_name, self.password = cfg.network.name, cfg.network.password
-
-    def _make_menu(self, cfg: MatchConfig) -> Menu:
-        """The menu's first values: the configuration's, the settings' where it names none."""
-        from ..sim.match import default_arena, default_vehicle
-
-        size = cfg.view.size
-        if tuple(size) == DEFAULT_SIZE and self.settings.resolution:
-            size = tuple(int(v) for v in self.settings.resolution.split("x"))   # --size overrides the saved one
-        arena, vehicle = cfg.arena, cfg.vehicle
-        arenas, vehicles = bundled("arenas"), bundled("vehicles")
-        menu = Menu(Choice("arena", arenas + ([arena] if arena and arena not in arenas else [])),
-                    Choice("vehicle", vehicles + ([vehicle] if vehicle and vehicle not in vehicles else [])
-                           or [None]))
-        menu.arena.set(arena or default_arena())
-        menu.vehicle.set(vehicle or default_vehicle())
-        menu.bots.set(min(max(cfg.opponents.count, 0), 7))
-        menu.view.set(cfg.view.mode)
-        # a first start offers easy; then the menu's last choice (--difficulty wins)
-        menu.difficulty.set(cfg.opponents.difficulty or self.settings.difficulty or "easy")
-        res = f"{size[0]}x{size[1]}"
-        if res not in menu.resolution.options:
-            menu.resolution.options.insert(0, res)
-        menu.resolution.set(res)
-        menu.fullscreen.set(cfg.view.fullscreen or self.settings.fullscreen)
-        menu.name = self.settings.name
-        if cfg.network is not None:
-            menu.network.set(cfg.network.mode)
-            menu.address = cfg.network.address
-        return menu
+        self._said_silent = False
 
     @property
     def replay(self) -> Any:
@@ -145,19 +117,10 @@ class App:
         """The network session's password: the menu's field (``--password`` fills it)."""
         return self.menu.password or None
 
-    @password.setter
-    def password(self, value: str | None) -> None:
-        self.menu.password = value or ""
-
     @property
     def player_name(self) -> str | None:
         """The name for network play: the menu's field (``--name`` or the settings fill it)."""
         return self.menu.name or None
-
-    @player_name.setter
-    def player_name(self, value: str | None) -> None:
-        if value:
-            self.menu.name = value
 
     def save_settings(self) -> Path | None:
         """Write the settings file; returns its path (None, and a notice, if it could not be written)."""
@@ -239,7 +202,12 @@ class App:
         if self.config.sound:
             from .sounds import GameAudio
 
-            self.audio = GameAudio(self.session)
+            self.audio = GameAudio(self.session, volumes=self.settings.volumes())
+            if not self.audio.sound.enabled and not self._said_silent:
+                self._said_silent = True           # one line a run, then silence
+                line = f"sound: off, {self.audio.sound.reason}; the game goes on silent"
+                print(line, file=sys.stderr)
+                self.notice = line
 
     def start_network(self) -> None:
         """Host or join a network session (the menu's ``network`` and ``address``) and
@@ -381,8 +349,10 @@ class App:
         elif item is not None:
             path = self.save_settings()
             if path is not None:
-                self.notice = f"{item} changed (saved to {path})"
+                self.notice = f"{item.replace('_', ' ')} changed (saved to {path})"
             self.apply_quality()
+            if self.audio is not None:
+                self.audio.set_volumes(self.settings.volumes())
 
     def _handle_match(self, event: Any, actions: list[str]) -> None:
         """Playing or paused: the input layer's actions (and the pause screen's keys)."""
@@ -515,17 +485,12 @@ class App:
         return True
 
     def _handle_over(self, event: Any) -> None:
-        """The end-of-match screen: Enter, Esc, M or a click: the menu; R: the same match
-        again; Q or F10: quit."""
-        if event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
-            self.state = "menu"
-        elif event.type == pygame.KEYDOWN:
-            if event.key in (pygame.K_RETURN, pygame.K_KP_ENTER, pygame.K_ESCAPE, pygame.K_m, pygame.K_SPACE):
-                self.state = "menu"
-            elif event.key == pygame.K_r:
-                self.start()
-            elif event.key in (pygame.K_q, pygame.K_F10):
-                self.state = "quit"
+        """The end-of-match screen (its keys: input.END_KEYS)."""
+        action = screen_action(event, END_KEYS)
+        if action == "restart":
+            self.start()
+        elif action is not None:
+            self.state = action
 
     def _replay_over(self) -> None:
         if self.replay_done:

@@ -286,12 +286,21 @@ PAUSE_KEYS: dict[str, tuple[str, ...]] = {
 }
 
 
+#: the end-of-match screen's: back to the menu (a click too), the same match again, quit
+END_KEYS: dict[str, tuple[str, ...]] = {
+    "menu": ("key:return", "key:enter", "key:escape", "key:m", "key:space", "mouse:1"),
+    "restart": ("key:r",),
+    "quit": ("key:q", "key:f10"),
+}
+
+
 def screen_action(event: Any, keys: dict[str, tuple[str, ...]]) -> str | None:
-    """The screen action (a key of ``keys``) a key press stands for, or None: screens
-    such as the pause screen read keys through this, never as key codes."""
+    """The screen action (a key of ``keys``) a press (key, mouse or joystick button)
+    stands for, or None: screens such as the pause screen read their keys through this,
+    never as key codes."""
     import pygame
 
-    if event.type != pygame.KEYDOWN:
+    if event.type not in (pygame.KEYDOWN, pygame.MOUSEBUTTONDOWN, pygame.JOYBUTTONDOWN):
         return None
     name = input_name(event)
     return next((a for a, names in keys.items() if name in names), None)

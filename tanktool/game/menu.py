@@ -10,8 +10,9 @@ wheel turns it, a click on a preview shows the next arena or vehicle, and a clic
 field (address, name, password) starts typing there.
 
 The settings page holds the graphics quality (a preset, and shadows or particles
-overriding it), the resolution and full screen; every change is saved at once to
-``settings.toml`` (game/quality.py) and used from the next match on.
+overriding it), the resolution and full screen, and the sound: master, effects and
+music volumes and mute; every change is saved at once to ``settings.toml``
+(game/quality.py), the sound's heard at once, the rest used from the next match on.
 """
 
 from __future__ import annotations
@@ -34,7 +35,10 @@ MAX_PASSWORD = 64
 FIELDS = ("address", "name", "password")
 ACTION_LABELS = {"settings": "settings...", "bindings": "key and joystick bindings...", "start": "START", "quit": "quit",
                  "back": "back"}
-SETTINGS_ITEMS = ("quality", "shadows", "particles", "resolution", "fullscreen", "back")
+SETTINGS_ITEMS = ("quality", "shadows", "particles", "resolution", "fullscreen", "master_volume", "effects_volume",
+                  "music_volume", "mute", "back")
+#: a volume step on the settings page
+VOLUME_STEP = 0.1
 RESOLUTIONS = ["1280x720", "1600x900", "1920x1080", "1024x576", "800x600"]
 #: the menu's network address: host on it, or join the session there
 DEFAULT_ADDRESS = "127.0.0.1:5000"
@@ -103,6 +107,38 @@ class Menu:
         return w, h
 
 
+def menu_for(cfg: Any, settings: Settings, arenas: list[str], vehicles: list[str]) -> Menu:
+    """The menu's first values: a ``game.config.MatchConfig``'s, the settings' where it
+    names none (``arenas``, ``vehicles``: the bundled names to choose from)."""
+    from ..sim.match import default_arena, default_vehicle
+    from .config import DEFAULT_SIZE
+
+    size = cfg.view.size
+    if tuple(size) == DEFAULT_SIZE and settings.resolution:
+        size = tuple(int(v) for v in settings.resolution.split("x"))   # --size overrides the saved one
+    arena, vehicle = cfg.arena, cfg.vehicle
+    m = Menu(Choice("arena", arenas + ([arena] if arena and arena not in arenas else [])),
+             Choice("vehicle", vehicles + ([vehicle] if vehicle and vehicle not in vehicles else []) or [None]))
+    m.arena.set(arena or default_arena())
+    m.vehicle.set(vehicle or default_vehicle())
+    m.bots.set(min(max(cfg.opponents.count, 0), 7))
+    m.view.set(cfg.view.mode)
+    # a first start offers easy; then the menu's last choice (--difficulty wins)
+    m.difficulty.set(cfg.opponents.difficulty or settings.difficulty or "easy")
+    res = f"{size[0]}x{size[1]}"
+    if res not in m.resolution.options:
+        m.resolution.options.insert(0, res)
+    m.resolution.set(res)
+    m.fullscreen.set(cfg.view.fullscreen or settings.fullscreen)
+    m.name = settings.name
+    if cfg.network is not None:
+        m.network.set(cfg.network.mode)
+        m.address = cfg.network.address
+        m.name = cfg.network.name or m.name
+        m.password = cfg.network.password or ""
+    return m
+
+
 # ---------------------------------------------------------------- labels
 def _shown(value: Any) -> str:
     if isinstance(value, bool):
@@ -142,6 +178,11 @@ def settings_label(m: Menu, s: Settings, item: str) -> tuple[str, str]:
         v = getattr(s, item)
         preset = getattr(PRESETS[s.quality], item)
         return item, f"<  {v if v is not None else f'as the preset ({preset})'}  >"
+    if item.endswith("_volume"):
+        label = item.replace("_", " ")
+        return label, f"<  {round(100 * getattr(s, item)):d} %  >" + ("  (muted)" if s.mute else "")
+    if item == "mute":
+        return "mute", f"<  {_shown(s.mute)}  >"
     c = getattr(m, item)
     return c.label, f"<  {_shown(c.value)}  >"
 
@@ -213,14 +254,16 @@ def draw_settings(m: Menu, settings: Settings, surf: "pygame.Surface", notice: s
     surf.fill(BG)
     w, h = surf.get_size()
     text(surf, "settings", (w // 2, 24), max(min(60, h // 9), 26), anchor="midtop")
-    line = max(min(40, (h - 200) // len(SETTINGS_ITEMS)), 16)
+    # the list, then three lines of notes, then the footer: all fit the window
+    line = max(min(40, (h - 100 - 16 - 3 * 26 - 70) // len(SETTINGS_ITEMS)), 16)
     x = int(w * 0.12) if w >= 640 else 18
     m.hits = _list(surf, [settings_label(m, settings, it) for it in SETTINGS_ITEMS], m.settings_cursor,
                    x, 100, line, max(int(line * 0.8), 13))
     q = settings.graphics()
     lines = [f"shadows {q.shadows} ({q.shadow_size or 'no'} map), particles {q.particles}, sky {q.sky}, "
              f"arena lit per {q.arena_light}",
-             "low keeps software OpenGL (Mesa llvmpipe) fastest; high is everything on"]
+             "low keeps software OpenGL (Mesa llvmpipe) fastest; high is everything on",
+             "effects and music play at their volume times the master's; mute silences both"]
     y = 100 + line * len(SETTINGS_ITEMS) + 16
     rects = [text(surf, s, (x, y + 26 * i), 22, HELP) for i, s in enumerate(lines)]
     panel(surf, rects[0].unionall(rects[1:]), (30, 36, 34, 255))
@@ -399,6 +442,10 @@ def change_setting(m: Menu, s: Settings, item: str, step: int) -> None:
         options = [None, *(SHADOWS if item == "shadows" else PARTICLES)]
         cur = getattr(s, item)
         setattr(s, item, options[(options.index(cur) + step) % len(options)])
+    elif item.endswith("_volume"):
+        setattr(s, item, round(min(max(getattr(s, item) + step * VOLUME_STEP, 0.0), 1.0), 2))
+    elif item == "mute":
+        s.mute = not s.mute
     else:
         c = getattr(m, item)
         c.shift(step)

@@ -93,6 +93,10 @@ def preset(name: str) -> Quality:
         raise FormatError(f"quality must be one of {', '.join(PRESETS)}, got {name!r}") from None
 
 
+#: the settings' volume keys (0..1 each)
+VOLUMES = ("master_volume", "effects_volume", "music_volume")
+
+
 @dataclass
 class Settings:
     """The settings page's choices."""
@@ -108,6 +112,17 @@ class Settings:
     difficulty: str | None = None
     #: the controls overlay was shown at a first start (it then shows on F1 only)
     controls_seen: bool = False
+    #: sound: the master volume and the effects' and music's under it (0..1), and mute
+    master_volume: float = 0.8
+    effects_volume: float = 1.0
+    music_volume: float = 0.5
+    mute: bool = False
+
+    def volumes(self) -> tuple[float, float]:
+        """(effects, music) as played: each times the master; both 0 when muted."""
+        if self.mute:
+            return 0.0, 0.0
+        return self.master_volume * self.effects_volume, self.master_volume * self.music_volume
 
     def graphics(self) -> Quality:
         q = preset(self.quality)
@@ -124,6 +139,9 @@ class Settings:
         if self.difficulty is not None:
             d["difficulty"] = self.difficulty
         d["controls_seen"] = self.controls_seen
+        for key in VOLUMES:
+            d[key] = round(getattr(self, key), 2)
+        d["mute"] = self.mute
         return d
 
 
@@ -156,7 +174,13 @@ def load_settings(path: str | os.PathLike | None = None) -> Settings:
         if not (isinstance(v, str) and re.fullmatch(r"\d{2,5}x\d{2,5}", v)):
             raise FormatError(f"{path}: resolution must be like \"1280x720\", got {v!r}")
         s.resolution = v
-    for key in ("fullscreen", "controls_seen"):
+    for key in VOLUMES:
+        if key in doc:
+            v = doc[key]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= v <= 1.0:
+                raise FormatError(f"{path}: {key} must be a number from 0 to 1, got {v!r}")
+            setattr(s, key, float(v))
+    for key in ("fullscreen", "controls_seen", "mute"):
         if key in doc:
             if not isinstance(doc[key], bool):
                 raise FormatError(f"{path}: {key} must be true or false, got {doc[key]!r}")

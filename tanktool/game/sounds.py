@@ -3,6 +3,7 @@
 Each tank has a looping engine voice whose pitch follows its speed; shots, hits and
 kills start one-shot voices where they happen.  The listener rides on the followed
 tank, facing where it faces.  All the 3D maths is :func:`tanktool.audio.spatialize`.
+Generated music (``audio.synth_music``) loops under it at its own volume.
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-from ..audio import Sound
+from ..audio import Sound, synth_music
 from ..sim.world import Event
 from .session import GameSession
 
@@ -22,9 +23,13 @@ EVENT_SOUNDS = {"shot": "shot", "hit": "impact", "kill": "explosion", "wall_bump
 class GameAudio:
     """Keeps a :class:`Sound` in step with a session; silent when ``sound`` has no device."""
 
-    def __init__(self, session: GameSession, sound: Sound | None = None) -> None:
+    def __init__(self, session: GameSession, sound: Sound | None = None,
+                 volumes: tuple[float, float] = (1.0, 1.0)) -> None:
         self.session = session
         self.sound = sound if sound is not None else Sound()
+        self.sound.set_volumes(*volumes)
+        if self.sound.enabled:
+            self.sound.play_music(_music(self.sound.rate))
         self.engines: list[int] = []
         for _ in session.world.tanks:
             v = self.sound.play("engine", loop=True)
@@ -57,5 +62,19 @@ class GameAudio:
             self.sound.set_gain(v, 0.5 if t.alive else 0.0)
         self.sound.update()
 
+    def set_volumes(self, volumes: tuple[float, float]) -> None:
+        """(effects, music), 0..1 each (the settings' ``volumes()``)."""
+        self.sound.set_volumes(*volumes)
+
     def close(self) -> None:
         self.sound.shutdown()
+
+
+_MUSIC: dict[int, object] = {}
+
+
+def _music(rate: int) -> object:
+    """The generated music loop at ``rate`` (made once a run: a second of numpy)."""
+    if rate not in _MUSIC:
+        _MUSIC[rate] = synth_music(rate)
+    return _MUSIC[rate]
