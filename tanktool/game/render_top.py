@@ -92,7 +92,7 @@ class TopView:
         a, b = self.to_px(x0, z0), self.to_px(x1, z1)
         pygame.draw.rect(surf, FLOOR, pygame.Rect(a, (b[0] - a[0], b[1] - a[1])))
         ground = getattr(self.session.world, "ground", None)
-        if ground is not None:
+        if getattr(ground, "relief", False):   # a flat ground is one shade: the floor's
             self._draw_heights(surf, ground)
         width = max(int(round(0.6 * self.scale)), 2)
         for (ax, az), (bx, bz) in self.session.world.walls.segments.tolist():
@@ -228,7 +228,7 @@ class TopView:
         if t.index == self.session.focus():
             px, pz = self.to_px(x, z)
             pygame.draw.circle(surface, (255, 255, 255), (px, pz), int(t.spec.radius * self.scale) + 4, 2)
-        if getattr(self.session.world, "ground", None) is not None and t.alive:
+        if getattr(getattr(self.session.world, "ground", None), "relief", False) and t.alive:
             # which floor it is on: its height beside it (a deck and the passage under it look alike)
             px, pz = self.to_px(x, z)
             text(surface, f"{t.y:.1f} m", (int(px + t.spec.radius * self.scale) + 2, int(pz)), 15, anchor="midleft")

@@ -18,8 +18,10 @@ simulation reads from them:
   bucketed by squares of the (x, z) plane, answers "where does this segment first cross
   a triangle".
 
-A flat one-floor arena has no Ground: the simulation is the 2002 one (a plane floor,
-walls infinitely tall).
+A flat one-floor arena has a ``sim.flat_ground.FlatGround`` instead: the same
+questions answered by a plane at the floor's height (the 2002 simulation: a plane
+floor, walls infinitely tall); ``sim.flat_ground.load_ground`` picks the one a bundle
+gets.
 """
 
 from __future__ import annotations
@@ -333,6 +335,9 @@ class Ground:
     climb : the largest step between neighbours [m]
     """
 
+    #: a surface with heights, slopes or levels (FlatGround: False)
+    relief = True
+
     def __init__(self, grid: Any, mesh: MeshIndex | None = None, climb: float = 0.9) -> None:
         h = np.asarray(grid.heights(), dtype=np.float64)
         self.h = h                                    # (L, nz, nx), NaN: no node
@@ -536,32 +541,54 @@ class Ground:
         return y, pitch, roll
 
 
-#: an arena whose surface heights differ by less than this is flat: no Ground
-FLAT_RANGE = 0.2
+    # ------------------------------------------------------------------ moves
+    def keep_move(self, t: Any, dx: float, dz: float) -> tuple[float, float]:
+        """The part of tank ``t``'s move (dx, dz) that keeps its centre on the walkable
+        surface: into a cell its node links to (the tank's level follows the link), else
+        along one axis only (sliding along the edge), else not at all; velocity into a
+        refused direction is taken away."""
+        i0, j0 = self.cell_of(t.x, t.z)
+        i1, j1 = self.cell_of(t.x + dx, t.z + dz)
+        if (i0, j0) == (i1, j1):
+            return dx, dz
+        lv = self.follow(t.level, i0, j0, i1, j1)
+        if lv >= 0:
+            t.level = lv
+            return dx, dz
+        if self.node_height(t.level, i0, j0) is None:
+            # off the surface already (placed there by hand, a spawn on its edge): any
+            # move onto a node near its height is a way back, others are refused
+            lv = self.locate(t.x + dx, t.z + dz, t.y)
+            hv = self.node_height(lv, i1, j1) if lv >= 0 else None
+            if hv is not None and abs(hv - t.y) <= self.climb:
+                t.level = lv
+                return dx, dz
+        # refused: slide along whichever axis is still open
+        for keep_x in (abs(dx) >= abs(dz), abs(dx) < abs(dz)):
+            ii, jj = self.cell_of(t.x + (dx if keep_x else 0.0), t.z + (0.0 if keep_x else dz))
+            lv = self.follow(t.level, i0, j0, ii, jj)
+            if lv >= 0:
+                t.level = lv
+                if keep_x:
+                    t.vz = 0.0
+                    return dx, 0.0
+                t.vx = 0.0
+                return 0.0, dz
+        t.vx = t.vz = 0.0
+        return 0.0, 0.0
 
+    def contain(self, tanks: Any, before: Any, tilt: Any) -> None:
+        """After the collision pushes: a push that would carry a tank's centre off the
+        walkable surface keeps only its part along the surface (containment wins over
+        the push, as a wall would), and a moved tank stands at its new place
+        (``tilt(t)``)."""
+        for t, (x0, z0) in zip(tanks, before):
+            if not t.alive or (t.x == x0 and t.z == z0):
+                continue
+            dx, dz = t.x - x0, t.z - z0
+            t.x, t.z = x0, z0
+            dx, dz = self.keep_move(t, dx, dz)
+            t.x += dx
+            t.z += dz
+            tilt(t)
 
-def load_ground(bundle: Any) -> "Ground | None":
-    """The Ground of an arena bundle (``arena.ArenaBundle``): from its navgrid.npz and
-    its model; None for a flat one-floor arena (or one without a grid)."""
-    from ..formats.models import load_model
-    from ..nav.navgrid import NavGrid
-    from ..nav.walkable import CLIMB
-
-    path = bundle.path / "navgrid.npz"
-    if not path.is_file():
-        return None
-    grid = NavGrid.load(path)
-    h = grid.heights()
-    hv = h[np.isfinite(h)]
-    if grid.height is None or len(hv) == 0 or (grid.levels == 1 and float(hv.max() - hv.min()) < FLAT_RANGE):
-        return None
-    model = bundle.file("model")
-    mesh = None
-    if model.is_file():
-        m = load_model(model, up="y")
-        mesh = MeshIndex(np.asarray(m.vertices), np.asarray(m.faces))
-    wk = bundle.toml.get("walkable", {})
-    climb = wk.get("climb", CLIMB) if isinstance(wk, dict) else CLIMB
-    climb = float(climb) if isinstance(climb, (int, float)) and not isinstance(climb, bool) and math.isfinite(climb) \
-        else CLIMB
-    return Ground(grid, mesh, climb)

@@ -41,7 +41,7 @@ class ArenaInfo:
     spawns: np.ndarray            # (k, 3) [x, z, heading], or (k, 4) with the ground's height y
     path: Path | None
     bounds: np.ndarray | None = None
-    ground: Any = None            # sim.ground.Ground, None on a flat arena
+    ground: Any = None            # sim.ground.Ground, or sim.flat_ground.FlatGround (None: flat at y = 0)
     vehicles: dict[str, Any] = field(default_factory=dict)   # the manifest's [vehicles]: what it was built for
 
 
@@ -80,6 +80,11 @@ def _bundle_dir(ref: str | Path, kind: str, defaults: tuple[str, ...]) -> Path:
     raise err(f"{ref}: no such {kind[:-1]} (a folder path, or one of: {', '.join(have) or 'none bundled yet'})")
 
 
+def arena_dir(ref: str | Path) -> Path:
+    """The folder of an arena given by path or bundled name (ArenaError when none)."""
+    return _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
+
+
 def default_arena() -> str | None:
     """The first bundled arena that exists, or None."""
     from ..content import bundled_dir
@@ -105,7 +110,7 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
     """Walls, spawn points and bounds of an arena bundle (name or folder)."""
     from ..arena import load_arena
 
-    from .ground import load_ground
+    from .flat_ground import load_ground
 
     path = _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
     bundle = load_arena(path)

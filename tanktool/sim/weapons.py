@@ -90,7 +90,8 @@ def fire(tank: Tank, walls: WallSet, rules: Rules | None = None, rng: random.Ran
         if rules.spread > 0.0 and rng is not None:
             a = rng.gauss(0.0, rules.spread)
             c, s = c * math.cos(a) - s * math.sin(a), s * math.cos(a) + c * math.sin(a)
-    if ground is not None and ground.mesh is not None:
+    mesh = getattr(ground, "mesh", None)     # a flat ground has no model: the walls stop shells
+    if mesh is not None:
         cp, sp = math.cos(tank.pitch), math.sin(tank.pitch)
         vx = v * cp * c + tank.vx
         vz = v * cp * s + tank.vz
@@ -100,7 +101,7 @@ def fire(tank: Tank, walls: WallSet, rules: Rules | None = None, rng: random.Ran
         return shell
     vx = v * c + tank.vx
     vz = v * s + tank.vz
-    shell = Shell(tank.index, tank.x, spec.muzzle_local[1], tank.z, vx, 0.0, vz, spec.shell_damage,
+    shell = Shell(tank.index, tank.x, tank.y + spec.muzzle_local[1], tank.z, vx, 0.0, vz, spec.shell_damage,
                   reach_max, g)
     reach = min(math.hypot(vx, vz) * shell.flight_time(), reach_max)     # finite: Rules sees to it
     if reach > 0.0 and (shell.ux != 0.0 or shell.uz != 0.0):

@@ -34,6 +34,7 @@ from .body import Tank, TankSpec
 from ..nav.quadtree import WallQuadtree
 from .collide import QuadtreeIndex, WallIndex, WallSet, shell_hits_tank, tank_contact, wall_contacts
 from .commands import Command
+from .flat_ground import FlatGround
 from .resolve import SLOP, correct_walls, pair_impulse, separate_pair, wall_impulse
 from .rules import DEFAULT as DEFAULT_RULES, GRAVITY, MatchState, Rules
 from .weapons import Shell, fire, fly, stop_fraction
@@ -101,11 +102,13 @@ class World:
     wall_index : the wall quadtree (``nav.quadtree.WallQuadtree``, built here by default
                  with leaves of about 12 m, or ``quadtree_depth``) or any object with
                  exact ``query_point`` and ``query_segment``
-    ground : an arena's ``sim.ground.Ground`` (relief, several levels), or None for a
-             flat one-floor arena (the 2002 simulation).  With a ground, tanks stand on
-             its surface (height, pitch and roll from it, gravity along its slopes), move
-             between levels along its links and never leave it, collide with the walls of
-             their own level only, and shells and sight meet the model's triangles.
+    ground : the arena's ground: a ``sim.ground.Ground`` (relief, several levels) or a
+             ``sim.flat_ground.FlatGround`` (a flat one-floor arena, the 2002
+             simulation; the default, at y = 0).  Tanks stand on its surface (height,
+             pitch and roll from it, gravity along its slopes), move between levels
+             along its links and never leave it, collide with the walls of their own
+             level only, and shells and sight meet the model's triangles (a flat
+             ground has none of these: the walls alone stop tanks, shells and sight).
     rules : the match's rules (``sim.rules.Rules``; default ``sim.rules.DEFAULT``).
             Every tank's spec is armed with the rules' gun (``Rules.arm``), so
             ``tank.spec.shell_speed`` is the speed its shells leave at.
@@ -145,7 +148,7 @@ class World:
         if hasattr(wall_index, "child") and hasattr(wall_index, "box"):
             wall_index = QuadtreeIndex(wall_index)   # same buckets, plain-Python lookups
         self.walls = WallSet(segments, wall_index)
-        self.ground = ground
+        self.ground = ground if ground else FlatGround(self.bounds)
         sp = np.asarray(spawns, dtype=np.float64)
         sp = sp.reshape(len(sp), -1) if sp.size else np.zeros((0, 3))
         self.spawns = [tuple(float(v) for v in row[:3]) for row in sp]
@@ -153,7 +156,7 @@ class World:
         self.spawn_y = [float(row[3]) if len(row) > 3 and math.isfinite(row[3]) else None for row in sp]
         self.level_walls: list[WallSet] = []
         self._wall_y: list[list[tuple[float, float]]] = []
-        if ground is not None:
+        if self.ground.relief:  # a flat ground's walls stop every tank: one set
             self._build_level_walls(walls, segments)
         if len(self.spawns) < len(specs):
             raise ArenaError(f"the arena has {len(self.spawns)} spawn points, {len(specs)} tanks asked for")
@@ -209,10 +212,9 @@ class World:
         self.integrate(dt)
         self.vertices()
         collisions = self.detect_collisions(range(len(self.tanks)), with_shells=True)
-        before = [(t.x, t.z) for t in self.tanks] if self.ground is not None else None
+        before = [(t.x, t.z) for t in self.tanks]
         self.resolve_collisions(collisions, events)
-        if before is not None:
-            self._contain(before)
+        self.ground.contain(self.tanks, before, self._tilt)
         if self.match.check(self) is not None:
             w = self.match.winner
             x, z = (self.tanks[w].x, self.tanks[w].z) if w is not None else (0.0, 0.0)
@@ -342,7 +344,7 @@ class World:
                 fr += sp.strafe_force * s * (0.0 if fade < 0.0 else 1.0 if fade > 1.0 else fade)
             t.fx = ff * c - fr * sn
             t.fz = ff * sn + fr * c
-            if self.ground is not None and (t.pitch != 0.0 or t.roll != 0.0):
+            if t.pitch != 0.0 or t.roll != 0.0:
                 # gravity along the slope: on a plane of gradient G the horizontal pull is
                 # g G / (1 + |G|^2) downhill (g sin(theta) cos(theta))
                 gf, gr = math.tan(t.pitch), -math.tan(t.roll)   # rise along forward, along right
@@ -380,8 +382,7 @@ class World:
                 t.vz += az * dt
                 t.omega += alpha * dt
                 dx, dz, dh = t.vx * dt, t.vz * dt, t.omega * dt
-            if self.ground is not None:
-                dx, dz = self._keep_on_ground(t, dx, dz)
+            dx, dz = self.ground.keep_move(t, dx, dz)
             t.x += dx
             t.z += dz
             h = t.heading + dh
@@ -403,8 +404,7 @@ class World:
             if not t.alive:
                 continue
             t.c, t.s = math.cos(t.heading), math.sin(t.heading)
-            if self.ground is not None:
-                self._tilt(t)
+            self._tilt(t)
             wc = t.wall_cache
             if wc is None or (t.x - wc[0]) ** 2 + (t.z - wc[1]) ** 2 > slack * slack or wc[3] != t.level:
                 t.wall_cache = self._wall_candidates(t, slack)
@@ -623,7 +623,7 @@ class World:
         model's solid on a ground (terrain, decks, ceilings, walls; a height left out is
         eye height over the lowest surface there)."""
         g = self.ground
-        if g is None or g.mesh is None:
+        if g.mesh is None:
             return self.walls.blocked(ax, az, bx, bz)
         a = (ax, self._eye_at(ax, az) if ay is None else ay, az)
         return g.solids.blocked(a, (bx, self._eye_at(bx, bz) if by is None else by, bz))
@@ -643,7 +643,7 @@ class World:
         ground in one go (``SolidField.visible_from``; a height left out is eye height
         over the lowest surface there), on a flat arena one by one as asked for."""
         g = self.ground
-        if g is None or g.mesh is None:
+        if g.mesh is None:
             return (self.line_blocked(ax, az, x, z, ay, y) for x, z, y in points)
         a = (ax, self._eye_at(ax, az) if ay is None else ay, az)
         pts = [(x, self._eye_at(x, z) if y is None else y, z) for x, z, y in points]
@@ -651,7 +651,7 @@ class World:
 
     def walls_of(self, t: Tank) -> WallSet:
         """The walls a tank can hit: its level's (all walls on a flat arena)."""
-        if self.ground is None or not self.level_walls:
+        if not self.level_walls:
             return self.walls
         return self.level_walls[min(max(t.level, 0), len(self.level_walls) - 1)]
 
@@ -660,7 +660,7 @@ class World:
         level whose region lies within the climb of its height."""
         ws = self.walls_of(t)
         cand = ws.near(t.x, t.z, t.spec.radius + slack)
-        if self.ground is not None and self.level_walls:
+        if self.level_walls:
             ys = self._wall_y[min(max(t.level, 0), len(self._wall_y) - 1)]
             tol = self.ground.climb + t.spec.height
             cand = [k for k in cand if ys[k][0] - tol <= t.y <= ys[k][1] + tol]
@@ -672,8 +672,6 @@ class World:
         network peer's state, a test): the nearest level to where it was keeps it on
         its deck or under it."""
         g = self.ground
-        if g is None:
-            return
         lv = g.near_level(t.x, t.z, y) if y is not None else g.locate(t.x, t.z)
         if lv < 0:
             lv = g.locate(t.x, t.z, y)
@@ -684,60 +682,10 @@ class World:
         bx0, bz0, bx1, bz1 = t.spec.box
         t.y, t.pitch, t.roll = self.ground.tilt(t.x, t.z, t.level, t.c, t.s, 0.5 * (bx1 - bx0), 0.5 * (bz1 - bz0))
 
-    def _contain(self, before: list[tuple[float, float]]) -> None:
-        """After the collision pushes: a push that would carry a tank's centre off the
-        walkable surface keeps only its part along the surface (containment wins over
-        the push, as a wall would), and a moved tank stands at its new place."""
-        for t, (x0, z0) in zip(self.tanks, before):
-            if not t.alive or (t.x == x0 and t.z == z0):
-                continue
-            dx, dz = t.x - x0, t.z - z0
-            t.x, t.z = x0, z0
-            dx, dz = self._keep_on_ground(t, dx, dz)
-            t.x += dx
-            t.z += dz
-            self._tilt(t)
-
-    def _keep_on_ground(self, t: Tank, dx: float, dz: float) -> tuple[float, float]:
-        """The part of a move (dx, dz) that keeps the tank's centre on the walkable
-        surface: into a cell its node links to (the tank's level follows the link), else
-        along one axis only (sliding along the edge), else not at all; velocity into a
-        refused direction is taken away."""
-        g = self.ground
-        i0, j0 = g.cell_of(t.x, t.z)
-        i1, j1 = g.cell_of(t.x + dx, t.z + dz)
-        if (i0, j0) == (i1, j1):
-            return dx, dz
-        lv = g.follow(t.level, i0, j0, i1, j1)
-        if lv >= 0:
-            t.level = lv
-            return dx, dz
-        if g.node_height(t.level, i0, j0) is None:
-            # off the surface already (placed there by hand, a spawn on its edge): any
-            # move onto a node near its height is a way back, others are refused
-            lv = g.locate(t.x + dx, t.z + dz, t.y)
-            hv = g.node_height(lv, i1, j1) if lv >= 0 else None
-            if hv is not None and abs(hv - t.y) <= g.climb:
-                t.level = lv
-                return dx, dz
-        # refused: slide along whichever axis is still open
-        for keep_x in (abs(dx) >= abs(dz), abs(dx) < abs(dz)):
-            ii, jj = g.cell_of(t.x + (dx if keep_x else 0.0), t.z + (0.0 if keep_x else dz))
-            lv = g.follow(t.level, i0, j0, ii, jj)
-            if lv >= 0:
-                t.level = lv
-                if keep_x:
-                    t.vz = 0.0
-                    return dx, 0.0
-                t.vx = 0.0
-                return 0.0, dz
-        t.vx = t.vz = 0.0
-        return 0.0, 0.0
-
     def _spawn_eye(self, k: int) -> float | None:
         """Eye height at spawn point ``k`` (None on a flat arena or with no height)."""
         y = self.spawn_y[k]
-        return None if self.ground is None or y is None else y + EYE
+        return None if not self.ground.relief or y is None else y + EYE
 
     def _watchers(self, k: int, tanks: Sequence[Tank]) -> int:
         """How many of ``tanks`` have a line of sight to spawn point ``k``."""

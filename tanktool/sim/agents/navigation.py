@@ -61,7 +61,7 @@ def agent_grid(world: "World", cell: float, clearance: float) -> NavGrid:
     the tank), the grid is made again with less (``FALLBACK``), down to every node off
     the walls: its ``clearance`` says which it kept.  Agents then plan as close to the
     walls as they must; the physics keeps them out."""
-    per = _GRIDS.setdefault(world.ground if world.ground is not None else world.walls, {})
+    per = _GRIDS.setdefault(world.ground if world.ground.relief else world.walls, {})
     key = (float(cell), float(clearance))
     if key not in per:
         grid = None
@@ -74,7 +74,7 @@ def agent_grid(world: "World", cell: float, clearance: float) -> NavGrid:
 
 
 def _make_grid(world: "World", cell: float, clearance: float) -> NavGrid:
-    if world.ground is not None:
+    if world.ground.relief:  # a flat ground: the 2002 grid of the walls
         from .layers import ground_agent_grid
 
         spawns = [(x, z, y) for (x, z, _), y in zip(world.spawns, world.spawn_y)]

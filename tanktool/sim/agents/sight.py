@@ -205,7 +205,7 @@ def views_for(world: "World", grid: NavGrid) -> Views:
     if v is None:
         if len(_VIEWS) >= 8:
             _VIEWS.pop(next(iter(_VIEWS)))
-        solids = world.ground.solids if grid.layers is not None and world.ground is not None else None
+        solids = world.ground.solids if grid.layers is not None else None
         v = _VIEWS[key] = Views(grid, seg, max_blocks=VIEW_BLOCKS if solids is not None else 700, solids=solids)
     return v
 

@@ -35,7 +35,7 @@ MARGIN = 0.5
 
 class Map:
     """The static arena for a tank of footprint radius ``radius`` (see the module
-    docstring).  ``ground`` is the arena's ``sim.ground.Ground`` (None on a flat
+    docstring).  ``ground`` is the arena's ``sim.ground.Ground`` (a ``FlatGround``, no model, on a flat
     arena), ``walls`` its ``WallSet`` and ``level_walls`` one per ground level;
     ``spawns`` are (x, z, heading) and ``spawn_y`` their heights (None: unknown)."""
 
@@ -60,7 +60,7 @@ class Map:
     @property
     def relief(self) -> bool:
         """Whether the arena has a ground with a solid (heights, slopes, levels)."""
-        return self.ground is not None and getattr(self.ground, "mesh", None) is not None
+        return getattr(self.ground, "mesh", None) is not None
 
     # ------------------------------------------------------------------ navigation
     @property
