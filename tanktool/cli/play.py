@@ -47,6 +47,18 @@ def _arena_ref(arena: str | None) -> str:
     return ref
 
 
+def _fresh_arena(arena: str | None) -> None:
+    """No silent fallback: the arena's derived files rebuilt when missing or stale (one
+    line on stderr says so), or an ArenaError naming the command that fixes them."""
+    from ..freshness import ensure_fresh
+    from ..sim.match import arena_dir, default_arena
+
+    ref = arena or default_arena()
+    if ref is None:
+        return
+    ensure_fresh(arena_dir(ref), say=lambda line: click.echo(line, err=True))
+
+
 def _size(text: str) -> tuple[int, int]:
     try:
         w, h = (int(v) for v in text.lower().split("x"))
@@ -132,6 +144,8 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
                     time_limit, score_limit, quality, tuple(bot_specs))
     if bot_specs:
         _check_bots(opts, host is not None or join is not None)
+    if replay_path is None:   # a replay plays what it recorded (its fingerprints say if that changed)
+        _fresh_arena(opts.arena)
     if host is not None or join is not None:
         _play_network(opts, host, join, player_name, password)
         return
