@@ -3,7 +3,7 @@ stale is rebuilt before a match uses it, or refused with the command that fixes 
 
 What a match reads of a bundle -- ``walls.txt``, ``model.glb``, ``navgrid.npz``,
 ``quadtree.npz`` -- must be there and have the sha256 its ``arena.toml`` records in
-``[derived]`` (a bundle import-arena made, one with a ``[source]``, must have its grid:
+``[derived]`` (a bundle import-arena made, one with ``[source]`` and ``[walkable]``, must have its grid:
 without it the match would run as if the arena were flat).  :func:`problems` says
 what is wrong; :func:`ensure_fresh` mends it where it can:
 
@@ -40,13 +40,14 @@ def problems(folder: Path, doc: dict[str, Any]) -> dict[str, str]:
     from .formats.bundle import sha256_file
 
     derived = doc.get("derived") if isinstance(doc.get("derived"), dict) else {}
-    imported = isinstance(doc.get("source"), dict)
+    # a bundle import-arena made: its [source] and the [walkable] surface it found
+    imported = isinstance(doc.get("source"), dict) and isinstance(doc.get("walkable"), dict)
     out: dict[str, str] = {}
     for name in MODEL_FILES + GRID_FILES:
         path = folder / name
         if name not in derived:
             # a hand-made bundle (walls.txt only) has no grid to miss; an imported one must
-            if imported and name in GRID_FILES + ("walls.txt",) and not path.is_file():
+            if imported and name in ("navgrid.npz", "walls.txt") and not path.is_file():
                 out[name] = "missing"
             continue
         if not path.is_file():

@@ -490,6 +490,7 @@ def make_level_cases() -> None:
     write_grid(b, free & ~ring | ((np.abs(x - 31.5) <= 1) & (np.abs(z - 31.5) <= 1)))
     expect(c, "A311", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml", [spawn_line(b / "arena.toml", 7)])
     c, b = case("A312", "low_headroom", headroom=1.0)
+    write_grid(b, free)   # an imported bundle has its grid (a missing one is B202)
     expect(c, "A312", f"arenas/{b.name}", f"arenas/{b.name}/arena.toml", [line_of(b / "arena.toml", "headroom = ")])
     c, b = case("A313", "spawn_on_slope")
     slope = np.where(x > 30, (x - 30) * np.tan(np.radians(28)), 0.0)  # 28 deg east of x = 30, under spawn 1

@@ -122,10 +122,11 @@ def check_arena(bundle: Path, vehicles: list[VehicleSize], model_rules: bool = T
         return out, info
     name = man.get("", "name")
     info.name = name if isinstance(name, str) and name else bundle.name
-    # an imported bundle (one with a [source]) plays on its grid: without it a match would
-    # run as if the arena were flat (issue 25), so a missing grid is an error, as in play
-    imported = isinstance(man.table("source"), dict)
-    out += file_rules(man, bundle, ("walls.txt",) + (("navgrid.npz", "quadtree.npz") if imported else ()))
+    # a bundle import-arena made (its [source] and the [walkable] surface it found) plays
+    # on its grid: without it a match would run as if the arena were flat (issue 25), so
+    # a missing grid is an error, as in play (tanktool/freshness.py)
+    imported = isinstance(man.table("source"), dict) and isinstance(man.table("walkable"), dict)
+    out += file_rules(man, bundle, ("walls.txt",) + (("navgrid.npz",) if imported else ()))
 
     spawns4, spawn_lines, info.ids = _spawns(man, out)
     spawns, spawn_y = spawns4[:, :3], spawns4[:, 3]
