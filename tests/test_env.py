@@ -114,3 +114,14 @@ def test_the_feelers_agree_with_the_walls_first_hit():
                     hit = walls.first_hit(x, z, x + FEELER * fx, z + FEELER * fz)
                     want.append(1.0 if hit is None else max(hit[0], 0.0))
                 assert feelers(walls, x, z, c, s) == pytest.approx(want, abs=1e-9)
+
+
+def test_gymnasium_make_finds_it():
+    import gymnasium
+
+    env_id = te.register()
+    env = gymnasium.make(env_id, opponents=["novice"], seconds=2.0)
+    check_env(env.unwrapped, skip_render_check=True)
+    obs, _ = env.reset(seed=1)
+    assert obs.shape == (te.SIZE,)
+    env.close()

@@ -29,6 +29,17 @@ def parallel_env(*args: Any, **kwargs: Any) -> Any:
     return make(*args, **kwargs)
 
 
+def register() -> str:
+    """Register ``tanktool/Tank-v0`` with Gymnasium (``gymnasium.make``); its id."""
+    try:
+        from .single import ENV_ID
+    except ImportError as e:
+        from ..errors import TanktoolError
+
+        raise TanktoolError(f"{_NEED} ({e})") from None
+    return ENV_ID
+
+
 def __getattr__(name: str) -> Any:
     if name in ("TankEnv", "TankParallelEnv"):
         try:
@@ -41,5 +52,5 @@ def __getattr__(name: str) -> Any:
     raise AttributeError(name)
 
 
-__all__ = ["EnvConfig", "Episode", "FIELDS", "RewardWeights", "SIZE", "TankEnv", "TankParallelEnv",
+__all__ = ["register", "EnvConfig", "Episode", "FIELDS", "RewardWeights", "SIZE", "TankEnv", "TankParallelEnv",
            "command_of", "observe", "parallel_env"]

@@ -41,3 +41,9 @@ class TankEnv(gym.Env):
             raise RuntimeError("step() before reset()")
         rewards, terminated, truncated = ep.step([action])
         return ep.observe(0), float(rewards[0]), terminated, truncated and not terminated, ep.info(0)
+
+
+#: ``gymnasium.make("tanktool/Tank-v0", arena="hills", opponents=["hard"])`` (after ``import tanktool.env``)
+ENV_ID = "tanktool/Tank-v0"
+if ENV_ID not in gym.registry:
+    gym.register(id=ENV_ID, entry_point="tanktool.env.single:TankEnv")
