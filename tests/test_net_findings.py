@@ -304,3 +304,33 @@ def test_a_second_ctrl_c_while_the_host_shuts_down_still_writes_the_report(tmp_p
     report = run_network("127.0.0.1:0", None, "solo", None, "box", None, 30.0, 0, out, echo, bots=0)
     assert out.exists() and report["seconds"] < 10
     assert any(line.startswith("report:") for line in lines)
+
+
+# ---------------------------------------------------------------- finding 8
+def test_a_members_flood_is_dropped_before_decoding_and_honest_states_pass(peers, monkeypatch):
+    """A member sends 600 valid-looking states at once (21,000 a second in the attack);
+    the host drops all but its burst unread (no tag check, no decode), and takes every
+    state of the honest member sent meanwhile."""
+    from tanktool.net import peer as peer_mod
+
+    _session(peers, 3)
+    host, honest, flooder = peers
+    decoded = Counter()
+    real_decode = P.decode
+
+    def counting(data, counter=None):
+        decoded[data[4]] += 1                    # the sender byte
+        return real_decode(data, counter)
+
+    monkeypatch.setattr(peer_mod.P, "decode", counting)
+    t = flooder.session_time()
+    for k in range(600):
+        flooder.send_state(P.State(flooder.number, t + k * 1e-4, 5.0, 5.0, 0, 0, 0, 0, 100, True))
+        if k % 100 == 0:
+            honest.send_state(P.State(honest.number, t + k * 1e-4, 7.0, 7.0, 0, 0, 0, 0, 100, True))
+    events = []
+    for _ in range(20):
+        events += [(1, e) for e in host.poll(0.005)]
+    assert states_from(events, 1, honest.number) == 6
+    assert host.dropped["flood"] >= 600 - 2 * peer_mod.UDP_BURST
+    assert decoded[flooder.number] <= 2 * peer_mod.UDP_BURST

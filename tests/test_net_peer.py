@@ -119,7 +119,10 @@ def test_impostor_state_and_events_ignored(peers):
     events = pump(peers, 0.2)
     assert not [e for _, e in events if e.kind == "state" and e.body.x == 999.0]
     assert not [e for _, e in events if e.kind in ("hit", "shot")]
-    assert peers[0].dropped["impostor"] >= 3 and peers[1].dropped["impostor"] >= 1
+    # (player 3's datagram: an impostor, or dropped unread when the pump above used up
+    # its address's budget; its HIT: only the host decides hits)
+    host = peers[0].dropped
+    assert host["impostor"] + host["flood"] >= 2 and host["not_host"] >= 1 and peers[1].dropped["impostor"] >= 1
     # a forged HELLO for a number that is already linked is refused
     s = socket.create_connection(peers[0].tcp_address, timeout=2)
     try:

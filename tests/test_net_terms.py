@@ -8,7 +8,7 @@ from __future__ import annotations
 import threading
 import time
 
-from net_helpers import LOOPBACK, join, peers, pump  # noqa: F401 (peers: the fixture)
+from net_helpers import LOOPBACK, join, peers, play, pump  # noqa: F401 (peers: the fixture)
 
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer
@@ -25,7 +25,7 @@ def _frozen_host_session(peers):
     pump(peers, 0.1)
     assert host.term == 1 and all(p.term == 1 for p in peers)
     # the host freezes (SIGSTOP): only the members go on
-    pump(peers[1:], 1.5, states=True)
+    play(peers[1:], 1.5)
     return host, peers[1], peers[2]
 
 
@@ -34,7 +34,7 @@ def test_a_frozen_host_steps_down_and_rejoins_without_duplicate_bots(peers):
     assert a.is_host and a.number == 3 and a.term == 2 and b.term == 2
     assert a.table[2].owner == 3                           # the new host adopted the bot
     # SIGCONT: the old host reads its closed links, finds itself alone, probes
-    events = pump(peers, 1.0, states=True)
+    events = play(peers, 1.0)
     steps = [e for who, e in events if who == 1 and e.kind == "stepdown"]
     assert steps and "term 2" in steps[0].reason, [e for who, e in events if who == 1]
     # the stale host sends a joiner on to the newer session
@@ -45,9 +45,9 @@ def test_a_frozen_host_steps_down_and_rejoins_without_duplicate_bots(peers):
     th.start()
     end = time.monotonic() + 8
     while th.is_alive() and time.monotonic() < end:
-        pump(peers[1:], 0.01, states=True)
+        play(peers[1:], 0.01)
     th.join(1)
-    pump(peers, 0.3, states=True)
+    play(peers, 0.3)
     assert host.number not in (0, 1) and host.host_number == 3 and host.term == 2
     for p in peers:
         assert sorted(p.table) == sorted([2, 3, 4, newcomer.number, host.number]), (p.number, p.table)
@@ -119,7 +119,8 @@ def test_a_frozen_host_match_rejoins_and_its_bots_are_not_duplicated(peers):
     runners = [_Runner(hm)]
     try:
         for name in ("p3", "p4"):
-            p = join(peers, host.tcp_address, name, silence=SILENCE, settle=False)
+            # (nobody else polls here: the host's own thread answers the join)
+            p = join([], host.tcp_address, name, silence=SILENCE, settle=False)
             peers.append(p)
             runners.append(_Runner(NetMatch(p, info, spec, seed=1)))
         time.sleep(0.5)

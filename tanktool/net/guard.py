@@ -147,6 +147,10 @@ KINDS = {
     "pending_timeout": "connections closed: said nothing within the handshake deadline",
     "link_failed": "mesh links that could not be opened",
     "send_failed": "datagrams the system would not send",
+    "flood": "datagrams from a member over what its tanks may send (dropped unread)",
+    "stepped_down": "probes that found a newer session (this peer stepped down)",
+    "refused_mismatch": "joins refused: another arena or vehicle (digests differ)",
+    "refused_name": "joins refused: a blank name or one like a player's",
 }
 
 

@@ -70,6 +70,8 @@ LISTEN_BACKLOG = 128
 #: per link / per tank message rates: a tank state at 30 Hz, a few events
 TCP_RATE, TCP_BURST = 100.0, 200.0
 UDP_RATE, UDP_BURST = 90.0, 45.0
+#: datagrams read per poll at most (a poll comes every step, 120 a second)
+UDP_READS = 1024
 #: joins (host): per address a burst that lets a whole LAN party (or a loopback test
 #: session) in at once, then one a second; overall, what many addresses together get
 JOIN_RATE, JOIN_BURST = 1.0, 10.0
@@ -194,6 +196,8 @@ class Peer(TermsMixin):
         #: sockets of kicked players, half-closed, closed after their deadline
         self._linger: list[tuple[socket.socket, float]] = []
         self._init_terms()
+        #: per member address: its datagram budget (rebuilt when the table changes)
+        self.addr_buckets: dict[tuple, Bucket] = {}
         self.password = password or None
         self.clock = clock
         self.silence = silence
@@ -449,6 +453,7 @@ class Peer(TermsMixin):
 
     def _saw(self, e: P.Entry) -> None:
         """Note an entry's epoch and number as used (never given again)."""
+        self.addr_buckets.clear()            # the tanks per address may have changed
         self.max_epoch = max(self.max_epoch, e.epoch)
         self.used_numbers.add(e.number)
         if e.number in self.freed:
@@ -912,6 +917,7 @@ class Peer(TermsMixin):
             old = self.table.get(e.number)
             if old is not None and old.epoch == e.epoch and old.owner != e.owner:
                 self.table[e.number] = e           # a computer opponent changed hands
+                self.addr_buckets.clear()
                 if e.owner == self.number:
                     self.events.append(NetEvent("adopt", e.number, e))
                 continue
@@ -940,7 +946,7 @@ class Peer(TermsMixin):
     def _read_udp(self) -> None:
         assert self.udp is not None
         now = self.clock()
-        for _ in range(256):          # bounded: a flood cannot starve the game loop
+        for _ in range(UDP_READS):    # bounded: a flood cannot starve the game loop
             try:
                 data, addr = self.udp.recvfrom(2048)
             except (BlockingIOError, InterruptedError):
@@ -950,6 +956,11 @@ class Peer(TermsMixin):
                 return
             self.counters["bytes_received"] += len(data)
             self.dropped.source = addr
+            if not self._udp_budget(addr, now):
+                # a member over what its tanks may send: dropped before any tag or decode,
+                # so its flood costs a dictionary look-up, not the others' states (finding 8)
+                self.dropped["flood"] += 1
+                continue
             if self.password:
                 data = self._unseal(data, addr)
                 if data is None:
@@ -965,6 +976,18 @@ class Peer(TermsMixin):
             if self._on_state(m, now):
                 self.counters["received"] += 1
                 self.last_heard[m.sender] = now
+
+    def _udp_budget(self, addr: tuple, now: float) -> bool:
+        """Whether a datagram from ``addr`` may be read: a member's address gets the
+        per-tank rate times the tanks it runs (the host's includes its computer
+        opponents); an address not in the table is read (and counted) as before."""
+        b = self.addr_buckets.get(addr)
+        if b is None:
+            tanks = sum(1 for e in self.table.values() if (e.ip, e.udp_port) == addr)
+            if tanks == 0:
+                return True
+            b = self.addr_buckets[addr] = Bucket(UDP_RATE * tanks, UDP_BURST * tanks, now)
+        return b.take(now)
 
     def _from_member(self, sender: int, addr: tuple) -> P.Entry | None:
         """The table entry of a datagram's sender if it came from that player's address;
@@ -1081,6 +1104,7 @@ class Peer(TermsMixin):
         """Player ``n`` left (exit, closed link, silence): out of the table; if it was
         the host, the lowest remaining number hosts."""
         e = self.table.pop(n, None)
+        self.addr_buckets.clear()
         link = self.links.get(n)
         if link is not None:
             self._close_link(link)
