@@ -12,7 +12,8 @@
  *       all int64; minh, asmin, asmax updated in place (Recast's rcFilterLedgeSpans)
  *   chamfer(link, dist, limit)
  *       link: int64 (n, 4); dist: int32 (n,), the starting values, relaxed in place
- *   raster_gentle(tri, abc, nz, nx, ch, max_steps) -> (col, tri, smin, smax) as int64 bytes
+ *   raster_gentle(tri, abc, nz, nx, ch, max_steps, row_lo, row_hi) -> (col, tri, smin, smax) as int64 bytes
+ *       (the cells of rows row_lo .. row_hi - 1 only)
  *       tri: float64 (n, 9) x0 x1 x2 z0 z1 z2 y0 y1 y2 in grid units (y in metres);
  *       abc: float64 (n, 3) the plane y = A + B x + C z of each triangle
  *   components(link, label)
@@ -265,7 +266,7 @@ static inline void quantise(double ymin, double ymax, double ch, i64 maxh, i64 *
 /* heightfield._rows and _cells_plane for one gentle triangle (y = A + B x + C z in grid
  * units), the same arithmetic in the same order so that the spans are identical */
 static int raster_one(Cells *out, i64 t, const double *X, const double *Z, const double *Y, double A, double B,
-                      double C, i64 nz, i64 nx, double ch, i64 maxh) {
+                      double C, i64 row_lo, i64 row_hi, i64 nx, double ch, i64 maxh) {
     double z[3] = {Z[0], Z[1], Z[2]}, x[3] = {X[0], X[1], X[2]}, y[3] = {Y[0], Y[1], Y[2]};
     static const int net[3][2] = {{0, 1}, {1, 2}, {0, 1}};  /* _sort3's network */
     for (int k = 0; k < 3; ++k) {
@@ -283,7 +284,7 @@ static int raster_one(Cells *out, i64 t, const double *X, const double *Z, const
     const double inv_bc = zc > zb ? 1.0 / (zc - zb) : 0.0;
     const double r0t = floor(za);
     const double r1t = zc > za ? ceil(zc) - 1 : r0t;
-    const double r0 = maxd(r0t, 0.0), r1 = mind(r1t, (double)(nz - 1));
+    const double r0 = maxd(r0t, (double)row_lo), r1 = mind(r1t, (double)(row_hi - 1));
     const i64 nrow = (i64)maxd(r1 - r0 + 1, 0.0);
     if (nrow <= 0) return 1;
     const int flat_z = za == zc;
@@ -360,9 +361,11 @@ static PyObject *as_bytes(const i64 *a, Py_ssize_t n) {
 
 static PyObject *raster_gentle(PyObject *self, PyObject *args) {
     Py_buffer tri, abc;
-    i64 nz, nx, maxh;
+    i64 nz, nx, maxh, row_lo, row_hi;
     double ch;
-    if (!PyArg_ParseTuple(args, "y*y*LLdL", &tri, &abc, &nz, &nx, &ch, &maxh)) return NULL;
+    if (!PyArg_ParseTuple(args, "y*y*LLdLLL", &tri, &abc, &nz, &nx, &ch, &maxh, &row_lo, &row_hi)) return NULL;
+    if (row_lo < 0) row_lo = 0;
+    if (row_hi > nz) row_hi = nz;
     const Py_ssize_t n = tri.len / (9 * 8);
     PyObject *ret = NULL;
     Cells out = {0};
@@ -373,7 +376,8 @@ static PyObject *raster_gentle(PyObject *self, PyObject *args) {
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t t = 0; t < n && ok; ++t) {
             const double *v = T + 9 * t; /* x0 x1 x2 z0 z1 z2 y0 y1 y2 */
-            ok = raster_one(&out, t, v, v + 3, v + 6, P[3 * t], P[3 * t + 1], P[3 * t + 2], nz, nx, ch, maxh);
+            ok = raster_one(&out, t, v, v + 3, v + 6, P[3 * t], P[3 * t + 1], P[3 * t + 2], row_lo, row_hi, nx, ch,
+                            maxh);
         }
         Py_END_ALLOW_THREADS
     }

@@ -10,7 +10,7 @@ triangle that gives it its top faces up no steeper than the maximum slope (spans
 whose tops lie within the climb of each other share the flag, as Recast's
 ``flagMergeThr``).
 
-Then Recast's three filters (``rcFilterLowHangingWalkableObstacles``,
+Then Recast's three filters (tanktool/geometry/span_filters.py: ``rcFilterLowHangingWalkableObstacles``,
 ``rcFilterLedgeSpans``, ``rcFilterWalkableLowHeightSpans``):
 
 * a non-walkable span whose top is within the climb of the walkable span below it in
@@ -36,10 +36,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ArenaError
-from .kernels import active, i64
+from .kernels import active
+from .span_filters import OPEN, _next_in_column, column_starts, filter_spans, neighbour_columns  # noqa: F401
 
-#: tops of columns with nothing above them (Recast's 0xffff in its filters)
-OPEN = 1 << 15
 #: refuse heightfields larger than this (columns) or spans beyond this many cells high
 MAX_COLUMNS = 40_000_000
 MAX_HEIGHT_STEPS = (1 << 15) - 1
@@ -93,14 +92,6 @@ def _ramp(cnt: np.ndarray) -> np.ndarray:
     """0, 1, .., cnt[0]-1, 0, 1, .., cnt[1]-1, ...: positions inside repeated blocks."""
     total = int(cnt.sum())
     return np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-
-
-def _next_in_column(col: np.ndarray, values: np.ndarray, fill: int) -> np.ndarray:
-    """values[k + 1] where span k + 1 is in the same column as span k, else ``fill``."""
-    out = np.full(len(col), fill, dtype=values.dtype)
-    same = col[1:] == col[:-1]
-    out[:-1][same] = values[1:][same]
-    return out
 
 
 def grid_for(vertices: np.ndarray, cs: float, origin_xz=None, shape=None) -> tuple[np.ndarray, tuple[int, int]]:
@@ -258,7 +249,7 @@ def _sort3(Z: list, *others: list) -> tuple[list, ...]:
     return tuple(arrs)
 
 
-def _rows(X: list, Z: list, Y: list, nz: int, nx: int) -> _Rows:
+def _rows(X: list, Z: list, Y: list, nz: int, nx: int, rows: tuple[int, int] | None = None) -> _Rows:
     """(triangle, row) pairs and their polygons Q (see :class:`_Rows`).
 
     Per triangle the vertices a, b, c by z; per z line strictly inside a triangle its
@@ -274,8 +265,9 @@ def _rows(X: list, Z: list, Y: list, nz: int, nx: int) -> _Rows:
     # the triangle's own rows [r0t, r1t], and the part of them on the grid [r0, r1]
     r0t = np.floor(za)
     r1t = np.where(zc > za, np.ceil(zc) - 1, r0t)
-    r0 = np.maximum(r0t, 0)
-    r1 = np.minimum(r1t, nz - 1)
+    lo_row, hi_row = rows if rows is not None else (0, nz)
+    r0 = np.maximum(r0t, lo_row)
+    r1 = np.minimum(r1t, hi_row - 1)
     nrow = np.maximum(r1 - r0 + 1, 0).astype(np.int64)
     # sections at the lines r0 .. r1 + 1 of each triangle (those past its ends unused)
     nline = np.where(nrow > 0, nrow + 1, 0)
@@ -438,8 +430,10 @@ GENTLE_NY = 0.5
 
 
 def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, walkable: np.ndarray,
-              flat: np.ndarray, origin: np.ndarray, shape: tuple[int, int], merge_steps: int):
-    """Spans of every (triangle, cell) pair, merged per column.
+              flat: np.ndarray, origin: np.ndarray, shape: tuple[int, int], merge_steps: int,
+              rows: tuple[int, int] | None = None):
+    """Spans of every (triangle, cell) pair, merged per column (of the rows
+    ``[rows[0], rows[1])`` only when given: the same spans there as the whole build's).
 
     Per (triangle, row) the polygon Q of the triangle inside the row's slab and the
     columns it covers; per (triangle, cell): for gentle triangles the range of their
@@ -482,16 +476,16 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
             if kern is not None:  # the same spans in one pass over the triangles
                 res = kern.raster_gentle(np.ascontiguousarray(np.column_stack(Xg + Zg + Yg)),
                                          np.ascontiguousarray(np.column_stack([A, B, C])), nz, nx, float(ch),
-                                         MAX_HEIGHT_STEPS)
+                                         MAX_HEIGHT_STEPS, *(rows or (0, nz)))
                 c_col, c_tri, smin, smax = (np.frombuffer(b, dtype=np.int64) for b in res)
                 out.append((c_col, group[c_tri], smin, smax))
                 continue
-            rows = _rows(Xg, Zg, Yg, nz, nx)
-            p, j, smin, smax = _cells_plane(rows, A, B, C, ch)
+            pairs = _rows(Xg, Zg, Yg, nz, nx, rows)
+            p, j, smin, smax = _cells_plane(pairs, A, B, C, ch)
         else:
-            rows = _rows(Xg, Zg, Yg, nz, nx)
-            p, j, smin, smax = _cells_exact(rows, Xg, Zg, Yg, ch)
-        out.append((rows.row[p] * nx + j, group[rows.tri[p]], smin, smax))
+            pairs = _rows(Xg, Zg, Yg, nz, nx, rows)
+            p, j, smin, smax = _cells_exact(pairs, Xg, Zg, Yg, ch)
+        out.append((pairs.row[p] * nx + j, group[pairs.tri[p]], smin, smax))
     if not out:
         return _merge(*(np.zeros(0, dtype=np.int64) for _ in range(5)), merge_steps), 0
     col, t_of_cell, smin, smax = (np.concatenate(v) for v in zip(*out))
@@ -544,111 +538,19 @@ def _merge(col, smin, smax, walk, flat, thr):
             any_in_group(walk & at_top))
 
 
-def column_starts(col: np.ndarray, ncols: int) -> np.ndarray:
-    """(ncols + 1,) index of each column's first span in a column-sorted span array."""
-    start = np.zeros(ncols + 1, dtype=np.int64)
-    np.cumsum(np.bincount(col, minlength=ncols), out=start[1:])
-    return start
-
-
-def neighbour_columns(col: np.ndarray, shape: tuple[int, int]) -> list[np.ndarray]:
-    """For each of +x, +z, -x, -z: the neighbour column of each span, -1 off the grid."""
-    nz, nx = shape
-    i, j = np.divmod(col, nx)
-    out = []
-    for di, dj in ((0, 1), (1, 0), (0, -1), (-1, 0)):
-        ii, jj = i + di, j + dj
-        ok = (ii >= 0) & (ii < nz) & (jj >= 0) & (jj < nx)
-        out.append(np.where(ok, ii * nx + jj, -1))
-    return out
-
-
-def filter_spans(hf_col, smin, smax, walk, shape, headroom: int, climb: int):
-    """Recast's three filters (see the module docstring); returns the new walkable flags
-    and how many spans each filter took away."""
-    ceil = _next_in_column(hf_col, smin, OPEN)
-    # 1. low hanging obstacles: walkable from the span below (its flag before this pass)
-    w = walk.copy()
-    below_walk = np.zeros(len(w), dtype=bool)
-    below_top = np.zeros(len(w), dtype=np.int64)
-    same = hf_col[1:] == hf_col[:-1]
-    below_walk[1:] = walk[:-1] & same
-    below_top[1:] = smax[:-1]
-    w |= ~walk & below_walk & (np.abs(smax - below_top) <= climb)
-    lifted = int((w & ~walk).sum())
-    # 2. ledges and steep spans: each walkable span against every floor of each
-    # neighbour column (_ledge_scan)
-    s_idx = np.flatnonzero(w)
-    minh, asmin, asmax = _ledge_scan(hf_col, smin, smax, ceil, s_idx, shape, headroom, climb)
-    ledge = minh < -climb
-    steep = ~ledge & ((asmax - asmin) > climb)
-    w2 = w.copy()
-    w2[s_idx[ledge | steep]] = False
-    # 3. too little headroom
-    low = w2 & ((ceil - smax) <= headroom)
-    w3 = w2 & ~low
-    counts = {"lifted": lifted, "ledge": int(ledge.sum()), "steep": int(steep.sum()), "low": int(low.sum())}
-    return w3, counts, low
-
-
-def _ledge_scan(hf_col, smin, smax, ceil, s_idx, shape, headroom: int, climb: int):
-    """For each span ``s_idx``: the lowest reachable neighbour floor relative to its own
-    (minh) and the range of the neighbour floors within the climb (asmin, asmax), over
-    every floor of each neighbour column, the empty space below a column's first span
-    counting as a floor at -climb (a drop to the bottom of the world).  The compiled
-    kernel when built (one pass), else numpy, neighbour spans visited k-th by k-th (the
-    k-th pass only sees columns with more than k spans: few beyond two)."""
-    nz, nx = shape
-    start = column_starts(hf_col, nz * nx)
-    bot = smax[s_idx]
-    top = ceil[s_idx]
-    minh = np.full(len(s_idx), OPEN, dtype=np.int64)
-    asmin = bot.astype(np.int64)
-    asmax = bot.astype(np.int64)
-    kern = active()
-    if kern is not None:
-        kern.ledge_scan(i64(hf_col[s_idx]), i64(bot), i64(top), i64(start), i64(smin), i64(smax), i64(ceil), nz, nx,
-                     int(headroom), int(climb), minh, asmin, asmax)
-        return minh, asmin, asmax
-    count = np.diff(start)
-    for ncol in neighbour_columns(hf_col[s_idx], shape):
-        off = ncol < 0
-        minh[off] = np.minimum(minh[off], -climb - bot[off])
-        nc = np.where(off, 0, ncol)
-        cnt = np.where(off, 0, count[nc])
-        first = start[nc]
-        # the virtual floor below the first span (or open sky over an empty column)
-        ntop = np.where(cnt > 0, smin[np.minimum(first, len(smin) - 1)], OPEN)
-        sel = ~off & (np.minimum(top, ntop) - np.maximum(bot, -climb) > headroom)
-        minh[sel] = np.minimum(minh[sel], -climb - bot[sel])
-        idx = np.arange(len(s_idx))
-        k = 0
-        while len(idx):
-            idx = idx[cnt[idx] > k]
-            if not len(idx):
-                break
-            kk = first[idx] + k
-            nbot, ntop = smax[kk], ceil[kk]
-            b = bot[idx]
-            ok = np.minimum(top[idx], ntop) - np.maximum(b, nbot) > headroom
-            i_ok = idx[ok]
-            nb = nbot[ok]
-            minh[i_ok] = np.minimum(minh[i_ok], nb - b[ok])
-            near = np.abs(nb - b[ok]) <= climb
-            i_n = i_ok[near]
-            asmin[i_n] = np.minimum(asmin[i_n], nb[near])
-            asmax[i_n] = np.maximum(asmax[i_n], nb[near])
-            k += 1
-    return minh, asmin, asmax
-
-
 def build_heightfield(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, max_slope: float,
-                      headroom: float, climb: float, origin_xz=None, shape=None) -> Heightfield:
+                      headroom: float, climb: float, origin_xz=None, shape=None, band_rows: int | None = None,
+                      workers: int | None = None) -> Heightfield:
     """Rasterise, merge and filter (see the module docstring).
 
     ``headroom`` and ``climb`` in metres become ``ceil(headroom / ch)`` and
-    ``floor(climb / ch)`` steps, as in Recast.
+    ``floor(climb / ch)`` steps, as in Recast.  A grid of more than TILE_COLUMNS
+    columns (or any grid, given ``band_rows``) is built in bands of rows on
+    ``workers`` processes (default: every core), with the same result
+    (tanktool/geometry/tiles.py).
     """
+    from .tiles import TILE_COLUMNS, build_tiled
+
     vertices = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces, dtype=np.int64)
     origin, shape = grid_for(vertices, cs, origin_xz, shape)
@@ -658,6 +560,11 @@ def build_heightfield(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: fl
     walk_f, flat_f = walkable_faces(vertices, faces, max_slope)
     climb_steps = int(math.floor(climb / ch + 1e-9))
     head_steps = int(math.ceil(headroom / ch - 1e-9))
+    if band_rows is not None or shape[0] * shape[1] > TILE_COLUMNS:
+        (col, smin, smax, walk2, flat, top_walk, low), counts = build_tiled(
+            vertices, faces, cs, ch, walk_f, flat_f, origin, shape, head_steps, climb_steps, band_rows, workers)
+        counts["walkable_faces"] = int(walk_f.sum())
+        return Heightfield(origin, float(cs), float(ch), shape, col, smin, smax, walk2, flat, top_walk, counts, low)
     (col, smin, smax, walk, flat, top_walk), pairs = rasterize(vertices, faces, cs, ch, walk_f, flat_f, origin, shape,
                                                                climb_steps)
     walk2, counts, low = filter_spans(col, smin, smax, walk, shape, head_steps, climb_steps)

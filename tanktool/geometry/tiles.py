@@ -1,0 +1,129 @@
+"""Large heightfields built in tiles, on every core, with the same result.
+
+A tile is a band of grid rows (all the columns).  Its spans are rasterised from the
+triangles that reach it, at the grid's own coordinates (the same arithmetic as the
+whole build: a column's spans depend only on the triangles over it), merged, and
+filtered with one row more on each side: Recast's filters look at a span's own column
+and its four neighbours only, so the band's inner rows come out exactly as in the
+whole build (the border rows are rasterised again by the next band and dropped here).
+Bands are concatenated in order, which keeps the spans sorted by column.
+
+Bands run in worker processes (forked: the model is shared, not copied) when there
+are several cores and enough of them; the work in flight -- the (triangle, cell)
+pieces, the keys sorted for merging -- is one band per worker, not the whole level.
+
+    hf = build_heightfield(vertices, faces, 0.5, 0.1, 35, 2.35, 0.9)   # tiles by itself when large
+    hf = build_heightfield_tiled(vertices, faces, 0.5, 0.1, 35, 2.35, 0.9, band_rows=256, workers=2)
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any
+
+import numpy as np
+
+from .span_filters import filter_masks
+
+#: levels with more columns than this are built in bands (by build_heightfield)
+TILE_COLUMNS = 2_000_000
+#: columns a band holds, about (its rows: this over the grid's width)
+BAND_COLUMNS = 1_000_000
+
+#: the level a forked worker reads (set before the pool starts; fork shares it)
+_JOB: dict[str, Any] = {}
+
+
+def bands(nz: int, nx: int, band_rows: int | None = None) -> list[tuple[int, int]]:
+    """[first, last) rows of each band."""
+    rows = band_rows or max(1, BAND_COLUMNS // max(nx, 1))
+    return [(a, min(a + rows, nz)) for a in range(0, nz, rows)]
+
+
+def _band(lo: int, hi: int) -> tuple:
+    """The spans of rows [lo, hi), filtered, and their counts (see the module docstring)."""
+    from .heightfield import rasterize
+
+    j = _JOB
+    nz, nx = j["shape"]
+    b_lo, b_hi = max(lo - 1, 0), min(hi + 1, nz)
+    # rows [b_lo, lo), [lo, hi), [hi, b_hi) rasterised apart: the pieces of the inner
+    # rows are counted as the whole build counts them
+    parts, pairs = [], 0
+    for a, b in ((b_lo, lo), (lo, hi), (hi, b_hi)):
+        if b <= a:
+            continue
+        tri = j["tri_of_rows"](a, b)
+        spans, n = rasterize(j["vertices"], j["faces"][tri], j["cs"], j["ch"], j["walk_f"][tri], j["flat_f"][tri],
+                             j["origin"], j["shape"], j["climb"], rows=(a, b))
+        parts.append(spans)
+        if a == lo:
+            pairs = n
+    col, smin, smax, walk, flat, top_walk = (np.concatenate(v) for v in zip(*parts))
+    local = col - b_lo * nx  # the band as a grid of its own (its edges off the grid only at the level's)
+    w3, lifted, ledge, steep, low = filter_masks(local, smin, smax, walk, (b_hi - b_lo, nx), j["head"], j["climb"])
+    inner = (col >= lo * nx) & (col < hi * nx)
+    counts = {"pairs": pairs, "spans": int(inner.sum()), "walkable_raw": int((walk & inner).sum()),
+              "lifted": int((lifted & inner).sum()), "ledge": int((ledge & inner).sum()),
+              "steep": int((steep & inner).sum()), "low": int((low & inner).sum())}
+    return (col[inner], smin[inner], smax[inner], w3[inner], flat[inner], top_walk[inner], low[inner]), counts
+
+
+def _triangles_by_row(vertices: np.ndarray, faces: np.ndarray, origin: np.ndarray, cs: float):
+    """A function (first, last) -> the triangles whose z range reaches rows [first, last):
+    triangles sorted by their first row, each band a binary search (a triangle is in a
+    band when its rows overlap it; the rasteriser drops what falls outside)."""
+    gz = (vertices[:, 2] - origin[2]) / cs
+    z = gz[faces]
+    r0 = np.floor(z.min(axis=1))
+    r1 = np.ceil(z.max(axis=1))  # one past the last row, or the row itself for a flat-in-z triangle
+    order = np.argsort(r0, kind="stable")
+    r0s = r0[order]
+    # the widest triangle bounds how far back a band must look
+    reach = float((r1 - r0).max()) if len(r0) else 0.0
+
+    def of_rows(first: int, last: int) -> np.ndarray:
+        a = np.searchsorted(r0s, first - reach - 1, side="left")
+        b = np.searchsorted(r0s, last, side="right")
+        cand = order[a:b]
+        keep = (r1[cand] >= first) & (r0[cand] <= last)
+        return np.sort(cand[keep])
+
+    return of_rows
+
+
+def build_tiled(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, walk_f: np.ndarray,
+                flat_f: np.ndarray, origin: np.ndarray, shape: tuple[int, int], head: int, climb: int,
+                band_rows: int | None = None, workers: int | None = None) -> tuple[tuple, dict]:
+    """The filtered spans of the whole grid, band by band (build_heightfield's arrays
+    and counts, identical to its single pass)."""
+    nz, nx = shape
+    todo = bands(nz, nx, band_rows)
+    _JOB.clear()
+    _JOB.update(vertices=vertices, faces=faces, cs=cs, ch=ch, walk_f=walk_f, flat_f=flat_f, origin=origin,
+                shape=shape, head=head, climb=climb, tri_of_rows=_triangles_by_row(vertices, faces, origin, cs))
+    if workers is None:
+        workers = min(len(todo), os.cpu_count() or 1)
+    try:
+        if workers > 1 and len(todo) > 1 and "fork" in _start_methods():
+            import multiprocessing as mp
+            from concurrent.futures import ProcessPoolExecutor
+
+            with ProcessPoolExecutor(workers, mp_context=mp.get_context("fork")) as pool:
+                results = list(pool.map(_band, *zip(*todo)))
+        else:
+            results = [_band(a, b) for a, b in todo]
+    finally:
+        _JOB.clear()
+    spans = tuple(np.concatenate(v) for v in zip(*(r[0] for r in results)))
+    counts: dict[str, int] = {}
+    for _, c in results:
+        for k, v in c.items():
+            counts[k] = counts.get(k, 0) + v
+    return spans, counts
+
+
+def _start_methods() -> list[str]:
+    import multiprocessing as mp
+
+    return mp.get_all_start_methods()

@@ -1,0 +1,59 @@
+"""Heightfields built in bands of rows (tanktool/geometry/tiles.py) are the whole
+build's, span for span and count for count, with or without the compiled kernels,
+in this process or on worker processes."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tanktool.geometry.heightfield import build_heightfield
+from tanktool.geometry.kernels import available, use_kernels
+from tanktool.geometry.tiles import bands
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+
+KEYS = ("col", "smin", "smax", "walkable", "flat", "top_walkable", "low_headroom")
+
+
+def _same(a, b):
+    assert a.shape == b.shape and a.counts == b.counts
+    for key in KEYS:
+        assert np.array_equal(getattr(a, key), getattr(b, key)), key
+
+
+def _mesh(name):
+    import make_levels
+    import trimesh
+
+    if name == "dungeon":
+        m = trimesh.load(ROOT / "tests" / "data" / "arenas_obj" / "dungeon.obj", force="mesh", process=False)
+    else:
+        m = make_levels.level(name)
+    return np.asarray(m.vertices, np.float64), np.asarray(m.faces, np.int64)
+
+
+@pytest.mark.parametrize("kernels", [True, False] if available() else [False], ids=["compiled", "numpy"][:2])
+@pytest.mark.parametrize("name", ["dungeon", "two_storeys", "rolling_terrain"])
+def test_bands_give_the_whole_build(name, kernels):
+    V, F = _mesh(name)
+    with use_kernels(kernels):
+        whole = build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9)
+        for rows in (1, 7, 64):  # one-row bands: every band all border
+            _same(build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9, band_rows=rows, workers=1), whole)
+    assert whole.walkable.sum() > 1000 and whole.counts["ledge"] > 0
+
+
+def test_bands_on_worker_processes_give_the_whole_build():
+    V, F = _mesh("dungeon")
+    whole = build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9)
+    _same(build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9, band_rows=40, workers=2), whole)
+
+
+def test_bands_cover_the_rows_once():
+    assert bands(10, 5, 4) == [(0, 4), (4, 8), (8, 10)]
+    assert bands(3, 2_000_000) == [(0, 1), (1, 2), (2, 3)]
