@@ -16,7 +16,7 @@ ever reading where an enemy is.
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -192,7 +192,7 @@ class Views:
         return np.asarray(dist)
 
 
-_VIEWS: dict[tuple, Views] = {}
+_VIEWS: dict[tuple, tuple[Any, Views]] = {}
 
 
 def views_for(world: "World", grid: NavGrid) -> Views:
@@ -201,12 +201,16 @@ def views_for(world: "World", grid: NavGrid) -> Views:
     valid = grid.layers.valid if grid.layers is not None else grid.valid
     key = (hash(seg.tobytes()), hash(np.asarray(valid).tobytes()), float(grid.cell),
            tuple(np.asarray(grid.origin, dtype=np.float64).tolist()), id(world.ground))
-    v = _VIEWS.get(key)
-    if v is None:
-        if len(_VIEWS) >= 8:
-            _VIEWS.pop(next(iter(_VIEWS)))
-        solids = world.ground.solids if grid.layers is not None else None
-        v = _VIEWS[key] = Views(grid, seg, max_blocks=VIEW_BLOCKS if solids is not None else 700, solids=solids)
+    hit = _VIEWS.get(key)
+    # the entry holds the ground it was made for: while it is cached its id() cannot
+    # be reused by another world's ground (a later match in the same process)
+    if hit is not None and hit[0] is world.ground:
+        return hit[1]
+    if len(_VIEWS) >= 8:
+        _VIEWS.pop(next(iter(_VIEWS)))
+    solids = world.ground.solids if grid.layers is not None else None
+    v = Views(grid, seg, max_blocks=VIEW_BLOCKS if solids is not None else 700, solids=solids)
+    _VIEWS[key] = (world.ground, v)
     return v
 
 
