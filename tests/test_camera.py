@@ -1,8 +1,10 @@
-"""The chase camera keeps the followed tank in view (game/camera.py): on the hills and
-through the fort (a ramp to its roof), in every frame of a drive."""
+"""The chase camera keeps the followed tank in view (game/camera.py): in every frame
+of scripted drives across the hills and through the fort (up its ramp, over its roof);
+and its shake."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -32,23 +34,75 @@ def in_frame(session, eye, target) -> float:
     return poly.intersection(box(0, 0, W, H)).area / max(poly.area, 1e-9)
 
 
-@pytest.mark.parametrize("arena, seed, follow, climbs", [("hills", 5, 0, 3.0), ("fort", 3, 1, 2.0)])
-def test_the_chase_camera_keeps_the_tank_in_view(arena, seed, follow, climbs):
-    s = GameSession(arena, bots=3, seed=seed, player=False)
-    s.follow = follow
+def route(points, step=0.25):
+    """(x, z, heading) every ``step`` metres along a polyline: a scripted drive."""
+    out = []
+    for (ax, az), (bx, bz) in zip(points, points[1:]):
+        n = max(int(math.hypot(bx - ax, bz - az) / step), 1)
+        h = math.atan2(bz - az, bx - ax)
+        out += [(ax + (bx - ax) * k / n, az + (bz - az) * k / n, h) for k in range(n)]
+    return out
+
+
+#: across the hills over their tops; from the fort's yard up its ramp and over its roof:
+#: places to drive through, joined by the bots' own paths (sim.bots.map), and the height
+#: the drive must reach
+DRIVES = {
+    "hills": ([(15.0, 15.0), (41.0, 38.0), (100.0, 40.0), (60.0, 100.0), (20.0, 60.0)], 5.5),
+    "fort": ([(10.0, 90.0), (71.0, 63.0), (60.0, 35.0)], 4.9),
+}
+
+
+def drive(session, places):
+    """A scripted drive through ``places`` along the navigation grid's paths, as
+    (x, z, heading) every quarter metre."""
+    from tanktool.sim.bots.map import Map
+
+    me = session.world.tanks[0]
+    m = Map.of(session.world, me.spec.radius)
+    points = [places[0]]
+    for goal in places[1:]:
+        here = points[-1]
+        points += [(p[0], p[1]) for p in m.path((here[0], here[1]), goal)] or [goal]
+    return route(points)
+
+
+@pytest.mark.parametrize("arena", sorted(DRIVES))
+def test_the_chase_camera_keeps_the_tank_in_view(arena):
+    points, climbs = DRIVES[arena]
+    s = GameSession(arena, bots=1, seed=1, player=True)
+    w = s.world
+    me = w.tanks[0]
+    w.tanks[1].alive = False
     mesh = arena_mesh(load_model(str(Path(s.info.path) / "model.glb")))
     cam = Camera(mesh)
-    me = s.world.tanks[follow]
     shares, hidden, top = [], 0, 0.0
-    for k in range(120 * 45):
-        s.step()
+    me.place(*points[0], 0.0)
+    s.step()
+    for x, z, heading in drive(s, points):
+        me.place(x, z, heading)                         # 0.25 m a step: 30 m/s at 120 steps a second
+        s.step()                                        # the simulation sets the height and tilt
         top = max(top, me.y)
-        if k % 4:
-            continue                                    # 30 frames a second
         eye, target = cam.pose(s, 1.0, "chase")
         shares.append(in_frame(s, eye, target))
         centre = (me.x, me.y + 0.6 * me.spec.height, me.z)
         hidden += mesh.first_hit(tuple(eye), centre) is not None
-    assert top >= climbs and me.distance > 60.0         # the drive went up the slopes / the ramp
-    assert min(shares) >= 0.8, (np.argmin(shares), min(shares))
+    assert top >= climbs                                # the drive went up the hills / onto the roof
+    assert min(shares) >= 0.8, (int(np.argmin(shares)), min(shares))
     assert hidden == 0
+
+
+def test_the_camera_shakes_when_firing_or_hit_then_settles():
+    from tanktool.game.camera import SHAKE_S, shake
+    from tanktool.game.session import Effect
+
+    s = GameSession("box", bots=1, seed=1, player=True)
+    assert not shake(s, 0, s.t).any()
+    s.effects.append(Effect("flash", 10.0, 1.5, 10.0, s.t, heading=0.0, tank=0))
+    fired = max(np.linalg.norm(shake(s, 0, s.t + k / 240)) for k in range(1, 20))
+    assert 0.02 < fired <= 0.11
+    s.effects.append(Effect("impact", 10.0, 1.5, 10.0, s.t, tank=0))
+    hit = max(np.linalg.norm(shake(s, 0, s.t + k / 240)) for k in range(1, 20))
+    assert hit > 2 * fired
+    assert not shake(s, 0, s.t + SHAKE_S + 0.01).any()      # short: gone after SHAKE_S
+    assert not shake(s, 1, s.t + 0.01).any()                # the other tank's camera does not shake

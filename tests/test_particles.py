@@ -60,13 +60,25 @@ def test_session_effects_become_bursts_dust_and_smoke():
     assert len(fx.particles) == n                         # an effect bursts once
     t = s.world.tanks[0]
     t.vx, t.vz = 10.0, 0.0                                # moving: dust behind the tracks
-    s.world.tanks[1].alive = False                        # a wreck: smoke
-    before = len(fx.particles)
+    wreck = s.world.tanks[1]
+    wreck.alive = False                                   # a wreck: smoke and flames
+    fx.sync(s)
     s.world.t += 0.5
     fx.sync(s)
-    assert len(fx.particles) > before - 10                # new dust and smoke (some old ones died)
-    dusty = fx.particles.pos[-20:]
-    assert np.isfinite(dusty).all()
+    p = fx.particles
+    assert np.isfinite(p.pos).all()
+    young = p.age <= 0.51
+    near_wreck = young & (np.hypot(p.pos[:, 0] - wreck.x, p.pos[:, 2] - wreck.z) < 4.0)
+    assert (near_wreck & (p.glow > 0.5)).sum() >= 5       # it burns
+    assert (near_wreck & (p.glow < 0.5)).sum() >= 2       # and smokes
+    behind = young & (np.hypot(p.pos[:, 0] - t.x, p.pos[:, 2] - t.z) < 6.0) & (p.glow < 0.5)
+    assert behind.sum() >= 3                              # dust behind the tracks
+    for _ in range(20):                                   # 10 s on: the fire is out, the smoke goes on
+        s.world.t += 0.5
+        fx.sync(s)
+    young = p.age <= 0.51
+    near_wreck = young & (np.hypot(p.pos[:, 0] - wreck.x, p.pos[:, 2] - wreck.z) < 4.0)
+    assert (near_wreck & (p.glow > 0.5)).sum() == 0 and (near_wreck & (p.glow < 0.5)).sum() >= 2
 
 
 def test_a_shell_stopped_by_a_wall_ricochets():

@@ -152,16 +152,48 @@ def slope_shot(only: list[str] | None) -> None:
         r.release()
 
 
+def explosion_shot(only: list[str] | None) -> None:
+    """A kill seen by the killer's chase camera a quarter second on: the explosion,
+    debris and the burning wreck."""
+    if only and "play-explosion" not in only:
+        return
+    from tanktool.game.hud import save_png, surface_from_rgb
+    from tanktool.game.render3d import Renderer3D
+    from tanktool.game.session import GameSession
+
+    s = GameSession("box", bots=6, seed=1, player=False)
+    r = Renderer3D(s, SIZE)
+    try:
+        seen = 0
+        for _ in range(120 * 120):
+            s.step()
+            kills = [e for e in s.feed if e.kind == "kill"]
+            if len(kills) > seen:                          # a new kill: ride with the killer
+                seen, kill = len(kills), kills[-1]
+                s.follow = kill.tank
+            if seen and 0.28 <= s.t - kill.t < 0.29:
+                r.matrices(1.0)
+                x, y, _ = r.project((kill.x, 1.0, kill.z))
+                if 0.2 * SIZE[0] < x < 0.8 * SIZE[0] and 0.2 * SIZE[1] < y < 0.8 * SIZE[1]:
+                    break                                  # the explosion is in the picture
+            if seen and s.t - kill.t < 0.3:
+                r.render(1.0, fps=0.0)                     # the particles and the camera live on
+        print(save_png(surface_from_rgb(r.render(1.0, fps=0.0)), DOCS / "play-explosion.png"))
+    finally:
+        r.release()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", action="append",
-                    help="arena-box, play-3d, play-top, play-menu, play-settings, play-destroyed, play-controls, play-slope")
+                    help="arena-box, play-3d, play-top, play-menu, play-settings, play-destroyed, play-controls, play-slope, play-explosion")
     args = ap.parse_args(argv)
     arena_shots(args.only)
     menu_shots(args.only)
     destroyed_shot(args.only)
     controls_shot(args.only)
     slope_shot(args.only)
+    explosion_shot(args.only)
     return 0
 
 

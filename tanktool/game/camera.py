@@ -14,7 +14,8 @@ tank, not into the ground or over it), and keeps the tank in view:
   constants (the view does not jolt when the hull bumps); it pulls in at once (a wall
   must never hide the tank) and lets out slowly (no swinging near walls).
 
-First person looks along the hull, its pitch smoothed the same way.  The pose is a
+First person looks along the hull, its pitch smoothed the same way.  Both shake for
+a moment when the tank fires, is hit, or something blows up near by (:func:`shake`).  The pose is a
 pure function of the session and the smoothing state: tests run it without OpenGL.
 """
 
@@ -34,6 +35,10 @@ CLEARANCE = 0.6
 TURN_S, SWING_S, OUT_S = 0.12, 0.25, 0.6
 #: the camera's pitch follows the hull's this much (the rest stays level: the horizon reads)
 PITCH_SHARE = 0.7
+#: the shake's strength [m] when the followed tank fires, is hit, or something blows up
+#: (the followed tank itself, or within SHAKE_REACH metres), and how long it lasts [s]
+SHAKE = {"flash": 0.08, "impact": 0.3, "explosion": 0.45}
+SHAKE_REACH, SHAKE_S = 25.0, 0.4
 #: swings tried when the way behind is not free: (round the tank [rad], up [rad]), and
 #: what each costs against the room it wins (the plain chase view is preferred)
 YAWS = (0.0, 0.7, -0.7, 1.4, -1.4, 2.1, -2.1)
@@ -96,12 +101,14 @@ class Camera:
         now = float(session.t) + alpha * float(session.dt)
         e = self._ease(now, t.index, h, pitch, (x, z))
         p = np.array([x, y, z])
+        jolt = shake(session, t.index, now)
         if mode == "first-person":
             f = np.array([math.cos(e.heading), 0.0, math.sin(e.heading)])
             eye = p + np.array([0.0, t.spec.height + 0.4, 0.0]) + f * 0.3 * max(t.spec.radius, 1.0)
             look = f * math.cos(e.pitch) + np.array([0.0, math.sin(e.pitch), 0.0])
-            return eye, eye + look * 10.0 + np.array([0.0, -0.6, 0.0])
-        return self._chase(session, t, p, e)
+            return eye + jolt, eye + look * 10.0 + np.array([0.0, -0.6, 0.0]) + 2.0 * jolt
+        eye, target = self._chase(session, t, p, e)
+        return eye + jolt, target + 0.5 * jolt
 
     # ------------------------------------------------------------------ chase
     def _chase(self, session: Any, t: Any, p: np.ndarray, e: _Eased) -> tuple[np.ndarray, np.ndarray]:
@@ -194,6 +201,30 @@ class Camera:
             return eye
         ground = eye[1] + 0.05 - hit * (CLEARANCE + 0.05)
         return np.array([eye[0], ground + CLEARANCE, eye[2]])
+
+
+def shake(session: Any, tank: int, now: float) -> np.ndarray:
+    """The camera's jolt [m] at ``now``: a short shake when the followed tank fires
+    (``SHAKE["flash"]``), is hit, or something blows up near by (less the farther),
+    fading over ``SHAKE_S``; a fixed sum of sines, so a replay shakes the same."""
+    amp = 0.0
+    me = session.world.tanks[tank] if 0 <= tank < len(session.world.tanks) else None
+    for fx in getattr(session, "effects", ()):
+        age = (now - fx.t0) / SHAKE_S
+        if not 0.0 <= age < 1.0:
+            continue
+        if fx.kind == "explosion" and me is not None:
+            near = max(1.0 - math.hypot(fx.x - me.x, fx.z - me.z) / SHAKE_REACH, 0.0)
+            a = SHAKE["explosion"] * (1.0 if fx.tank == tank else near)
+        elif fx.tank == tank:
+            a = SHAKE.get(fx.kind, 0.0)
+        else:
+            continue
+        amp = max(amp, a * (1.0 - age) ** 2)
+    if amp <= 0.0:
+        return np.zeros(3)
+    w = 2.0 * math.pi * now
+    return amp * np.array([math.sin(9.0 * w), 0.8 * math.sin(13.0 * w + 1.0), math.sin(11.0 * w + 2.0)])
 
 
 def _offset(p: np.ndarray, heading: float, pitch: float, reach: float, lift: float) -> np.ndarray:

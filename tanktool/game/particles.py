@@ -2,15 +2,16 @@
 
 What the match does becomes bursts of particles (:data:`RECIPES`):
 
-* a **shot**: the muzzle flash (one bright flare for a few hundredths of a second), a
-  cone of flame forward and a puff of smoke;
+* a **shot**: the muzzle flash (one big bright flare for a few hundredths of a second),
+  a long cone of flame forward, the muzzle brake's blast to the sides and smoke;
 * a **hit**: sparks thrown back towards the shooter, a flash, smoke and a few fragments;
 * a **kill**: the explosion: a flash, fire that rises and cools from yellow to red,
-  dark smoke that swells and drifts up, debris thrown out that falls and bounces, sparks;
+  dark smoke that swells and drifts up, debris (some of it glowing) thrown out that
+  falls and bounces, sparks, and a ring of dust blown along the ground;
 * a shell stopped by a wall or the ground (no event says so: a shell that leaves the
   world without a hit): a puff of dust and a few sparks;
-* **dust** behind the tracks of every moving tank (more the faster it goes) and smoke
-  rising from wrecks.
+* **dust** behind the tracks of every moving tank (more the faster it goes), and over
+  wrecks smoke and, for ``BURN_S`` seconds after the kill, flames dying down.
 
 Each particle has a life, a size and a colour going from their start to their end
 values, a drag, a lift (negative: it falls) and ``glow`` (1 adds light, 0 covers what is
@@ -60,11 +61,14 @@ class Burst:
 FLASH = (1.0, 0.78, 0.42, 0.85)
 RECIPES: dict[str, tuple[Burst, ...]] = {
     "shot": (
-        Burst(1, (0.06, 0.07), (0.0, 0.0), 0.0, (1.6, 2.4), FLASH, (1.0, 0.6, 0.2, 0.0), glow=1.0, jitter=0.0),
-        Burst(8, (0.08, 0.16), (8.0, 22.0), 0.25, (0.5, 0.9), (1.0, 0.8, 0.3, 0.9), (1.0, 0.3, 0.05, 0.0),
+        # a heavy gun: a big flare, a long tongue of flame, the muzzle brake's side blast
+        Burst(1, (0.07, 0.09), (0.0, 0.0), 0.0, (2.8, 4.0), FLASH, (1.0, 0.6, 0.2, 0.0), glow=1.0, jitter=0.0),
+        Burst(16, (0.1, 0.2), (10.0, 30.0), 0.2, (0.6, 1.2), (1.0, 0.82, 0.35, 0.95), (1.0, 0.3, 0.05, 0.0),
               glow=1.0, drag=6.0, jitter=0.05),
-        Burst(4, (0.6, 1.0), (1.0, 3.0), 0.5, (0.6, 2.0), (0.55, 0.53, 0.5, 0.35), (0.6, 0.6, 0.6, 0.0),
-              lift=0.8, drag=2.0, jitter=0.1, fade_in=0.08),
+        Burst(10, (0.08, 0.14), (6.0, 14.0), 1.4, (0.5, 0.9), (1.0, 0.75, 0.3, 0.9), (1.0, 0.3, 0.05, 0.0),
+              glow=1.0, drag=8.0, jitter=0.05),
+        Burst(8, (0.8, 1.4), (1.0, 4.0), 0.9, (0.8, 2.8), (0.55, 0.53, 0.5, 0.4), (0.6, 0.6, 0.6, 0.0),
+              lift=0.8, drag=2.0, jitter=0.15, fade_in=0.08),
     ),
     "hit": (
         Burst(1, (0.08, 0.1), (0.0, 0.0), 0.0, (1.2, 2.0), FLASH, (1.0, 0.5, 0.1, 0.0), glow=1.0, jitter=0.0),
@@ -81,8 +85,14 @@ RECIPES: dict[str, tuple[Burst, ...]] = {
               glow=0.6, lift=3.0, drag=2.2, jitter=0.9, up=1.2),
         Burst(18, (1.8, 3.0), (1.0, 3.5), math.pi, (1.8, 5.0), (0.12, 0.11, 0.1, 0.55), (0.35, 0.34, 0.33, 0.0),
               lift=1.8, drag=1.2, jitter=1.0, up=1.5, fade_in=0.35),
-        Burst(16, (1.2, 2.0), (5.0, 13.0), 1.2, (0.3, 0.3), (0.12, 0.1, 0.08, 1.0), (0.12, 0.1, 0.08, 0.9),
+        # debris: hull plates and track links thrown out, falling and bouncing, some still glowing
+        Burst(26, (1.4, 2.4), (5.0, 15.0), 1.2, (0.45, 0.35), (0.12, 0.1, 0.08, 1.0), (0.12, 0.1, 0.08, 0.9),
               lift=-GRAVITY, drag=0.2, jitter=0.5, up=0.8),
+        Burst(10, (1.0, 1.8), (6.0, 14.0), 1.0, (0.3, 0.2), (1.0, 0.6, 0.2, 1.0), (0.5, 0.12, 0.03, 0.6),
+              glow=1.0, lift=-GRAVITY, drag=0.3, jitter=0.4, up=0.9),
+        # the blast's dust ring along the ground
+        Burst(20, (0.8, 1.4), (6.0, 11.0), 0.25, (1.0, 3.0), (0.5, 0.45, 0.36, 0.5), (0.56, 0.52, 0.45, 0.0),
+              lift=0.3, drag=3.0, jitter=0.4, up=-1.0),
         Burst(22, (0.3, 0.8), (8.0, 20.0), math.pi, (0.2, 0.08), (1.0, 0.9, 0.5, 1.0), (1.0, 0.35, 0.05, 0.0),
               glow=1.0, lift=-GRAVITY, drag=0.6, jitter=0.3, up=0.4),
     ),
@@ -100,10 +110,16 @@ RECIPES: dict[str, tuple[Burst, ...]] = {
         Burst(1, (1.8, 2.8), (0.4, 1.0), 0.5, (1.0, 3.6), (0.1, 0.1, 0.1, 0.45), (0.3, 0.3, 0.3, 0.0),
               lift=1.6, drag=0.8, jitter=0.6, up=1.0),
     ),
+    "fire": (
+        Burst(1, (0.35, 0.7), (0.5, 1.5), 0.4, (1.2, 0.3), (1.0, 0.7, 0.25, 0.9), (0.9, 0.2, 0.03, 0.0),
+              glow=1.0, lift=2.5, drag=1.5, jitter=0.8, up=1.0),
+    ),
 }
 #: dust puffs per second and track at top speed; wreck smoke puffs per second
 DUST_RATE = 14.0
-WRECK_RATE = 5.0
+WRECK_RATE = 7.0
+#: flames a second over a fresh wreck, dying down over BURN_S seconds
+FIRE_RATE, BURN_S = 24.0, 8.0
 
 
 class Particles:
@@ -248,6 +264,7 @@ class SessionEffects:
         self._seen: set[int] = set()
         self._shells: dict[int, tuple[float, float, float]] = {}
         self._t: float | None = None
+        self._died: dict[int, float] = {}        # when each wreck was first seen [s]
 
     def sync(self, session: Any, floor_y: float = 0.0) -> None:
         """Catch up with ``session`` (call once a frame, before drawing)."""
@@ -258,6 +275,7 @@ class SessionEffects:
             p.clear()
             self._seen.clear()
             self._shells.clear()
+            self._died.clear()
             dt = 0.0
         self._t = t
         live = set()
@@ -303,7 +321,12 @@ class SessionEffects:
             y = float(getattr(t, "y", floor_y))
             if not t.alive:
                 p.emit_steady(("wreck", t.index), "wreck", WRECK_RATE, dt, (t.x, y + 1.5, t.z), floor=y)
+                burning = 1.0 - (float(session.t) - self._died.setdefault(t.index, float(session.t))) / BURN_S
+                if burning > 0.0:           # the wreck burns, the flames dying down
+                    p.emit_steady(("fire", t.index), "fire", FIRE_RATE * burning, dt,
+                                  (t.x, y + 0.6 * t.spec.height, t.z), floor=y)
                 continue
+            self._died.pop(t.index, None)
             speed = t.speed()
             if speed < 1.0:
                 continue

@@ -43,6 +43,8 @@ class Effect:
     #: towards the shooter (sparks fly that way)
     heading: float | None = None
     back: tuple[float, float, float] | None = None
+    #: the tank it happened to: the shooter of a flash, the one hit or destroyed
+    tank: int | None = None
 
     def age(self, t: float) -> float:
         """0 when it starts, 1 when it is over."""
@@ -59,7 +61,8 @@ def update_effects(effects: list[Effect], events: Sequence[Event], world: World)
             tank = world.tanks[e.tank]
             mx, my, mz = tank.spec.muzzle_local
             x, z = tank.to_world(mx, mz)
-            out.append(Effect("flash", x, my + float(getattr(tank, "y", 0.0)), z, t, heading=tank.heading))
+            out.append(Effect("flash", x, my + float(getattr(tank, "y", 0.0)), z, t, heading=tank.heading,
+                              tank=e.tank))
         elif e.kind == "hit":
             victim = world.tanks[e.other] if 0 <= e.other < len(world.tanks) else None
             base = float(getattr(victim, "y", 0.0)) if victim is not None else 0.0
@@ -70,12 +73,12 @@ def update_effects(effects: list[Effect], events: Sequence[Event], world: World)
                 dx, dz = shooter.x - e.x, shooter.z - e.z
                 n = math.hypot(dx, dz)
                 back = (dx / n, 0.35, dz / n) if n > 1e-9 else None
-            out.append(Effect("impact", e.x, base + height, e.z, t, back=back))
+            out.append(Effect("impact", e.x, base + height, e.z, t, back=back, tank=e.other))
         elif e.kind == "kill":
             victim = world.tanks[e.other] if 0 <= e.other < len(world.tanks) else None
             base = float(getattr(victim, "y", 0.0)) if victim is not None else 0.0
             top = 0.8 * victim.spec.height if victim is not None else 1.0
-            out.append(Effect("explosion", e.x, base + top, e.z, t))
+            out.append(Effect("explosion", e.x, base + top, e.z, t, tank=e.other))
     return out
 
 
