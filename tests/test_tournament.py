@@ -156,3 +156,15 @@ def test_a_bot_that_cannot_be_made_is_one_error_line(tmp_path, workers):
         assert r.exit_code == 2 and message in r.output, r.output
     r = CliRunner().invoke(cli, ["play", "--headless", "--bot", f"{tmp_path / 'bad.py'}:Never", "--seconds", "1"])
     assert r.exit_code == 2 and "no bot today" in r.output
+
+
+def test_a_ray_address_where_nothing_listens_is_refused_at_once():
+    pytest.importorskip("ray")
+    import socket
+
+    with socket.socket() as s:          # a port that was free a moment ago
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    r = CliRunner().invoke(cli, ["tournament", "--bot", "easy", "--bot", "novice", "--matches", "1",
+                                 "--seconds", "1", "--no-replays", "--ray", f"127.0.0.1:{port}"])
+    assert r.exit_code == 2 and "no Ray cluster answers there" in r.output

@@ -38,7 +38,7 @@ def _check_replay_dir(folder: Path, names: list[str]) -> None:
 @click.command("tournament")
 @click.option("--bot", "bots", multiple=True, metavar="NAME|FILE.py:Class",
               help="A player (repeat, at least two): easy, normal, hard, robot, camper, duellist, novice, "
-                   "or a bot class in a file.")
+                   "a bot class in a file, or scripted (the old scripted baseline).")
 @click.option("--arena", "arenas", multiple=True, metavar="A", help="Arena (repeat; default: box).")
 @click.option("--vehicle", "vehicles", multiple=True, metavar="V", help="Vehicle (repeat; default: light).")
 @click.option("--matches", type=click.IntRange(1, 10000), default=2, show_default=True,
@@ -97,6 +97,10 @@ def tournament(bots: tuple[str, ...], arenas: tuple[str, ...], vehicles: tuple[s
 
     run = "ray" if ray_address else ("serial" if workers == 1 else "pool")
     n = workers or default_workers()
+    if run == "ray":            # connected (or refused) before the progress bar
+        from ..tournament.runners import ray_connect
+
+        ray_connect(ray_address or "local", n)
     with progress(length=len(tasks), label=f"{len(tasks)} matches ({run}, {n if run != 'serial' else 1} "
                   f"worker{'s' if n > 1 and run != 'serial' else ''})") as bar:
         result = run_tournament(config, run=run, workers=n, ray_address=ray_address or "local",

@@ -51,6 +51,21 @@ def _ray() -> Any:
     return ray
 
 
+def _reachable(address: str, timeout: float = 5.0) -> None:
+    """Refuse a HOST:PORT where nothing listens at once: Ray itself would retry for
+    minutes.  Other forms (``auto``, ``ray://...``) are left to Ray."""
+    import socket
+
+    host, sep, port = address.rpartition(":")
+    if not sep or not port.isdigit() or "/" in address:
+        return
+    try:
+        socket.create_connection((host.strip("[]") or "127.0.0.1", int(port)), timeout=timeout).close()
+    except OSError as e:
+        raise TanktoolError(f"--ray {address}: no Ray cluster answers there ({e.strerror or e}); start one with "
+                            f"'ray start --head' or use --ray local") from None
+
+
 def ray_connect(address: str, workers: int | None = None) -> Any:
     """Ray, initialised: an existing connection is kept (tests share one cluster);
     ``local`` starts a cluster on this machine with ``workers`` CPUs."""
@@ -62,7 +77,10 @@ def ray_connect(address: str, workers: int | None = None) -> Any:
             ray.init(num_cpus=workers or default_workers(), include_dashboard=False, log_to_driver=False,
                      configure_logging=False)
         else:
+            _reachable(address)
             ray.init(address=address, log_to_driver=False, configure_logging=False)
+    except TanktoolError:
+        raise
     except Exception as e:     # Ray's own errors: no cluster there, a version mismatch
         raise TanktoolError(f"--ray {address}: cannot connect to a Ray cluster: {type(e).__name__}: "
                             f"{str(e).splitlines()[0] if str(e) else ''}") from None
