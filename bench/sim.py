@@ -9,11 +9,11 @@ the same process, pymunk (Chipmunk2D, C) steps an equivalent scene: 8 box bodies
 the same size and mass driven by changing forces and torques inside 4 static walls.
 The ratio column is our World.step rate over pymunk's.
 
-Then 8 computer agents (sim/agents, normal) drive the same arena: the CPU time of
+Then 8 computer agents (sim/agents, ``--level``, default normal) drive the same arena: the CPU time of
 their calls per world step, and the one-off time of their first think (each builds
 its grid and sight map; cached per arena).
 
-    python bench/sim.py [--steps N] [--seed K] [--json]
+    python bench/sim.py [--steps N] [--seed K] [--level easy|normal|hard] [--json]
 """
 
 from __future__ import annotations
@@ -75,13 +75,14 @@ def bench_ours(walls, spawns, spec: TankSpec, steps: int, seed: int, ground=None
             "mean_shells": shells / steps, "shots": sum(t.shots for t in tanks)}
 
 
-def bench_agents(walls, spawns, spec: TankSpec, steps: int, seed: int, ground=None, bounds=None) -> dict:
-    """8 computer agents (normal) driving: CPU seconds in their calls per world step,
-    after each has set up (its grid and sight map: timed apart, once per arena)."""
-    from tanktool.sim.match import make_bots
+def bench_agents(walls, spawns, spec: TankSpec, steps: int, seed: int, ground=None, bounds=None,
+                 level: str = "normal") -> dict:
+    """8 computer agents (of ``level``) driving: CPU seconds in their calls per world
+    step, after each has set up (its grid and sight map: timed apart, once per arena)."""
+    from tanktool.sim.agents import make_agents
 
     world = World(walls, [spec] * 8, spawns, seed=seed, ground=ground, bounds=bounds)
-    bots = make_bots(world)
+    bots = make_agents(world, level)
     tanks = world.tanks
     s0 = time.process_time()
     cmds = [b(world, t) for b, t in zip(bots, tanks)]   # the first think sets each agent up
@@ -142,6 +143,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=6000, help="steps per run (default 6000 = 50 s simulated)")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--level", default="normal", choices=("easy", "normal", "hard"),
+                    help="the computer agents' difficulty (default normal; hard thinks most often)")
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
     args = ap.parse_args(argv)
     vref = default_vehicle()
@@ -150,7 +153,7 @@ def main(argv: list[str] | None = None) -> int:
     rows = []
     for name, walls, spawns, ground, bounds in arenas():
         ours = bench_ours(walls, spawns, spec, args.steps, args.seed, ground)
-        agents = bench_agents(walls, spawns, spec, args.steps, args.seed, ground, bounds)
+        agents = bench_agents(walls, spawns, spec, args.steps, args.seed, ground, bounds, args.level)
         rows.append({
             "arena": name,
             "levels": int(ground.levels) if ground is not None else 1,
@@ -167,7 +170,8 @@ def main(argv: list[str] | None = None) -> int:
             "agent_setup_s": round(agents["agent_setup_s"], 2),
         })
     result = {"benchmark": "sim", "tanks": 8, "vehicle": spec.name, "dt": 1 / 120, "steps": args.steps,
-              "goal_steps_per_s": 2000, "goal_agent_ms_per_step": 1.0, "pymunk": peer["version"] if peer else None, "arenas": rows}
+              "goal_steps_per_s": 2000, "goal_agent_ms_per_step": 1.0, "agent_level": args.level,
+              "pymunk": peer["version"] if peer else None, "arenas": rows}
     if args.json:
         print(json.dumps(result))
         return 0
@@ -185,7 +189,7 @@ def main(argv: list[str] | None = None) -> int:
               f"{r['realtime_factor']:>6.0f}x {r['mean_shells_in_flight']:>6.2f} {pm} {ratio} "
               f"{r['agent_ms_per_step']:>14.3f} {r['agent_setup_s']:>7.2f}")
     print(f"goal: >= {result['goal_steps_per_s']} steps/s with 8 tanks; computer agents < "
-          f"{result['goal_agent_ms_per_step']:g} ms CPU per step for 8 (normal, after setting up); "
+          f"{result['goal_agent_ms_per_step']:g} ms CPU per step for 8 ({args.level}, after setting up); "
           f"lv: levels, * on a ground (relief or levels)")
     return 0
 

@@ -214,12 +214,18 @@ class Agent(Pilot):
         return super().follow(view, points, speed, lookahead, corner, stop)
 
     def _camp_ahead(self, view: "View", points: list[tuple[float, float]]) -> tuple[float, float] | None:
-        """A camping enemy remembered (``CAMP_MEMORY`` s, within vision range) that sees
-        us here or at the first point of the way at least 6 m ahead."""
+        """A camping enemy remembered (``CAMP_MEMORY`` s, within vision range), or where
+        the enemy was seen or heard in the last seconds (``memory.known``), that sees us
+        here or at the first point of the way at least 6 m ahead: the gun goes on it
+        before the way comes round the corner (peeking with the gun on it)."""
         t, me = view.t, view.me
         ahead = next((q for q in points if math.hypot(q[0] - me.x, q[1] - me.z) >= 6.0), points[-1])
         best, best_d = None, math.inf
-        for cx, cz, ct, _ in self.memory.camps.values():
+        places = [(cx, cz, ct) for cx, cz, ct, _ in self.memory.camps.values()]
+        known = self.memory.known(t)
+        if known is not None:
+            places.append((known[0], known[1], t))
+        for cx, cz, ct in places:
             d = math.hypot(cx - me.x, cz - me.z)
             if t - ct > CAMP_MEMORY or d > self.senses.vision_range or d >= best_d:
                 continue
