@@ -1037,7 +1037,7 @@ class Peer(TermsMixin):
         self.last_state_seq[key] = m.seq
         self.window.anchor(m.sender, m.seq, now)
         self.counters["states_received"] += 1
-        self.latencies.append(now - m.timestamp)
+        self.latencies.append(P.age(now, m.timestamp))
         self.events.append(NetEvent("state", m.sender, m.body))
         return True
 
