@@ -67,3 +67,20 @@ def test_a_bot_file_the_workers_lack_is_sent_with_the_task(cluster, tmp_path):
     shutil.rmtree(copy.parent)                       # as on a machine that never had it
     results = list(run_ray(tasks, 2))
     assert len(results) == 1 and results[0]["a"] == "Hunter" and "bot_errors" not in results[0]
+
+
+def test_the_cli_joins_a_running_cluster_by_its_address(cluster, tmp_path):
+    import subprocess
+    import sys
+
+    address = cluster.get_runtime_context().gcs_address
+    out = tmp_path / "t.json"
+    r = subprocess.run([sys.executable, "-m", "tanktool.cli.main", "tournament", "--bot", HUNTER, "--bot", "novice",
+                        "--matches", "2", "--seconds", "4", "--json", str(out), "--no-replays", "--ray", address],
+                       capture_output=True, text=True, timeout=240)
+    assert r.returncode == 0, r.stderr[-2000:]
+    report = json.loads(out.read_text())
+    assert report["timing"]["runner"] == "ray" and len(report["matches"]) == 2
+    serial = run_tournament(TournamentConfig(bots=(HUNTER, "novice"), matches=2, seconds=4.0), run="serial",
+                            record=False)
+    assert _plain(serial.report) == _plain(report)
