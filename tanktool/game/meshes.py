@@ -172,16 +172,28 @@ def _batches(parts: list[tuple[np.ndarray, np.ndarray | None, bool]]) -> list[Ba
     return batches
 
 
-def model_from_meshes(meshes: list[Any]) -> Model:
+def model_from_meshes(meshes: list[Any], default_look: bool = False) -> Model:
     """Group meshes into batches by texture image (same pixels, one batch), and the far
-    version without the parts smaller than FAR_PART of the whole."""
+    version without the parts smaller than FAR_PART of the whole.  ``default_look``: a
+    mesh without any material gets one by face kind (floor, ramp, wall, ceiling:
+    game/looks.py), as an arena should."""
+    from .looks import looked_parts, untextured
+
     parts, sizes = [], []
     for m in meshes:
         if len(m.faces) == 0:
             continue
+        closed = _is_closed(m.vertices, m.faces)
+        size = float(np.linalg.norm(np.ptp(np.asarray(m.vertices), axis=0)))
+        if default_look and untextured(m):
+            normals = smooth_normals(m.vertices, m.faces)
+            for arr, image in looked_parts(m.vertices, m.faces, normals):
+                parts.append((arr, image, closed))
+                sizes.append(size)
+            continue
         arr, image = mesh_vertices(m)
-        parts.append((arr, image, _is_closed(m.vertices, m.faces)))
-        sizes.append(float(np.linalg.norm(np.ptp(np.asarray(m.vertices), axis=0))))
+        parts.append((arr, image, closed))
+        sizes.append(size)
     model = Model(_batches(parts))
     if parts:
         whole = float(np.linalg.norm(np.ptp(np.concatenate([p[0][:, :3] for p in parts]), axis=0)))
@@ -222,8 +234,9 @@ def tessellate(vertices: np.ndarray, max_edge: float) -> np.ndarray:
 
 
 @lru_cache(maxsize=16)
-def load_model(path: str) -> Model:
-    """A bundle's model.glb as batches (scene transforms applied)."""
+def load_model(path: str, default_look: bool = False) -> Model:
+    """A bundle's model.glb as batches (scene transforms applied; ``default_look``: see
+    :func:`model_from_meshes`)."""
     import trimesh
 
     p = Path(path)
@@ -249,7 +262,7 @@ def load_model(path: str) -> Model:
         m = g.copy()
         m.apply_transform(transform)
         meshes.append(m)
-    return model_from_meshes(meshes)
+    return model_from_meshes(meshes, default_look)
 
 
 def box_tank_model(spec: Any) -> Model:

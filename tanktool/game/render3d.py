@@ -202,7 +202,7 @@ class Renderer3D:
         (x0, z0), (x1, z1) = session.world.bounds.tolist()
         self.centre = ((x0 + x1) / 2, (z0 + z1) / 2)
         self.span = max(x1 - x0, z1 - z0, 1.0)
-        self.arena_model = load_model(str(self._arena_model()))
+        self.arena_model = load_model(str(self._arena_model()), default_look=True)
         self.floor_y = self._floor_y()
         box = self.arena_model.bounds()
         top = float(box[1, 1]) if self.arena_model.triangles else 3.0

@@ -106,7 +106,7 @@ def arena_picture(ref: Any, size: tuple[int, int], ctx: Any = None) -> np.ndarra
         raise FileNotFoundError(ref)
     bundle = load_arena(folder)
     f = bundle.file("model")
-    model = load_model(str(f if f.name else folder / "model.glb"))
+    model = load_model(str(f if f.name else folder / "model.glb"), default_look=True)
     (x0, z0), (x1, z1) = np.asarray(bundle.bounds, dtype=np.float64).tolist()
     span = max(x1 - x0, z1 - z0, 1.0)
     c = np.array([(x0 + x1) / 2, bundle.floor_y, (z0 + z1) / 2])
