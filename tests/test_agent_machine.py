@@ -76,3 +76,20 @@ def test_the_docs_show_the_table_the_code_runs():
 def test_no_agent_module_is_over_600_lines():
     for f in (ROOT / "tanktool" / "sim" / "agents").glob("*.py"):
         assert len(f.read_text(encoding="utf-8").splitlines()) <= 600, f.name
+
+
+def test_breaking_off_a_lost_fight_is_a_levels_choice_and_no_level_makes_it():
+    import dataclasses
+
+    from tanktool.sim.agents import DIFFICULTIES, Agent
+
+    assert not any(lv.break_off for lv in DIFFICULTIES.values())
+    sight = SimpleNamespace(x=10.0, z=0.0, index=1, vehicle=None)
+    vehicle = SimpleNamespace(shell_damage=25.0, hit_points=115.0)
+    view = SimpleNamespace(me=SimpleNamespace(hp=40.0, vehicle=vehicle))
+    p = SimpleNamespace(sight=sight, t=10.0)
+    lost = Agent(dataclasses.replace(DIFFICULTIES["hard"], break_off=True))
+    assert GUARDS["losing"](lost, view, p) == (10.0, 0.0)       # 40 hp left, the enemy whole
+    assert not GUARDS["losing"](Agent("hard"), view, p)
+    view.me.hp = 115.0
+    assert not GUARDS["losing"](lost, view, p)

@@ -58,7 +58,7 @@ def _but(*names: str) -> tuple[str, ...]:
 
 TRANSITIONS = tuple(Transition(*row) for row in (
     (_but("evade", "return_fire"), "ambushed", "evade", "hit twice in 4 s, nobody in sight, shot from cover"),
-    (("attack",), "losing", "evade", "out-traded (levels that break off)"),
+    (("attack",), "losing", "evade", "out-traded (Difficulty.break_off: no level)"),
     (("evade",), "done", "search", "in cover or 5 s: from the threat"),
     (_but("evade", "attack", "return_fire"), "shot_from_open", "return_fire",
      "hit, the shot heard from a place in sight"),
@@ -263,7 +263,9 @@ def _in_open(view: "View", h: Any) -> bool:
 
 
 def _losing(a: Agent, view: "View", p: "Percept") -> Any:
-    if a.level.cover and a.level.break_off and p.sight is not None and p.t >= a.memory.evade_cooldown and a.memory.losing(view, p.sight):
+    lv = a.level
+    if lv.cover and lv.break_off and p.sight is not None and p.t >= a.memory.evade_cooldown \
+            and a.memory.losing(view, p.sight):
         return (p.sight.x, p.sight.z)
     return None
 
