@@ -24,6 +24,7 @@ import io
 import json
 import os
 import random
+import re
 import shutil
 import struct
 import time
@@ -609,6 +610,60 @@ def _textured_import(path: Path) -> None:
     export_glb(path, load_scene(path), path.parent / "bundle", warn=lambda _m: None)
 
 
+def mutate_image_pixels(data: bytes, rng: random.Random, pool: list[bytes] | None = None) -> bytes:
+    """A textured box whose embedded PNG has bytes changed past its header (inside
+    the compressed pixels): the header still reads, the pixels do not (issue 26)."""
+    image = bytearray(png_bytes(rng.choice([8, 32, 64]), rng.choice([8, 32, 64])))
+    for _ in range(rng.randint(1, 3)):
+        k = rng.randrange(41, max(42, len(image) - 12))   # past IHDR (8 + 25 bytes) and the IDAT length/tag
+        image[k] = rng.randrange(256)
+    return glb_bytes(*textured_box_gltf(bytes(image), "image/png"))
+
+
+#: what a coordinate of a plan is changed to: a stretch to 65 km, far, huge, tiny, overflowing
+COORDINATE_BOMBS = ["65535", "-65535", "1e6", "1e9", "-1e12", "1e308", "-1e308", "1e-300", "1e309", "4e5"]
+
+
+def mutate_plan_coordinates(data: bytes, rng: random.Random, pool: list[bytes] | None = None) -> bytes:
+    """A floor plan with one to three of its numbers replaced by a coordinate bomb."""
+    text = data.decode("utf-8", "replace")
+    spans = [m.span() for m in re.finditer(r"(?<![\w.])-?\d+(\.\d+)?(?![\w.])", text)]
+    if "ENTITIES" in text:   # DXF: only the values of coordinate group codes (10-39), not the codes
+        lines = text.split("\n")
+        at = np.cumsum([0] + [len(ln) + 1 for ln in lines])
+        spans = [(int(at[i + 1]), int(at[i + 1]) + len(lines[i + 1])) for i in range(0, len(lines) - 1, 2)
+                 if lines[i].strip().isdigit() and 10 <= int(lines[i].strip()) <= 39]
+    if not spans:
+        return data
+    for a, b in sorted(rng.sample(spans, min(len(spans), rng.randint(1, 3))), reverse=True):
+        text = text[:a] + rng.choice(COORDINATE_BOMBS) + text[b:]
+    return text.encode()
+
+
+def mutate_replay_fields(data: bytes, rng: random.Random, pool: list[bytes] | None = None) -> bytes:
+    """A replay with one to three header fields removed (or set to null)."""
+    hlen = struct.unpack_from("<I", data, 5)[0]
+    head = json.loads(data[9:9 + hlen])
+    for key in rng.sample(sorted(head), min(len(head), rng.randint(1, 3))):
+        if rng.random() < 0.8:
+            del head[key]
+        else:
+            head[key] = None
+    h = json.dumps(head).encode()
+    return data[:5] + struct.pack("<I", len(h)) + h + data[9 + hlen:]
+
+
+def _plan_work(path: Path) -> None:
+    """What import-arena does with a plan before the heavy work: read it (the overlap
+    limit), then check the cells it asks for against the file's budget."""
+    from tanktool.formats.limits import check_cells
+    from tanktool.formats.models import load_scene
+
+    scene = load_scene(path)
+    lo, hi = scene.bounds
+    check_cells(str(path), float(hi[0] - lo[0]), float(hi[2] - lo[2]), 0.5, path.stat().st_size)
+
+
 # ---------------------------------------------------------------------------- targets
 
 def _load_scene(path: Path) -> None:
@@ -785,6 +840,12 @@ KINDS: dict[str, Kind] = {k.name: k for k in [
     Kind("spheres", ".txt", _files("vehicles/*/spheres.txt"), mutate_text, _spheres),
     Kind("bindings", ".toml", _bindings_seeds, mutate_toml, _bindings),
     Kind("replay", ".ttr", _replay_seeds, mutate_replay, _replay, share=3),
+    Kind("replay-fields", ".ttr", lambda t: _replay_seeds(t)[:1], mutate_replay_fields, _replay),
+    Kind("glb-pixels", ".glb", _textured_glb_seeds, mutate_image_pixels, _textured_import, share=2),
+    Kind("plan-coords-dxf", ".dxf", _files("tests/data/plans/room.dxf"), mutate_plan_coordinates, _plan_work,
+         share=2),
+    Kind("plan-coords-svg", ".svg", _files("tests/data/plans/yard.svg"), mutate_plan_coordinates, _plan_work,
+         share=2),
     Kind("quadtree", ".npz", _files("arenas/*/quadtree.npz"), mutate_bytes, _quadtree),
     Kind("arena", "arena.toml", _files("arenas/box/arena.toml"), mutate_toml, _check_bundle,
          bundle=ROOT / "arenas" / "box", share=3),

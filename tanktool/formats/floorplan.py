@@ -42,6 +42,9 @@ MAX_PLAN_POINTS = 2_000_000
 #: lines where they cross): a base plus a share for each segment
 MAX_OVERLAPS_BASE = 1_000_000
 MAX_OVERLAPS_PER_SEGMENT = 16
+#: a coordinate of a drawing, in its own units (a 2 km town drawn in millimetres is
+#: 2e6): beyond this (or inf) it is damage, refused with its line
+MAX_DRAWING_COORDINATE = 1e9
 #: how many wall thicknesses a drawing may be across
 MAX_THICKNESSES = 1e6
 
@@ -82,6 +85,9 @@ def check_dxf(path: Path, data: bytes) -> None:
         value = lines[i + 1].strip()
         if (10 <= code <= 59 or 140 <= code <= 147) and not _NUMBER.match(value):
             raise FormatError(f"{path}:{i + 2}: group code {code} expects a number, got {value[:40]!r}")
+        if 10 <= code <= 39 and not abs(float(value)) <= MAX_DRAWING_COORDINATE:   # inf and nan fail too
+            raise FormatError(f"{path}:{i + 2}: group code {code}: coordinate {value[:40]} is beyond "
+                              f"{MAX_DRAWING_COORDINATE:g} drawing units from the origin")
         if code == 0 and value == "EOF":
             return
 
@@ -92,6 +98,8 @@ _SVG_NUMBERS = {
     "circle": ("cx", "cy", "r"),
     "ellipse": ("cx", "cy", "rx", "ry"),
 }
+_ANY_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
+_SVG_UNIT = re.compile(r"(px|mm|cm|in|pt|pc|%)$")
 _SVG_LENGTH = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?(px|mm|cm|in|pt|pc|%)?$")
 
 
@@ -111,16 +119,29 @@ def check_svg(path: Path, data: bytes) -> None:
         if not isinstance(el.tag, str):
             continue
         tag = etree.QName(el).localname
+        for attr, v in el.attrib.items():   # path data, transforms, viewBox: no number beyond the limit
+            far = next((m.group() for m in _ANY_NUMBER.finditer(v)
+                        if not abs(float(m.group())) <= MAX_DRAWING_COORDINATE), None)
+            if far is not None:
+                raise FormatError(f"{path}:{el.sourceline}: <{tag}> {etree.QName(attr).localname}: {far[:40]} is "
+                                  f"beyond {MAX_DRAWING_COORDINATE:g} drawing units from the origin")
         for attr in _SVG_NUMBERS.get(tag, ()):
             v = el.get(attr)
             if v is not None and not _SVG_LENGTH.match(v.strip()):
                 raise FormatError(f"{path}:{el.sourceline}: <{tag}> {attr} expects a number, got {v[:40]!r}")
+            if v is not None and not abs(float(_SVG_UNIT.sub("", v.strip()))) <= MAX_DRAWING_COORDINATE:
+                raise FormatError(f"{path}:{el.sourceline}: <{tag}> {attr} {v[:40]} is beyond "
+                                  f"{MAX_DRAWING_COORDINATE:g} drawing units from the origin")
         if tag in ("polyline", "polygon"):
             pts = el.get("points", "")
             nums = [p for p in re.split(r"[\s,]+", pts.strip()) if p]
             bad = next((p for p in nums if not _NUMBER.match(p)), None)
             if bad is not None:
                 raise FormatError(f"{path}:{el.sourceline}: <{tag}> points expects numbers, got {bad[:40]!r}")
+            far = next((p for p in nums if not abs(float(p)) <= MAX_DRAWING_COORDINATE), None)
+            if far is not None:
+                raise FormatError(f"{path}:{el.sourceline}: <{tag}> points: {far[:40]} is beyond "
+                                  f"{MAX_DRAWING_COORDINATE:g} drawing units from the origin")
             if len(nums) % 2:
                 raise FormatError(f"{path}:{el.sourceline}: <{tag}> points has an odd count of numbers ({len(nums)})")
 
