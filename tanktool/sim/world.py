@@ -158,8 +158,11 @@ class World:
         self._wall_y: list[list[tuple[float, float]]] = []
         if self.ground.relief:  # a flat ground's walls stop every tank: one set
             self._build_level_walls(walls, segments)
-        if len(self.spawns) < len(specs):
-            raise ArenaError(f"the arena has {len(self.spawns)} spawn points, {len(specs)} tanks asked for")
+        if len(self.spawns) < len(specs):   # more tanks than spawn points: free places of the ground too
+            from .extra_spawns import extend
+
+            big = max(specs, key=lambda s: s.radius)
+            extend(self, len(specs), big.radius, big.box[2] - big.box[0], big.name)
         self.seed = int(seed)
         self.rng = random.Random(self.seed)
         self.dt = float(dt)

@@ -73,6 +73,12 @@ def agent_grid(world: "World", cell: float, clearance: float) -> NavGrid:
     return per[key]
 
 
+def strict_grid(world: "World", cell: float, clearance: float) -> NavGrid:
+    """The agents' grid of ``world`` at exactly ``clearance`` (no fallback, not cached):
+    where a tank of that footprint radius fits (sim/extra_spawns.py)."""
+    return _make_grid(world, cell, clearance)
+
+
 def _make_grid(world: "World", cell: float, clearance: float) -> NavGrid:
     if world.ground.relief:  # a flat ground: the 2002 grid of the walls
         from .layers import ground_agent_grid

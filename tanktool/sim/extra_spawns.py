@@ -1,0 +1,104 @@
+"""Spawning beyond the spawn points (issue 25): when more tanks play than an arena has
+spawn points, the others start at free places of the ground where they fit.
+
+The places are nodes of the ground's grid (the agents' grid at ``CELL`` m with the
+tank's footprint radius as clearance: on a relief, measured along the surface, so a
+node by a drop-off or a wall's foot does not count), reachable from the arena's own
+spawn points, so every one is on a level -- never in a hole or on a roof nobody can
+reach.  They are picked by farthest-point sampling from the spawn points already there
+(each the candidate farthest from every spawn so far, at least a tank's length from
+them), which also keeps them out of the others' way; each faces the arena's centre.
+Deterministic: the same arena gives the same places.  How many tanks of a size an
+arena holds at once is :func:`capacity`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ..errors import ArenaError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .world import World
+
+#: the node spacing of the places [m]
+CELL = 1.0
+
+
+def _candidates(world: "World", radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """(k, 2) centres of the reachable nodes a tank of ``radius`` fits on and (k,) their
+    heights (NaN on a flat ground)."""
+    from .agents.navigation import strict_grid
+
+    grid = strict_grid(world, CELL, radius)
+    layered = grid.layers if grid.layers is not None else None
+    g = layered if layered is not None else grid
+    ok = np.asarray(g.valid) & np.asarray(g.reachable)
+    if ok.ndim == 2:
+        ii, jj = np.nonzero(ok)
+        ys = np.full(len(ii), np.nan)
+    else:
+        ll, ii, jj = np.nonzero(ok)
+        ys = np.asarray(g.heights(), dtype=np.float64)[ll, ii, jj]
+    pts = np.stack([g.origin[0] + (jj + 0.5) * g.cell, g.origin[1] + (ii + 0.5) * g.cell], axis=1)
+    return pts.astype(np.float64), ys
+
+
+def _pick(pts: np.ndarray, taken: np.ndarray, count: int, spacing: float) -> list[int]:
+    """Farthest-point picks among ``pts`` from the ``taken`` points, each at least
+    ``spacing`` from all before it (first index on ties)."""
+    if len(pts) == 0:
+        return []
+    d = np.full(len(pts), np.inf)
+    for p in taken:
+        d = np.minimum(d, np.hypot(pts[:, 0] - p[0], pts[:, 1] - p[1]))
+    out: list[int] = []
+    while len(out) < count:
+        k = int(np.argmax(d))
+        if not d[k] >= spacing:
+            break
+        out.append(k)
+        d = np.minimum(d, np.hypot(pts[:, 0] - pts[k, 0], pts[:, 1] - pts[k, 1]))
+    return out
+
+
+def places(world: "World", count: int, radius: float, length: float) -> list[tuple[float, float, float, Any]]:
+    """Up to ``count`` more spawn places (x, z, heading, y or None) for tanks of footprint
+    ``radius`` and ``length``, a tank's length from the spawns there are."""
+    pts, ys = _candidates(world, radius)
+    taken = np.array([s[:2] for s in world.spawns], dtype=np.float64).reshape(-1, 2)
+    picks = _pick(pts, taken, count, length)
+    (x0, z0), (x1, z1) = np.asarray(world.bounds, dtype=np.float64).tolist()
+    cx, cz = 0.5 * (x0 + x1), 0.5 * (z0 + z1)
+    out = []
+    for k in picks:
+        x, z = float(pts[k, 0]), float(pts[k, 1])
+        h = math.atan2(cz - z, cx - x) if math.hypot(cx - x, cz - z) > 1.0 else 0.0
+        y = float(ys[k]) if math.isfinite(ys[k]) else None
+        out.append((x, z, h, y))
+    return out
+
+
+def capacity(world: "World", radius: float, length: float, limit: int = 64) -> int:
+    """How many tanks of this size the arena holds at once (its spawn points and the
+    free places a tank's length apart), up to ``limit``."""
+    return len(world.spawns) + len(places(world, max(limit - len(world.spawns), 0), radius, length))
+
+
+def extend(world: "World", tanks: int, radius: float, length: float, vehicle: str) -> None:
+    """Add free places to ``world.spawns`` / ``world.spawn_y`` until ``tanks`` fit, or
+    raise ArenaError saying how many the arena holds."""
+    need = tanks - len(world.spawns)
+    if need <= 0:
+        return
+    more = places(world, need, radius, length)
+    for x, z, h, y in more:
+        world.spawns.append((x, z, h))
+        world.spawn_y.append(y)
+    if len(more) < need:
+        raise ArenaError(f"the arena holds {len(world.spawns)} tanks of {vehicle} at once "
+                         f"({len(world.spawns) - len(more)} spawn points and {len(more)} free places a tank's length "
+                         f"apart), {tanks} asked for")
