@@ -73,8 +73,16 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path):
     r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(bad)])
     assert r.exit_code == 2 and "walls.txt:1" in r.output
     arena = _arena(tmp_path)
-    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(arena), "--bots", "20"])
-    assert r.exit_code == 2 and "spawn points" in r.output
+    # more tanks than spawn points take free places; more than fit are refused in one line
+    import numpy as np
+    from tanktool.formats.walls_txt import WallList, aux_rectangle
+
+    room = WallList(np.zeros((0, 2, 2)), np.zeros(0, np.int8), aux_rectangle(0, 0, 24, 24))
+    small = write_arena_bundle(tmp_path / "small", room, np.array([[6.0, 6.0, 0.0], [18.0, 18.0, 3.1]]),
+                               name="small")
+    r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(small), "--bots", "12"])
+    assert r.exit_code == 2 and "holds" in r.output and "(2 spawn points" in r.output, r.output
+    assert len([ln for ln in r.output.splitlines() if ln.startswith("error:")]) == 1
     r = CliRunner().invoke(cli, ["play", "--headless", "--arena", str(arena), "--report",
                                  str(tmp_path / "no" / "such" / "r.json")])
     assert r.exit_code == 2 and "does not exist" in r.output
