@@ -72,3 +72,14 @@ def test_terrain_walls_are_not_voxel_steps():
     assert len(new.walls) < 0.6 * len(old.walls)
     # the same free space, give or take the edge error along the ridge
     assert abs(new.free().area - old.free().area) < 0.002 * old.free().area
+
+
+def test_exact_floors_are_modelled_floors_not_hilltops():
+    """The exact cut replaces the cells' outline on floors made of level faces, not on
+    the top of a smooth hill (a few terrain triangles a degree or two off level)."""
+    from tanktool.nav.level_walls import modelled_floors
+
+    yard = make_levels.join(make_levels.walled_yard(40, 30))
+    assert np.allclose(modelled_floors(np.asarray(yard.vertices), np.asarray(yard.faces)), [0.0, 3.0])
+    m = make_levels.level("rolling_terrain")
+    assert len(modelled_floors(np.asarray(m.vertices) * 3, np.asarray(m.faces))) == 0

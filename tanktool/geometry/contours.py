@@ -96,3 +96,21 @@ def _split(raw: np.ndarray, n: int, a: int, b: int, max_len: float) -> list[int]
         else:
             out.append(i)
     return out
+
+
+def simplify_chains(seg: np.ndarray, max_error: float) -> np.ndarray:
+    """Wall segments (k, 2, 2) along cell edges (ledges across terrain: runs along rows
+    and columns meeting at cell corners) joined into chains and simplified within
+    ``max_error`` (Douglas-Peucker), as (m, 2, 2) segments.  Chains that lose no
+    vertex come back as they were, in their order."""
+    if len(seg) < 2:
+        return seg
+    lines = shapely.linestrings(seg.reshape(-1, 2), indices=np.repeat(np.arange(len(seg)), 2))
+    chains = shapely.get_parts(shapely.line_merge(shapely.multilinestrings(lines)))
+    simple = shapely.simplify(chains, max_error, preserve_topology=False)
+    if shapely.get_num_coordinates(simple).sum() == shapely.get_num_coordinates(chains).sum():
+        return seg
+    coords, index = shapely.get_coordinates(simple, return_index=True)
+    same = index[1:] == index[:-1]
+    out = np.stack([coords[:-1][same], coords[1:][same]], axis=1)
+    return out[np.any(out[:, 0] != out[:, 1], axis=1)]

@@ -54,6 +54,10 @@ MARGIN = 2.5
 THIN_MERGE = 0.15
 #: flat floors smaller than this (m^2) keep the cells' outline (stair treads)
 MIN_EXACT_AREA = 4.0
+#: a floor the exact cut replaces is mostly (by area) of faces horizontal to within
+#: 0.1 deg, as a modelled floor is: the tops and bottoms of smooth terrain, flat to
+#: within a few degrees, keep the cells' outline
+EXACT_FLAT_NY = 0.999999
 #: gap between the walls' extent and the auxiliary rectangle (m)
 AUX_MARGIN = 1.0
 
@@ -182,6 +186,19 @@ class ExactCuts:
         return self.cache[key]
 
 
+def modelled_floors(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Heights of the model's flat floors (``flat_heights``) made mostly of faces level
+    to within EXACT_FLAT_NY: not a hilltop of terrain triangles a degree or two off."""
+    flat_h, flat_a = flat_heights(vertices, faces)
+    if len(flat_h) == 0:
+        return flat_h
+    level_h, level_a = flat_heights(vertices, faces, EXACT_FLAT_NY)
+    share = np.zeros(len(flat_h))
+    if len(level_h):
+        np.add.at(share, np.abs(level_h[:, None] - flat_h[None, :]).argmin(axis=1), level_a)
+    return flat_h[share >= 0.5 * flat_a]
+
+
 def _pieces(walls: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
     """Each wall cut into pieces of at most ``step``: (pieces (m, 2, 2), wall of each)."""
     length = np.hypot(*(walls[:, 1] - walls[:, 0]).T)
@@ -254,7 +271,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     exists, height, _, span_of = surface_layers(surface)
     L, nz, nx = exists.shape
     cuts = ExactCuts(vertices, faces, cut_height, headroom, tolerance, math.cos(math.radians(max_slope)), climb_m)
-    flat_h, _ = flat_heights(vertices, faces)
+    flat_h = modelled_floors(vertices, faces)
     span_flat = np.zeros((L, nz, nx), dtype=bool)
     span_rim = np.zeros((L, nz, nx), dtype=bool)
     m = span_of >= 0
@@ -355,6 +372,8 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
                     taken = near if taken is None else shapely.union(taken, near)
             thin = _unique_segments(np.concatenate(thin), tolerance) if thin else np.zeros((0, 2, 2))
             ledges = ledge_walls(cells, same[level], origin, cell, cells & ~floor)
+            if smooth_margin:  # a ledge across terrain is cell steps too: simplified as outlines are
+                ledges = contours.simplify_chains(ledges, edge_error * cell)
             if len(ledges):
                 thin = np.concatenate([thin, ledges])
             thin = _split_crossings(_clip_crossings(thin, outline, R, tolerance), tolerance)
