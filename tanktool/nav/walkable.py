@@ -250,8 +250,9 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
     pos = np.full(len(level) + 1, -1, dtype=np.int64)  # span -> its row in idx
     pos[idx] = np.arange(len(idx))
     nb = np.where(link[idx] >= 0, link[idx], len(level))
-    col_rank = np.searchsorted(np.unique(c), c)
+    col_rank = np.cumsum(first) - 1  # c is sorted: the rank of each span's column
     active = (lv[nb] != lv[idx][:, None]).any(axis=1)  # only spans at a level's border can move
+    is_cand = np.zeros(len(idx), dtype=bool)
     for _ in range(rounds):
         a = np.flatnonzero(active)
         if len(a) == 0:
@@ -273,10 +274,7 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
         # the new level must be free in the column: no other kept span there holds it,
         # and of two spans of one column moving to the same level in a round, neither does
         cand = a[move]
-        key = col_rank * 256 + lv[idx]
-        key[cand] = col_rank[cand] * 256 + best[move]
-        uniq, counts = np.unique(key, return_counts=True)
-        taken = counts[np.searchsorted(uniq, key[cand])] > 1
+        taken = _level_taken(c, col_rank, lv[idx], cand, best[move], is_cand)
         ok = cand[~taken]
         if len(ok) == 0:
             break
@@ -287,12 +285,32 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
         active[ok] = True
     level = lv[:-1]
     # levels numbered from 0 without gaps, in order of height
-    used = np.unique(level[idx])
+    used = np.flatnonzero(np.bincount(level[idx]))  # small counts: no hashing sort
     remap = np.full(int(used.max()) + 1, -1)
     remap[used] = np.arange(len(used))
     level[idx] = remap[level[idx]]
     return level
 
+
+
+def _level_taken(c: np.ndarray, col_rank: np.ndarray, lv: np.ndarray, cand: np.ndarray, new: np.ndarray,
+                 is_cand: np.ndarray) -> np.ndarray:
+    """Whether each candidate's new level is held in its column by another kept span
+    (at its current level, or a candidate's new one): the (column, level) keys of the
+    candidates' columns only (``c`` sorted), where one sort over every kept span would
+    find the same."""
+    cc = c[cand]  # sorted, as cand is
+    ucol = cc[np.append(True, cc[1:] != cc[:-1])]
+    lo = np.searchsorted(c, ucol, side="left")
+    cnt = np.searchsorted(c, ucol, side="right") - lo
+    rows = np.repeat(lo, cnt) + (np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt))
+    is_cand[cand] = True
+    others = rows[~is_cand[rows]]
+    is_cand[cand] = False
+    key_cand = col_rank[cand] * 256 + new
+    keys = np.concatenate([col_rank[others] * 256 + lv[others], key_cand])
+    uniq, counts = np.unique(keys, return_counts=True)
+    return counts[np.searchsorted(uniq, key_cand)] > 1
 
 def walkable_surface(vertices: np.ndarray, faces: np.ndarray, params: WalkableParams, clearance: float,
                      origin_xz=None, shape=None, seeds: np.ndarray | None = None) -> Surface:
