@@ -22,10 +22,11 @@ def goto(app, item: str) -> None:
 
 
 def match_config(arena="box", vehicle=None, bots=3, seed=0, view="top", size=(320, 240), difficulty="normal",
-                 bot="agent", seconds=None, rules=None, record=None, replay=None, replay_name="", quality=None, sound=False):
+                 bot="agent", seconds=None, rules=None, record=None, replay=None, replay_name="", quality=None, sound=False, watch=None):
     """A MatchConfig from the few choices a test names (no sound: tests have no audio device)."""
     from tanktool.game.config import MatchConfig, Opponents, Recording, ViewConfig
 
     return MatchConfig(arena=arena, vehicle=vehicle, opponents=Opponents(bots, difficulty, bot), seed=seed,
                        rules=rules, seconds=seconds, view=ViewConfig(view, tuple(size), False, quality),
-                       recording=Recording(record=record, replay=replay, replay_name=replay_name), sound=sound)
+                       recording=Recording(record=record, replay=replay, replay_name=replay_name), sound=sound,
+                       watch=watch)

@@ -116,6 +116,9 @@ def _size(text: str) -> tuple[int, int]:
               metavar="S", help="The match ends after S simulated seconds (its rules: the scoreboard says who won).")
 @click.option("--score-limit", "score_limit", type=click.IntRange(1, 1_000_000), default=None, metavar="K",
               help="The match ends when a tank has K kills.")
+@click.option("--watch", "watch", type=click.Path(dir_okay=False, path_type=Path), default=None, metavar="MODEL",
+              help="The authoring loop: import MODEL (.obj, .glb, .3ds, ...) into a scratch bundle, play it in "
+                   "the window, and reload the arena there whenever the file changes on disk.")
 @network_options
 def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | None, seconds: float | None,
          seed: int, integrator: str, report_path: Path | None, picture: Path | None, view: str,
@@ -124,7 +127,7 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
          password: str | None = None, difficulty: str | None = None, bot_driver: str = "agent",
          record_path: Path | None = None, replay_path: Path | None = None,
          time_limit: float | None = None, score_limit: int | None = None, quality: str | None = None,
-         bot_specs: tuple[str, ...] = ()) -> None:
+         bot_specs: tuple[str, ...] = (), watch: Path | None = None) -> None:
     """Play a match: bots on an arena.
 
     \b
@@ -146,6 +149,9 @@ def play(headless: bool, arena: str | None, vehicle: str | None, bots: int | Non
         _check_bots(opts, host is not None or join is not None)
     if replay_path is None:   # a replay plays what it recorded (its fingerprints say if that changed)
         _fresh_arena(opts.arena)
+    if watch is not None:
+        _play_watch(opts, watch, host is not None or join is not None)
+        return
     if host is not None or join is not None:
         _play_network(opts, host, join, player_name, password)
         return
@@ -232,6 +238,32 @@ def _check_bots(o: _Options, network: bool) -> None:
         raise click.UsageError(f"--bots {o.bots} leaves no tank for {len(o.bot_specs)} --bot "
                                f"(it counts every tank{'' if o.headless else ', yours too'})")
     lineup(o.bot_specs)
+
+
+def _play_watch(o: _Options, model: Path, network: bool) -> None:
+    """``--watch MODEL``: import it into a scratch bundle and play it in the window,
+    reloading it there when the file changes (game/watch.py)."""
+    from ..game.app import display_problem
+    from ..game.watch import ModelWatch
+
+    if o.arena is not None or o.headless or network or o.replay_path or o.record_path or o.frames is not None \
+            or o.screenshot is not None:
+        raise click.UsageError("--watch plays its model in the window: it goes without --arena, --headless, "
+                               "--host/--join, --record/--replay and --frames/--screenshot")
+    if not model.is_file():
+        raise TanktoolError(f"{model}: no such model file to watch")
+    problem = display_problem()
+    if problem is not None:
+        raise TanktoolError(f"--watch needs the game window, and there is no display here ({problem})")
+    watcher = ModelWatch(model)
+    try:
+        o.arena = str(watcher.import_now())
+        echo(f"watching {model}: imported into {o.arena}; save the file to reload the arena in the window")
+        config = window_config(o)
+        config.watch = watcher
+        _play_window(o, config)
+    finally:
+        watcher.close()
 
 
 def _play_network(o: _Options, host: str | None, join: str | None, player_name: str | None,

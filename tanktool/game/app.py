@@ -283,6 +283,28 @@ class App:
         self.notice = f"recorded to {self.record_path}"
         return line
 
+    def _watch_model(self) -> None:
+        """``--watch``: a finished re-import replaces the arena (game/watch.py); a failed
+        one is shown and the last good arena stays."""
+        done = self.config.watch.poll()
+        if done is None:
+            return
+        kind, what = done
+        if kind == "error":
+            self.notice = f"{what}  (the last good arena stays)"
+            return
+        from .watch import moved_session
+
+        self.menu.arena.options.append(str(what))
+        self.menu.arena.set(str(what))
+        if self.session is None or getattr(self.session, "realtime", False) or self.state not in ("playing", "paused"):
+            self.notice = f"{self.config.watch.model.name} re-imported: the next match plays it"
+            return
+        self.session, self.notice = moved_session(self.session, self.menu, self.config)
+        self._make_views(self.view)
+        if self.audio is not None:
+            self._restart_audio()
+
     def _make_views(self, view: str) -> None:
         from .render_top import TopView
 
@@ -442,7 +464,7 @@ class App:
                 self._replay_over()
                 self.acc = 0.0
                 break
-            if self._time_up() or self._match_over():
+            if self._match_end():
                 break
             events = self.session.step(self.input.command())
             if self.audio is not None:
@@ -451,37 +473,17 @@ class App:
             steps += 1
         return steps
 
-    def _time_up(self) -> bool:
-        """``--seconds`` is over for a local match: record it, back to the menu with a notice."""
-        seconds = self.config.seconds
-        if seconds is None or self.replay is not None or self.session is None:
-            return False
-        if self.session.world.steps * self.session.dt < seconds - 1e-9:
-            return False
-        self.end_match()
-        self.acc = 0.0
-        self.state = "over"
-        from .scoreboard import result_line
+    def _match_end(self) -> bool:
+        """The match is over: ``--seconds`` of a local match are up, or the simulation's
+        rules say so (``world.match``; game/scoreboard.py words why): the end screen."""
+        from .scoreboard import end_reason
 
-        self.over_reason = f"time up: the match lasted {seconds:g} s (--seconds): {result_line(self.session)}"
-        self.notice = self.over_reason
-        return True
-
-    def _match_over(self) -> bool:
-        """The simulation says the match is over (its rules' time or score limit,
-        ``world.match``): the end screen."""
-        w = getattr(self.session, "world_all", getattr(self.session, "world", None))
-        m = getattr(w, "match", None)
-        if self.replay is not None or m is None or not m.over:
+        why = None if self.replay is not None else end_reason(self.session, self.config.seconds)
+        if why is None:
             return False
         self.end_match()
-        self.acc = 0.0
-        self.state = "over"
-        why = {"time": "time up", "score": "score limit reached"}.get(m.reason, "the match is over")
-        from .scoreboard import result_line
-
-        self.over_reason = f"{why}: {result_line(self.session)}"
-        self.notice = self.over_reason
+        self.acc, self.state = 0.0, "over"
+        self.over_reason = self.notice = why
         return True
 
     def _handle_over(self, event: Any) -> None:
@@ -509,6 +511,8 @@ class App:
         return self.acc / self.session.dt if self.session is not None else 1.0
 
     def frame(self, real_dt: float) -> None:
+        if self.config.watch is not None:
+            self._watch_model()
         self.advance(real_dt)
         self.input.end_frame()
         if self.audio is not None and self.state == "playing":

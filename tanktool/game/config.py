@@ -87,3 +87,6 @@ class MatchConfig:
     network: NetworkConfig | None = None
     recording: Recording = field(default_factory=Recording)
     sound: bool = True
+    #: ``--watch MODEL``: a ``game.watch.ModelWatch`` whose re-imports replace the arena
+    #: while the window is open (None: no watching)
+    watch: Any = None

@@ -48,6 +48,22 @@ def result_line(session: Any) -> str:
     return f"{getattr(session, 'world_all', session.world).tanks[w].name} wins" if w is not None else "a draw"
 
 
+def end_reason(session: Any, seconds: float | None = None) -> str | None:
+    """Why the match in ``session`` is over and who won, or None while it goes on:
+    ``seconds`` of simulated time are up (``play --seconds``), or the simulation's rules
+    ended it (``world.match``: a time or score limit)."""
+    if session is None:
+        return None
+    if seconds is not None and session.world.steps * session.dt >= seconds - 1e-9:
+        return f"time up: the match lasted {seconds:g} s (--seconds): {result_line(session)}"
+    w = getattr(session, "world_all", getattr(session, "world", None))
+    m = getattr(w, "match", None)
+    if m is None or not m.over:
+        return None
+    why = {"time": "time up", "score": "score limit reached"}.get(m.reason, "the match is over")
+    return f"{why}: {result_line(session)}"
+
+
 def draw_end(app: Any, surf: "pygame.Surface") -> None:
     surf.fill(BG)
     w, h = surf.get_size()
