@@ -26,7 +26,17 @@ and then while an attacker holds 200 silent connections and opens ~500 more a se
 then a flood of joins with the password for 2 s: how many the host let in, and how many
 of the host's messages the real peers dropped to their own rate limiters.
 
-    python bench/net.py [--seconds S] [--peers N] [--json]
+Phase 4 (judge, in this process): the CPU a member state costs the host, decoded and
+kept for drawing, with the judge's checks (net/judge.py) and without them, on a flat
+arena (box) and a ground (hills).
+
+Phase 5 (flood): a host and an honest joiner as processes; this script joins as a third
+member and floods the host with 20,000 valid states a second from its own address for
+``--flood-seconds``; the host's report says how many of the honest player's states it
+took a second (goal: the 30 it sends), how many flood datagrams it dropped unread, and
+how many steps it had to skip.
+
+    python bench/net.py [--seconds S] [--peers N] [--parts steady,password,migration,attack,judge,flood] [--json]
 """
 
 from __future__ import annotations
@@ -241,6 +251,118 @@ def attack(tmp: Path) -> dict:
             "peers_rate_drops": [r["network"]["dropped_reasons"].get("rate", 0) for r in reps if r["me"] != 1]}
 
 
+def judge_costs(states: int = 1500) -> dict:
+    """Microseconds of host CPU per member state (decode, then kept for drawing), with
+    the judge and without, on box (flat) and hills (a ground): an honest tank circling."""
+    import math
+    import random
+
+    from tanktool.net.judge import Judge
+    from tanktool.net.remote import RemoteTank
+    from tanktool.net.session import NET_RULES
+    from tanktool.sim.driver import ScriptedDriver
+    from tanktool.sim.match import load_match_arena, load_tank_spec
+    from tanktool.sim.world import World
+
+    out = {}
+    spec = load_tank_spec("light")
+    for arena in ("box", "hills"):
+        info = load_match_arena(arena)
+        world = World(info.walls, [spec] * 8, info.spawns, bounds=info.bounds, ground=info.ground, rules=NET_RULES)
+        # an honest stream: tank 2 of a scripted match, sampled at 30 Hz
+        sim = World(info.walls, [spec] * 2, info.spawns, seed=5, bounds=info.bounds, ground=info.ground,
+                    rules=NET_RULES)
+        drivers = [ScriptedDriver(random.Random(k)) for k in range(2)]
+        msgs, next_t = [], 0.0
+        while len(msgs) < states:
+            sim.step(None, [d(sim, t) if t.alive else None for d, t in zip(drivers, sim.tanks)])
+            if sim.t >= next_t:
+                next_t += 1.0 / 30.0
+                t = sim.tanks[1]
+                msgs.append(P.encode(P.State(2, sim.t, t.x, t.z, math.remainder(t.heading, 2 * math.pi), t.vx, t.vz,
+                                             t.omega, t.hp, t.alive), 2, len(msgs) + 1, sim.t))
+
+        def run(judged: bool) -> float:
+            best = float("inf")
+            for _ in range(3):
+                judge, rt = Judge(world), RemoteTank()
+                t0 = time.perf_counter()
+                for d in msgs:
+                    m = P.decode(d)
+                    shown = judge.state(m.body, m.body.t) if judged else m.body
+                    if shown is not None:
+                        rt.push(shown)
+                best = min(best, (time.perf_counter() - t0) / len(msgs) * 1e6)
+            corrected = sum(judge.corrections.values()) if judged else 0
+            assert corrected == 0, judge.report()
+            return best
+
+        off, on = run(False), run(True)
+        out[arena] = {"off_us": round(off, 2), "on_us": round(on, 2), "ratio": round(on / off, 2)}
+    return out
+
+
+def flood(tmp: Path, seconds: float, rate: float = 20000.0) -> dict:
+    """A host and an honest member (processes); this process joins and floods the host
+    with ``rate`` valid states a second from its own address."""
+    from tanktool.net.digest import match_digest
+    from tanktool.sim.match import choose_vehicle, load_match_arena, load_tank_spec
+
+    info = load_match_arena("box")
+    spec = load_tank_spec(choose_vehicle(info, None, lambda line: None))
+    port = free_port(LOOPBACK)
+    rep_h, rep_o = tmp / "flood_host.json", tmp / "flood_honest.json"
+    base = ["play", "--headless", "--arena", "box", "--seconds", "3600"]
+    host = Proc([*base, "--name", "fhost", "--report", str(rep_h), "--host", f"{LOOPBACK}:{port}"])
+    procs = [host]
+    try:
+        host.wait_line(r"hosting on")
+        honest = Proc([*base, "--name", "honest", "--report", str(rep_o), "--join", f"{LOOPBACK}:{port}"])
+        procs.append(honest)
+        n_honest = int(honest.wait_line(r"as player (\d)").group(1))
+        flooder = Peer.join((LOOPBACK, port), "flooder", digest=match_digest(info, spec))
+        try:
+            time.sleep(1.0)
+            for p in procs:
+                p.p.send_signal(signal.SIGUSR1)
+            t0 = time.monotonic()
+            sent, next_poll = 0, t0
+            target = (LOOPBACK, port)
+            while True:
+                now = time.monotonic()
+                if now - t0 >= seconds:
+                    break
+                if now >= next_poll:
+                    flooder.poll(0)
+                    next_poll = now + 0.01
+                due = int((now - t0) * rate) - sent
+                if due <= 0:
+                    time.sleep(0.0005)
+                    continue
+                st = P.State(flooder.number, flooder.session_time(), 20.0, 20.0, 0.0, 0.0, 0.0, 0.0, 100.0, True)
+                for _ in range(min(due, 500)):
+                    flooder.udp.sendto(flooder._pack(st), target)
+                sent += min(due, 500)
+            flood_s = time.monotonic() - t0
+        finally:
+            flooder.close()
+        for p in procs:
+            p.p.send_signal(signal.SIGINT)
+        for p in procs:
+            p.stop(signal.SIGINT)
+        h, o = json.loads(rep_h.read_text()), json.loads(rep_o.read_text())
+    finally:
+        for p in procs:
+            p.stop()
+    s = h["stats_seconds"]
+    net = h["network"]
+    return {"flood_per_s": round(sent / flood_s), "seconds": round(s, 2),
+            "honest_sent_per_s": round(o["network"]["state_rounds"] / o["stats_seconds"], 1),
+            "honest_taken_by_host_per_s": round(net["states_received_by_sender"].get(str(n_honest), 0) / s, 1),
+            "flood_dropped_unread": net["dropped_reasons"].get("flood", 0),
+            "host_skipped_steps": h["timing"]["skipped_steps"]}
+
+
 def rows_of(reports: list[dict], peers: int) -> list[dict]:
     rows = []
     for r in sorted(reports, key=lambda r: r["me"]):
@@ -288,26 +410,58 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=20.0, help="steady play (the issue's goal run: 60)")
     ap.add_argument("--peers", type=int, default=8)
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    ap.add_argument("--parts", default="steady,password,migration,attack,judge,flood",
+                    help="which phases to run (comma-separated)")
+    ap.add_argument("--flood-seconds", type=float, default=5.0)
     args = ap.parse_args()
-    costs = seal_costs()
+    parts = set(args.parts.split(","))
+    unknown = parts - {"steady", "password", "migration", "attack", "judge", "flood"}
+    if unknown:
+        ap.error(f"--parts: unknown {sorted(unknown)}")
+    result: dict = {"peers": args.peers, "seconds": args.seconds,
+                    "goals": {"updates_per_s": 30, "latency_p99_ms": 10, "bytes_up_per_s_with_headers": 16 * 1024,
+                              "migration_s": 3, "honest_per_s_under_flood": 30}}
+    result["seal_costs"] = costs = seal_costs()
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         # the machine may be shared: say how busy it was when each phase began
-        load_plain = round(os.getloadavg()[0], 2)
-        plain = rows_of(steady(tmp, args.peers, args.seconds), args.peers)
-        load_sealed = round(os.getloadavg()[0], 2)
-        sealed = rows_of(steady(tmp, args.peers, args.seconds, PASSWORD), args.peers)
-        mig = migration(tmp, args.peers)
-        atk = attack(tmp)
-    worst, worst_sealed = worst_of(plain), worst_of(sealed)
-    result = {"peers": args.peers, "seconds": args.seconds, "rows": plain, "worst": worst, "load_average": load_plain,
-              "password": {"rows": sealed, "worst": worst_sealed, "load_average": load_sealed},
-              "seal_costs": costs, "migration": mig,
-              "attack": atk,
-              "goals": {"updates_per_s": 30, "latency_p99_ms": 10, "bytes_up_per_s": 16 * 1024, "migration_s": 3}}
+        if "steady" in parts:
+            load = round(os.getloadavg()[0], 2)
+            rows = rows_of(steady(tmp, args.peers, args.seconds), args.peers)
+            result.update(rows=rows, worst=worst_of(rows), load_average=load)
+        if "password" in parts:
+            load = round(os.getloadavg()[0], 2)
+            rows = rows_of(steady(tmp, args.peers, args.seconds, PASSWORD), args.peers)
+            result["password"] = {"rows": rows, "worst": worst_of(rows), "load_average": load}
+        if "migration" in parts:
+            result["migration"] = migration(tmp, args.peers)
+        if "attack" in parts:
+            result["attack"] = attack(tmp)
+        if "judge" in parts:
+            result["judge"] = judge_costs()
+        if "flood" in parts:
+            result["flood"] = dict(flood(tmp, args.flood_seconds), load_average=round(os.getloadavg()[0], 2))
     if args.json:
         print(json.dumps(result))
         return
+    if "judge" in parts:
+        print("host CPU per member state (decode + kept for drawing), in this process [us]")
+        print(f"{'arena':<8} {'no judge':>9} {'judged':>9} {'ratio':>6}")
+        for arena, c in result["judge"].items():
+            print(f"{arena:<8} {c['off_us']:>9.2f} {c['on_us']:>9.2f} {c['ratio']:>6.2f}")
+        print()
+    if "flood" in parts:
+        f = result["flood"]
+        print(f"flood: a member sends {f['flood_per_s']} valid states/s for {f['seconds']} s; the honest member "
+              f"sends {f['honest_sent_per_s']}/s and the host takes {f['honest_taken_by_host_per_s']}/s of them "
+              f"(goal 30); {f['flood_dropped_unread']} flood datagrams dropped unread, "
+              f"{f['host_skipped_steps']} host steps skipped (load average {f['load_average']})")
+        print()
+    if not {"steady", "password"} <= parts:
+        return
+    plain, worst, load_plain = result["rows"], result["worst"], result["load_average"]
+    sealed, worst_sealed, load_sealed = (result["password"][k] for k in ("rows", "worst", "load_average"))
+    mig, atk = result.get("migration"), result.get("attack")
     print_table(f"{args.peers} peers on loopback, {args.seconds:g} s of steady play (separate processes, box arena; "
                 f"load average {load_plain} at the start)", plain, worst)
     print()
@@ -326,6 +480,8 @@ def main() -> None:
     print(f"{'one state round, 7 peers [us CPU]':<34} {costs['send_round_plain_us']:>9.2f} "
           f"{costs['send_round_sealed_7_us']:>9.2f}")
     print(f"{'reading one datagram [us CPU]':<34} {costs['read_plain_us']:>9.2f} {costs['read_sealed_us']:>9.2f}")
+    if mig is None or atk is None:
+        return
     print()
     print(f"migration: host frozen (SIGSTOP) -> join through player {mig['host_after_silence']} works after "
           f"{mig['silent_host_s']} s; host SIGKILLed -> join through player {mig['host_after_kill']} works after "

@@ -215,6 +215,7 @@ class Peer(TermsMixin):
         self.joins = JoinLimiter((JOIN_RATE, JOIN_BURST), (JOINS_RATE, JOINS_BURST), now)
         self.auth_failures = Buckets(AUTH_FAIL_RATE, AUTH_FAIL_BURST)
         self.counters: Counter = Counter()          # sent, received, bytes_sent, bytes_received
+        self.states_from: Counter = Counter()       # states taken, by sender
         self.dropped: DropLog = DropLog()           # reason -> count (and where from, for -v)
         self.latencies: deque[float] = deque(maxlen=LATENCY_SAMPLES)
         self.host_changes: list[tuple[float, int]] = []
@@ -1037,6 +1038,7 @@ class Peer(TermsMixin):
         self.last_state_seq[key] = m.seq
         self.window.anchor(m.sender, m.seq, now)
         self.counters["states_received"] += 1
+        self.states_from[m.sender] += 1
         self.latencies.append(P.age(now, m.timestamp))
         self.events.append(NetEvent("state", m.sender, m.body))
         return True
@@ -1197,6 +1199,7 @@ class Peer(TermsMixin):
         """Restart the traffic counters and latency samples (a benchmark's window);
         drop reasons are kept."""
         self.counters.clear()
+        self.states_from.clear()
         self.latencies.clear()
 
     def network_report(self) -> dict[str, Any]:
@@ -1208,6 +1211,7 @@ class Peer(TermsMixin):
             "state_rounds": self.counters["state_rounds"],
             "states_sent": self.counters["states_sent"], "states_received": self.counters["states_received"],
             "states_unkeyed": self.counters["states_unkeyed"],
+            "states_received_by_sender": {str(k): v for k, v in sorted(self.states_from.items())},
             "dropped_reasons": dict(sorted(self.dropped.items())),
         }
 
