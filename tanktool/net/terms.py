@@ -27,6 +27,8 @@ from typing import Any
 from ..errors import NetError
 from . import protocol as P
 from .guard import Bucket
+from .limits import TCP_BURST, TCP_RATE
+from .links import Link, NetEvent
 
 #: how long after losing everyone a peer probes their addresses, and how often [s]
 PROBE_TIME = 6.0
@@ -94,8 +96,6 @@ class TermsMixin:
             self.first_round = False
 
     def _dial_probe(self, addr: tuple[str, int], now: float) -> None:
-        from .peer import Link, TCP_BURST, TCP_RATE
-
         sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
         sock.setblocking(False)
         err = sock.connect_ex(addr)
@@ -127,8 +127,6 @@ class TermsMixin:
             return
         mine = (self.term, len(self._others()) + 1)
         if (body.term, body.players) > mine:
-            from .peer import NetEvent
-
             self.step_down_to = link.addr
             self.first_round = False
             self.dropped["stepped_down"] += 1                          # type: ignore[attr-defined]
