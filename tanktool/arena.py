@@ -148,8 +148,9 @@ def load_arena(path: str | os.PathLike) -> ArenaBundle:
         if not (bounds[1] > bounds[0]).all():
             raise ArenaError(f"{manifest}: 'bounds' must have xmin < xmax and zmin < zmax")
     floor_y = doc.get("floor_y", 0.0)
-    if not _finite(floor_y):
-        raise ArenaError(f"{manifest}: 'floor_y' must be a finite number, got {floor_y!r:.60}")
+    if not (_finite(floor_y) and abs(floor_y) <= MAX_COORDINATE):
+        raise ArenaError(f"{manifest}: 'floor_y' must be a finite number within {MAX_COORDINATE:g} m of the origin, "
+                         f"got {floor_y!r:.60}")
     return ArenaBundle(name, path, walls, bounds, spawns, float(floor_y), doc)
 
 

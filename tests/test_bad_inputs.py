@@ -56,12 +56,16 @@ def test_a_far_spawn_is_refused_at_load_naming_the_spawn(box_copy, value):
     assert "B102" in res.output and "spawn 1 must be" in res.output, res.output
 
 
-def test_far_bounds_are_refused(box_copy):
+def test_far_bounds_and_floor_are_refused(box_copy):
     from tanktool.arena import load_arena
 
     toml = box_copy / "arena.toml"
-    toml.write_text(toml.read_text().replace("[60.0, 60.0]", "[1e308, 60.0]"))
+    text = toml.read_text()
+    toml.write_text(text.replace("[60.0, 60.0]", "[1e308, 60.0]"))
     with pytest.raises(TanktoolError, match="arena.toml: 'bounds'.*beyond"):
+        load_arena(box_copy)
+    toml.write_text(text.replace("floor_y = 0.0", "floor_y = -1e308"))
+    with pytest.raises(TanktoolError, match="arena.toml: 'floor_y' must be a finite number within 1e\\+06 m"):
         load_arena(box_copy)
 
 
@@ -173,7 +177,8 @@ def test_check_of_a_model_and_of_missing_names(tmp_path, monkeypatch):
     assert "A101" not in res.output
     res = run("check", "fort", "mytank")
     assert res.exit_code == 2, res.output
-    assert "error: fort: no such file or folder" in res.output and "error: mytank: no such file" in res.output
+    assert "error: fort: no such file or folder (the bundled arena fort is " in res.output
+    assert "error: mytank: no such file or folder\n" in res.output
     assert "0 errors" not in res.output and "in 0 files" not in res.output, res.output
     assert "nothing checked: 2 paths could not be read" in res.output
 

@@ -88,11 +88,24 @@ def _is_walls_file(p: Path) -> bool:
     return p.name == "walls.txt" or p.name.endswith(".walls.txt") or p.name.endswith("_walls.txt")
 
 
+def _bundled_hint(p: Path) -> str:
+    """For a bare name that is a bundled arena or vehicle (``check fort``): where it is."""
+    if len(p.parts) != 1:
+        return ""
+    from ..content import bundled_dir
+
+    for kind in ("arenas", "vehicles"):
+        folder = bundled_dir(kind)
+        if folder is not None and (folder / p.name).is_dir():
+            return f" (the bundled {kind[:-1]} {p.name} is {folder / p.name}: give that path)"
+    return ""
+
+
 def discover(paths: list[Path]) -> Targets:
     t = Targets()
     for p in paths:
         if not p.exists():
-            t.unreadable.append(f"{p}: no such file or folder")
+            t.unreadable.append(f"{p}: no such file or folder{_bundled_hint(p)}")
         elif p.is_file():
             if not os.access(p, os.R_OK):
                 t.unreadable.append(f"{p}: cannot be read (permission denied)")
