@@ -95,3 +95,19 @@ def test_import_prints_the_problems_it_leaves(tmp_path, monkeypatch):
     r = CliRunner().invoke(cli, ["-q", "import-arena", str(src), "-o", str(tmp_path / "c")])
     assert r.exit_code == 0
     assert "warning:" in r.output and "cross each other, the first at (1.50, 2.50)" in r.output
+
+
+def test_a_pocket_closed_by_thin_walls_alone_is_sealed():
+    """Three fences meeting in a small triangle: the copies facing into it go (check
+    takes the pocket as solid: its walls' normals cancel), the copies facing out stay."""
+    free = shapely.box(0, 0, 20, 20)
+    outline = _w([0, 0, 20, 0], [20, 0, 20, 20], [20, 20, 0, 20], [0, 20, 0, 0])
+    thin = _w([4, 5, 10, 5], [10, 5, 7, 9], [7, 9, 4, 5], [12, 12, 16, 12])
+    r = Repairs()
+    segs, n_thin = repair_walls(outline, thin, free, TOL, r)
+    assert r.sealed == 3 and n_thin == 5 and len(segs) == 9
+    tri = shapely.Polygon([(4, 5), (10, 5), (7, 9)])
+    d = segs[4:, 1] - segs[4:, 0]
+    front = segs[4:].mean(axis=1) + 0.01 * np.stack([-d[:, 1], d[:, 0]], axis=1) / np.hypot(*d.T)[:, None]
+    assert not shapely.contains_xy(tri, *front.T).any()
+    assert any("pockets" in line for line in r.remarks())

@@ -6,7 +6,9 @@ crossing): candidate pairs from an STR tree, classified all at once with numpy.
 ``import-arena`` runs the same test on the walls it is about to write
 (:func:`repair_walls`): what it can repair it repairs -- repeated and overlapping
 walls on one line become one wall per stretch, a wall whose normal points away
-from the free space it bounds is turned round -- and it reports what is left, so an
+from the free space it bounds is turned round, thin walls facing into a pocket closed
+by thin walls alone (which check takes as solid) are left out -- and it reports what
+is left, so an
 import never hands over walls that fail their own check without saying so.
 
 Walls here are (n, 2, 2) segments with Direction +1 (the free space on their left),
@@ -160,6 +162,7 @@ class Repairs:
     turned: int = 0      # walls turned round to face their free space
     crossings: list[np.ndarray] = field(default_factory=list)  # X crossings left, a point each
     overlaps: int = 0    # repeats / overlaps left (rounding beyond the tolerance)
+    sealed: int = 0      # thin walls facing into pockets closed by thin walls, left out
 
     def remarks(self) -> list[str]:
         """One line per kind of repair done or problem left, for import-arena to print."""
@@ -168,6 +171,9 @@ class Repairs:
             out.append(f"{self.merged} repeated or overlapping wall(s) joined into one")
         if self.turned:
             out.append(f"{self.turned} wall(s) turned round to face their free space")
+        if self.sealed:
+            out.append(f"{self.sealed} thin wall(s) facing into pockets closed by thin walls left out "
+                       "(the pockets are taken as solid)")
         if self.overlaps:
             out.append(f"{self.overlaps} pair(s) of walls still repeat or overlap each other "
                        "(check reports them as A202/A203)")
@@ -195,14 +201,38 @@ def repair_walls(outline: np.ndarray, thin: np.ndarray, free, tol: float,
         if merged_thin:
             thin = joined
             repairs.merged += 2 * merged_thin
-    segs = np.concatenate([outline, thin, thin[:, ::-1]]) if len(thin) else outline
+    both = np.concatenate([thin, thin[:, ::-1]]) if len(thin) else thin
+    both, sealed = _seal_pockets(both, max(4 * tol, 1e-3))
+    n_thin = len(both)
+    segs = np.concatenate([outline, both]) if len(both) else outline
     repairs.turned += turned
+    repairs.sealed += sealed
     repairs.merged += merged
     live = np.flatnonzero(np.hypot(*(segs[:, 1] - segs[:, 0]).T) > 0)
     left = classify_pairs(segs, np.ones(len(segs)), live, tol)
     repairs.overlaps += len(left.repeat[0]) + len(left.overlap[0])
     repairs.crossings.extend(left.cross[2])
-    return segs, 2 * len(thin)
+    return segs, n_thin
+
+
+def _seal_pockets(both: np.ndarray, probe: float) -> tuple[np.ndarray, int]:
+    """Thin walls (written both ways) that face into a pocket closed by thin walls
+    alone (three fences meeting in a small triangle) left out: nothing says such a
+    pocket is free space, ``check`` counts it as solid (its walls' normals cancel
+    out) and no tank gets in.  Returns (walls, how many were left out)."""
+    if len(both) < 6:
+        return both, 0
+    noded = shapely.union_all(shapely.linestrings(both))
+    pockets = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
+    if len(pockets) == 0:
+        return both, 0
+    d = both[:, 1] - both[:, 0]
+    n = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)[:, None]
+    front = shapely.points(both.mean(axis=1) + probe * n)
+    into = np.zeros(len(both), dtype=bool)
+    _, hit = shapely.STRtree(front).query(pockets, predicate="contains_properly")
+    into[hit] = True
+    return both[~into], int(into.sum())
 
 
 def pair_tolerance(seg: np.ndarray) -> float:
