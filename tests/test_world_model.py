@@ -4,9 +4,11 @@ FlatGround at its floor's real height (not 0), and the simulation's callers hold
 
 from __future__ import annotations
 
+import math
 import re
 from pathlib import Path
 
+import numpy as np
 import trimesh
 from click.testing import CliRunner
 
@@ -63,3 +65,20 @@ def test_no_ground_is_none_branches_left():
             for p in sorted((ROOT / "tanktool" / pkg).rglob("*.py"))
             for k, line in enumerate(p.read_text().splitlines(), 1) if pattern.search(line)]
     assert not hits, hits
+
+
+def test_a_spawn_where_the_ground_has_no_level_is_put_on_the_nearest_node():
+    info = load_match_arena("fort")
+    g = info.ground
+    from scipy import ndimage
+
+    # cells with no level at all, nor in the cells around them
+    holes = np.argwhere(~ndimage.maximum_filter(np.isfinite(g.h).any(axis=0), size=3))
+    i, j = holes[len(holes) // 2]
+    x, z = g.ox + (j + 0.5) * g.cell, g.oz + (i + 0.5) * g.cell
+    assert g.locate(x, z) < 0 and g.near_level(x, z, 0.0) < 0
+    spawns = np.array([[x, z, 0.0, -2.0]] + info.spawns[1:].tolist())    # 2 m under the surface
+    w = World(info.walls, [load_tank_spec("light")], spawns[:1], bounds=info.bounds, ground=g)
+    t = w.tanks[0]
+    assert g.locate(t.x, t.z) >= 0 and math.hypot(t.x - x, t.z - z) < 10.0
+    assert abs(t.y - g.height(t.x, t.z, t.level)) < 1e-9 and g.node_height(t.level, *g.cell_of(t.x, t.z)) is not None

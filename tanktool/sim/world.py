@@ -35,6 +35,7 @@ from ..nav.quadtree import WallQuadtree
 from .collide import QuadtreeIndex, WallIndex, WallSet, shell_hits_tank, tank_contact, wall_contacts
 from .commands import Command
 from .flat_ground import FlatGround
+from .on_ground import put_back
 from .resolve import SLOP, correct_walls, pair_impulse, separate_pair, wall_impulse
 from .rules import DEFAULT as DEFAULT_RULES, GRAVITY, MatchState, Rules
 from .weapons import Shell, fire, fly, stop_fraction
@@ -673,8 +674,10 @@ class World:
         """Put a tank on the ground under it: its level (the one nearest ``y``), height
         and tilt (nothing on a flat arena).  For a tank placed from outside the step (a
         network peer's state, a test): the nearest level to where it was keeps it on
-        its deck or under it."""
+        its deck or under it.  Where the ground has no level under it (a spawn point in
+        a hole), it is put on the nearest node first (sim/on_ground.py)."""
         g = self.ground
+        put_back(g, t, y)
         lv = g.near_level(t.x, t.z, y) if y is not None else g.locate(t.x, t.z)
         if lv < 0:
             lv = g.locate(t.x, t.z, y)
