@@ -103,12 +103,11 @@ def fits(world: Any, index: int, x: float, z: float, heading: float, y: float) -
     there (ground under it on some level, no wall through its hull).  Leaves it there."""
     t = world.tanks[index]
     t.place(x, z, heading)
-    ground = getattr(world, "ground", None)
-    if ground is not None:
-        level = ground.locate(t.x, t.z, y)
-        if level < 0:
-            return False
-        t.level, t.y = level, ground.height(t.x, t.z, level)
+    ground = world.ground        # every world has one (a flat arena's: sim.flat_ground.FlatGround)
+    level = ground.locate(t.x, t.z, y)
+    if level < 0:
+        return False
+    t.level, t.y = level, ground.height(t.x, t.z, level)
     x0, z0 = world.bounds[0]
     x1, z1 = world.bounds[1]
     if not (x0 < t.x < x1 and z0 < t.z < z1):
