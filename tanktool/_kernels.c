@@ -12,8 +12,9 @@
  *       all int64; minh, asmin, asmax updated in place (Recast's rcFilterLedgeSpans)
  *   chamfer(link, dist, limit)
  *       link: int64 (n, 4); dist: int32 (n,), the starting values, relaxed in place
- *   raster_gentle(tri, abc, nz, nx, ch, max_steps, row_lo, row_hi) -> (col, tri, smin, smax) as int64 bytes
- *       (the cells of rows row_lo .. row_hi - 1 only)
+ *   raster(tri, abc, nz, nx, ch, max_steps, row_lo, row_hi, steep) -> (col, tri, smin, smax) as int64 bytes
+ *       (the cells of rows row_lo .. row_hi - 1 only); steep: the triangles' exact sections
+ *       (heightfield._cells_exact) instead of their planes (_cells_plane; abc unused)
  *       tri: float64 (n, 9) x0 x1 x2 z0 z1 z2 y0 y1 y2 in grid units (y in metres);
  *       abc: float64 (n, 3) the plane y = A + B x + C z of each triangle
  *   components(link, label)
@@ -263,10 +264,116 @@ static inline void quantise(double ymin, double ymax, double ch, i64 maxh, i64 *
     *hi = (i64)b;
 }
 
+
+/* heightfield._sections: the section of a triangle by the line u = a in the (u, v)
+ * plane (u, v, y: its vertices in their own order) */
+typedef struct {
+    double vlo, ylo, vhi, yhi, ymn, ymx;
+} Section;
+
+static inline void take(Section *s, double vv, double yy) {
+    if (vv < s->vlo) s->ylo = yy;
+    if (vv > s->vhi) s->yhi = yy;
+    s->vlo = mind(s->vlo, vv);
+    s->vhi = maxd(s->vhi, vv);
+    s->ymn = mind(s->ymn, yy);
+    s->ymx = maxd(s->ymx, yy);
+}
+
+static int section(const double *U, const double *V, const double *Y, double a, Section *s) {
+    s->vlo = INFINITY;
+    s->vhi = -INFINITY;
+    s->ylo = s->yhi = 0.0;
+    s->ymn = INFINITY;
+    s->ymx = -INFINITY;
+    for (int k = 0; k < 3; ++k)
+        if (U[k] == a) take(s, V[k], Y[k]);
+    static const int E[3][2] = {{0, 1}, {1, 2}, {2, 0}};
+    for (int e = 0; e < 3; ++e) {
+        const int i = E[e][0], j = E[e][1];
+        const double du = U[j] - U[i];
+        if ((U[i] - a) * (U[j] - a) < 0) {
+            const double t = (a - U[i]) / du;
+            take(s, V[i] + t * (V[j] - V[i]), Y[i] + t * (Y[j] - Y[i]));
+        }
+    }
+    return isfinite(s->vlo);
+}
+
+/* growable scratch of doubles */
+typedef struct {
+    double *v;
+    Py_ssize_t cap;
+} Scratch;
+
+static double *scratch(Scratch *s, Py_ssize_t n) {
+    if (n > s->cap) {
+        double *v = realloc(s->v, n * sizeof(double));
+        if (!v) return NULL;
+        s->v = v;
+        s->cap = n;
+    }
+    return s->v;
+}
+
+/* heightfield._cells_exact for one (triangle, row) pair: the y range over Q's vertices
+ * in each cell and the triangle's sections by the cell's two x lines, clipped to the
+ * slab [z0, z1] */
+static int cells_exact(Cells *out, Scratch *buf, i64 t, const double *X, const double *Z, const double *Y, i64 row,
+                       i64 nx, i64 j0, i64 ncell, double z0, double z1, const double *qx, const double *qy, double ch,
+                       i64 maxh) {
+    double *lo_l = scratch(buf, 4 * (ncell + 1));
+    if (!lo_l) return 0;
+    double *hi_l = lo_l + (ncell + 1), *ymin = hi_l + (ncell + 1), *ymax = ymin + (ncell + 1);
+    const double xlo = mind(mind(X[0], X[1]), X[2]), xhi = maxd(maxd(X[0], X[1]), X[2]);
+    const double a0 = ceil(xlo), a1 = floor(xhi);
+    for (i64 k = 0; k <= ncell; ++k) {
+        const double a = (double)(j0 + k);
+        Section s;
+        int ok = a >= a0 && a <= a1 && section(X, Z, Y, a, &s);
+        lo_l[k] = INFINITY;
+        hi_l[k] = -INFINITY;
+        if (!ok) continue;
+        const int vertical = s.vhi == s.vlo;
+        if (vertical) {
+            if (s.vlo >= z0 && s.vlo <= z1) {
+                lo_l[k] = s.ymn;
+                hi_l[k] = s.ymx;
+            }
+            continue;
+        }
+        const double za = maxd(s.vlo, z0), zb = mind(s.vhi, z1);
+        if (!(za <= zb)) continue;
+        const double slope = (s.yhi - s.ylo) / (s.vhi - s.vlo);
+        const double ya = s.ylo + (za - s.vlo) * slope, yb = s.ylo + (zb - s.vlo) * slope;
+        lo_l[k] = mind(ya, yb);
+        hi_l[k] = maxd(ya, yb);
+    }
+    for (i64 k = 0; k < ncell; ++k) {
+        ymin[k] = mind(lo_l[k], lo_l[k + 1]);
+        ymax[k] = maxd(hi_l[k], hi_l[k + 1]);
+    }
+    for (int q = 0; q < 5; ++q) {  /* Q's vertices, each in the cell of its column */
+        const double jj = floor(qx[q]) - (double)j0;
+        if (jj >= 0 && jj < (double)ncell) {
+            const i64 k = (i64)jj;
+            ymin[k] = mind(ymin[k], qy[q]);
+            ymax[k] = maxd(ymax[k], qy[q]);
+        }
+    }
+    for (i64 k = 0; k < ncell; ++k) {
+        if (!isfinite(ymin[k])) continue;
+        i64 s0, s1;
+        quantise(ymin[k], ymax[k], ch, maxh, &s0, &s1);
+        if (!cells_push(out, row * nx + j0 + k, t, s0, s1)) return 0;
+    }
+    return 1;
+}
+
 /* heightfield._rows and _cells_plane for one gentle triangle (y = A + B x + C z in grid
  * units), the same arithmetic in the same order so that the spans are identical */
-static int raster_one(Cells *out, i64 t, const double *X, const double *Z, const double *Y, double A, double B,
-                      double C, i64 row_lo, i64 row_hi, i64 nx, double ch, i64 maxh) {
+static int raster_one(Cells *out, Scratch *buf, int steep, i64 t, const double *X, const double *Z, const double *Y,
+                      double A, double B, double C, i64 row_lo, i64 row_hi, i64 nx, double ch, i64 maxh) {
     double z[3] = {Z[0], Z[1], Z[2]}, x[3] = {X[0], X[1], X[2]}, y[3] = {Y[0], Y[1], Y[2]};
     static const int net[3][2] = {{0, 1}, {1, 2}, {0, 1}};  /* _sort3's network */
     for (int k = 0; k < 3; ++k) {
@@ -325,7 +432,11 @@ static int raster_one(Cells *out, i64 t, const double *X, const double *Z, const
             const double jf = floor(lo);
             const double jl = hi > lo ? ceil(hi) - 1 : jf;
             const double j0f = maxd(jf, 0.0), j1f = mind(jl, (double)(nx - 1));
-            if ((z1 > z0 || flat_z) && j1f >= j0f) {
+            if ((z1 > z0 || flat_z) && j1f >= j0f && steep) {
+                if (!cells_exact(out, buf, t, X, Z, Y, row, nx, (i64)j0f, (i64)(j1f - j0f + 1), z0, z1, qx, qy, ch,
+                                 maxh))
+                    return 0;
+            } else if ((z1 > z0 || flat_z) && j1f >= j0f) {
                 const i64 j0 = (i64)j0f, ncell = (i64)(j1f - j0f + 1);
                 const double band = floor(ylo / ch);
                 if (band == floor(yhi / ch)) {  /* the whole row within one cell height */
@@ -359,16 +470,19 @@ static PyObject *as_bytes(const i64 *a, Py_ssize_t n) {
     return PyBytes_FromStringAndSize(n ? (const char *)a : "", n * 8);
 }
 
-static PyObject *raster_gentle(PyObject *self, PyObject *args) {
+static PyObject *raster(PyObject *self, PyObject *args) {
     Py_buffer tri, abc;
     i64 nz, nx, maxh, row_lo, row_hi;
     double ch;
-    if (!PyArg_ParseTuple(args, "y*y*LLdLLL", &tri, &abc, &nz, &nx, &ch, &maxh, &row_lo, &row_hi)) return NULL;
+    int steep;
+    if (!PyArg_ParseTuple(args, "y*y*LLdLLLp", &tri, &abc, &nz, &nx, &ch, &maxh, &row_lo, &row_hi, &steep))
+        return NULL;
     if (row_lo < 0) row_lo = 0;
     if (row_hi > nz) row_hi = nz;
     const Py_ssize_t n = tri.len / (9 * 8);
     PyObject *ret = NULL;
     Cells out = {0};
+    Scratch buf = {0};
     int ok = 1;
     if (!need(&tri, 9 * n, 8, "tri") || !need(&abc, 3 * n, 8, "abc")) goto done;
     {
@@ -376,8 +490,8 @@ static PyObject *raster_gentle(PyObject *self, PyObject *args) {
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t t = 0; t < n && ok; ++t) {
             const double *v = T + 9 * t; /* x0 x1 x2 z0 z1 z2 y0 y1 y2 */
-            ok = raster_one(&out, t, v, v + 3, v + 6, P[3 * t], P[3 * t + 1], P[3 * t + 2], row_lo, row_hi, nx, ch,
-                            maxh);
+            ok = raster_one(&out, &buf, steep, t, v, v + 3, v + 6, P[3 * t], P[3 * t + 1], P[3 * t + 2], row_lo,
+                            row_hi, nx, ch, maxh);
         }
         Py_END_ALLOW_THREADS
     }
@@ -388,6 +502,7 @@ static PyObject *raster_gentle(PyObject *self, PyObject *args) {
     ret = Py_BuildValue("(NNNN)", as_bytes(out.col, out.n), as_bytes(out.tri, out.n), as_bytes(out.smin, out.n),
                         as_bytes(out.smax, out.n));
 done:
+    free(buf.v);
     free(out.col);
     free(out.tri);
     free(out.smin);
@@ -510,7 +625,7 @@ static PyMethodDef methods[] = {
     {"link_spans", link_spans, METH_VARARGS, "links between open spans (see nav/kernels.py)"},
     {"ledge_scan", ledge_scan, METH_VARARGS, "the ledge filter's scan of neighbour columns"},
     {"chamfer", chamfer, METH_VARARGS, "chamfer distance relaxed to its fixed point, in place"},
-    {"raster_gentle", raster_gentle, METH_VARARGS, "spans of gentle triangles, as heightfield._cells_plane"},
+    {"raster", raster, METH_VARARGS, "spans of triangles, as heightfield._cells_plane / _cells_exact"},
     {"components", components, METH_VARARGS, "component labels (smallest span index), in place"},
     {"merge_spans", merge_spans, METH_VARARGS, "the merged spans of sorted packed keys"},
     {NULL, NULL, 0, NULL},

@@ -469,22 +469,25 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
         if len(group) == 0:
             continue
         Xg, Zg, Yg = ([a[group] for a in arr] for arr in (X, Z, Y))
-        if gentle[group[0]]:
+        steep = not gentle[group[0]]
+        if steep:
+            A = B = C = np.zeros(len(group))
+        else:
             ny_ = n_y[group]
             B, C = -n_x[group] / ny_, -n_z[group] / ny_
             A = Yg[0] - B * Xg[0] - C * Zg[0]
-            if kern is not None:  # the same spans in one pass over the triangles
-                res = kern.raster_gentle(np.ascontiguousarray(np.column_stack(Xg + Zg + Yg)),
-                                         np.ascontiguousarray(np.column_stack([A, B, C])), nz, nx, float(ch),
-                                         MAX_HEIGHT_STEPS, *(rows or (0, nz)))
-                c_col, c_tri, smin, smax = (np.frombuffer(b, dtype=np.int64) for b in res)
-                out.append((c_col, group[c_tri], smin, smax))
-                continue
-            pairs = _rows(Xg, Zg, Yg, nz, nx, rows)
-            p, j, smin, smax = _cells_plane(pairs, A, B, C, ch)
-        else:
-            pairs = _rows(Xg, Zg, Yg, nz, nx, rows)
+        if kern is not None:  # the same spans in one pass over the triangles
+            res = kern.raster(np.ascontiguousarray(np.column_stack(Xg + Zg + Yg)),
+                              np.ascontiguousarray(np.column_stack([A, B, C])), nz, nx, float(ch), MAX_HEIGHT_STEPS,
+                              *(rows or (0, nz)), steep)
+            c_col, c_tri, smin, smax = (np.frombuffer(b, dtype=np.int64) for b in res)
+            out.append((c_col, group[c_tri], smin, smax))
+            continue
+        pairs = _rows(Xg, Zg, Yg, nz, nx, rows)
+        if steep:
             p, j, smin, smax = _cells_exact(pairs, Xg, Zg, Yg, ch)
+        else:
+            p, j, smin, smax = _cells_plane(pairs, A, B, C, ch)
         out.append((pairs.row[p] * nx + j, group[pairs.tri[p]], smin, smax))
     if not out:
         return _merge(*(np.zeros(0, dtype=np.int64) for _ in range(5)), merge_steps), 0
