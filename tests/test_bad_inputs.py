@@ -394,3 +394,10 @@ def test_zero_area_faces_raise_no_numpy_warning(tmp_path):
         warnings.simplefilter("error")
         res = run("import-vehicle", str(tank), "-o", str(tmp_path / "tank"), "-q")
     assert res.exit_code == 0, res.output
+
+
+def test_no_arguments_still_shows_the_help():
+    res = run()
+    assert "Usage: tanktool" in res.output and "Commands:" in res.output and "error:" not in res.output
+    res = run("import-arena")
+    one_error_line(res, "Missing argument 'MODEL'", "tanktool import-arena --help")

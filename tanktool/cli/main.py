@@ -54,6 +54,10 @@ class OneLineUsageError(click.UsageError):
         click.echo(f"error: {' '.join(self.format_message().split())}{where}", err=True)
 
 
+#: click's "no arguments: show the help" (a UsageError since click 8.2): help, not an error
+_HELP = getattr(click.exceptions, "NoArgsIsHelpError", ())
+
+
 def _one_line(e: click.UsageError) -> OneLineUsageError:
     one = OneLineUsageError(e.format_message(), e.ctx)
     one.exit_code = e.exit_code
@@ -102,7 +106,7 @@ class LazyGroup(click.Group):
     def make_context(self, info_name, args, parent=None, **extra) -> click.Context:
         try:  # the group's own options (``tanktool --bogus``)
             return super().make_context(info_name, args, parent=parent, **extra)
-        except OneLineUsageError:
+        except (OneLineUsageError, _HELP):
             raise
         except click.UsageError as e:
             raise _one_line(e) from e
@@ -110,7 +114,7 @@ class LazyGroup(click.Group):
     def invoke(self, ctx: click.Context):
         try:
             return super().invoke(ctx)
-        except OneLineUsageError:
+        except (OneLineUsageError, _HELP):
             raise
         except click.UsageError as e:  # a sub-command's options, or no such command
             raise _one_line(e) from e
