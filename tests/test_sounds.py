@@ -79,3 +79,13 @@ def test_no_audio_device_is_one_line_and_the_game_goes_on_silent(make_app, monke
     lines = [line for line in err.splitlines() if line.strip()]
     assert lines == [lines[0]] and lines[0].startswith("sound: off, no sound device (ALSA: Couldn't open")
     assert "goes on silent" in lines[0] and "ALSA lib" not in err
+
+
+def test_hits_and_kills_are_layered_and_louder():
+    s = GameSession("box", bots=1, seed=4, player=True)
+    audio = GameAudio(s, Sound(device=False))
+    audio.on_events([Event(1, 0.1, "kill", 1, 10.0, 20.0, 0)])
+    kill = [v for v in audio.sound.voices.values() if not v.loop]
+    assert {v.name for v in kill} == {"explosion", "shot", "impact"} and max(v.gain for v in kill) > 1.0
+    assert min(v.pitch for v in kill) < 0.6                      # the deep crack under the blast
+    audio.close()

@@ -16,8 +16,14 @@ from ..sim.world import Event
 from .session import GameSession
 
 EAR_HEIGHT = 2.0
-#: one-shot sound per event kind
-EVENT_SOUNDS = {"shot": "shot", "hit": "impact", "kill": "explosion", "wall_bump": "impact"}
+#: one-shot sounds per event kind, layered: (sound, gain, pitch); a hit is the ring of
+#: armour over a dull thump, a kill the blast over a deep crack
+EVENT_SOUNDS = {
+    "shot": (("shot", 1.0, 1.0),),
+    "hit": (("impact", 1.4, 1.0), ("shot", 0.8, 0.6)),
+    "kill": (("explosion", 1.8, 1.0), ("shot", 1.2, 0.45), ("impact", 0.8, 0.7)),
+    "wall_bump": (("impact", 0.7, 0.8),),
+}
 
 
 class GameAudio:
@@ -38,12 +44,15 @@ class GameAudio:
 
     def on_events(self, events: Sequence[Event]) -> None:
         for e in events:
-            name = EVENT_SOUNDS.get(e.kind)
-            if name is None or (e.kind == "wall_bump" and e.value < 5000.0):
+            layers = EVENT_SOUNDS.get(e.kind)
+            if layers is None or (e.kind == "wall_bump" and e.value < 5000.0):
                 continue          # gentle scrapes are not worth a clank
-            v = self.sound.play(name)
-            self.sound.set_source(v, (e.x, 1.5, e.z))
-            self.sound.set_range(v, 4.0, 300.0 if e.kind in ("shot", "kill") else 150.0)
+            for name, gain, pitch in layers:
+                v = self.sound.play(name)
+                self.sound.set_source(v, (e.x, 1.5, e.z))
+                self.sound.set_range(v, 4.0, 300.0 if e.kind in ("shot", "kill") else 150.0)
+                self.sound.set_gain(v, gain)
+                self.sound.set_pitch(v, pitch)
 
     def update(self, alpha: float = 1.0) -> None:
         s = self.session
