@@ -418,8 +418,12 @@ def floor_region(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
     return _winding_region(seg, tolerance)
 
 
-def _winding_region(seg: np.ndarray, tolerance: float):
-    """Points of positive winding number about directed segments (region on their left)."""
+def _winding_region(seg: np.ndarray, tolerance: float, inside: Callable[[np.ndarray], np.ndarray] | None = None):
+    """Points of positive winding number about directed segments (region on their left).
+
+    ``inside``, when given, says for (k, 2) points strictly inside the faces of the
+    segments' arrangement which are in the region, instead of counting crossings with
+    every segment (a mask of cells knows it by looking a point's cell up)."""
     if len(seg) == 0:
         return shapely.Polygon()
     lines = shapely.linestrings(seg.reshape(-1, 2), indices=np.repeat(np.arange(len(seg)), 2))
@@ -434,6 +438,8 @@ def _winding_region(seg: np.ndarray, tolerance: float):
     if len(faces) == 0:
         return shapely.Polygon()
     rep = shapely.get_coordinates(shapely.point_on_surface(faces))
+    if inside is not None:
+        return shapely.union_all(faces[inside(rep)])
     winding = np.zeros(len(rep))
     # crossing number with signs, a block of faces at a time to bound memory
     block = max(1, 2_000_000 // max(1, len(a)))

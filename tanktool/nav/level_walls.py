@@ -111,7 +111,14 @@ def cells_polygon(mask: np.ndarray, origin: np.ndarray, cell: float, tolerance: 
     if len(seg) == 0:
         return shapely.Polygon()
     seg = np.asarray(origin, dtype=np.float64) + seg * cell
-    return cut._winding_region(seg, tolerance)
+
+    def in_cells(p: np.ndarray) -> np.ndarray:
+        # the faces of the cells' outline are unions of whole cells: a point inside one
+        # is in the region when its cell is (no crossing count over every edge)
+        ij = np.floor((p - origin) / cell).astype(np.int64)
+        return m[ij[:, 1] + 1, ij[:, 0] + 1]
+
+    return cut._winding_region(seg, tolerance, in_cells)
 
 
 class ExactCuts:
