@@ -123,7 +123,40 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
         valid = int(g.grid.valid.sum())
         echo(f"  navgrid: {g.grid.nz} x {g.grid.nx} nodes{f' on {g.grid.levels} levels' if g.grid.levels > 1 else ''} "
              f"at {g.cell:g} m, clearance {g.clearance:g} m ({g.clearance_source}): {valid:,} valid")
+        echo(f"  holds at once: {_holds(result)}")
     echo(f"  wrote {result.path} in {result.seconds:.2f} s")
+
+
+#: play's largest --bots: the count of tanks an arena holds is given up to this
+HOLDS_LIMIT = 64
+
+
+def _holds(result) -> str:
+    """How many tanks of each bundled vehicle the arena holds at once (its spawn points
+    and free places of its ground a tank's length apart: sim/extra_spawns.py)."""
+    from ..errors import TanktoolError
+    from ..sim.extra_spawns import holds
+    from ..sim.match import load_match_arena, load_tank_spec
+
+    info = load_match_arena(result.path)
+    parts = []
+    too_big = {n for n, _ in (getattr(result.levels, "too_big", None) or [])}
+    for name in _vehicle_names():
+        if name in too_big:
+            parts.append(f"{name} 0 (too big)")
+            continue
+        try:
+            (_, n), = holds(info, [load_tank_spec(name)], HOLDS_LIMIT)
+        except TanktoolError:
+            n = 0
+        parts.append(f"{name} {n}{'+' if n >= HOLDS_LIMIT else ''}")
+    return ", ".join(parts) if parts else "no bundled vehicle"
+
+
+def _vehicle_names() -> list[str]:
+    from ..content import bundled_names
+
+    return sorted(bundled_names("vehicles"))
 
 
 def _describe_params(params, where: dict[str, str]) -> str:

@@ -102,3 +102,20 @@ def extend(world: "World", tanks: int, radius: float, length: float, vehicle: st
         raise ArenaError(f"the arena holds {len(world.spawns)} tanks of {vehicle} at once "
                          f"({len(world.spawns) - len(more)} spawn points and {len(more)} free places a tank's length "
                          f"apart), {tanks} asked for")
+
+
+def holds(info: Any, specs: list, limit: int = 64) -> list[tuple[str, int]]:
+    """(vehicle, how many of it the arena ``info`` (``match.ArenaInfo``) holds at once,
+    up to ``limit``) for each TankSpec of ``specs``."""
+    from .world import World
+
+    out = []
+    for spec in specs:
+        w = World(info.walls, [spec], info.spawns[:1] if len(info.spawns) else info.spawns, bounds=info.bounds,
+                  ground=info.ground)
+        w.spawns, w.spawn_y = w.spawns[:0], w.spawn_y[:0]   # count from the arena's own spawn points
+        for row in np.asarray(info.spawns, dtype=np.float64).reshape(len(info.spawns), -1):
+            w.spawns.append((float(row[0]), float(row[1]), float(row[2])))
+            w.spawn_y.append(float(row[3]) if len(row) > 3 and math.isfinite(row[3]) else None)
+        out.append((spec.name, min(capacity(w, spec.radius, spec.box[2] - spec.box[0], limit), limit)))
+    return out
