@@ -395,9 +395,10 @@ def plot_scale(rows: list[dict], path: Path) -> None:
     bottom = np.zeros(len(ok))
     names = [s for s in STAGES if any(r["stages"].get(s, 0) > 0.03 * r["seconds"] for r in ok)]
     x = np.arange(len(ok))
-    for s in names:  # each stage's share of its import
+    colours = plt.get_cmap("tab20").colors
+    for k, s in enumerate(names):  # each stage's share of its import
         v = 100 * np.array([r["stages"].get(s, 0) for r in ok]) / sec
-        a1.bar(x, v, bottom=bottom, label=s)
+        a1.bar(x, v, bottom=bottom, label=s, color=colours[(2 * k) % 20 + (2 * k) // 20])
         bottom += v
     a1.bar(x, 100 - bottom, bottom=bottom, label="the rest", color="0.8")
     a1.set_xticks(x, [f"{r['size_m']:g} m\n{r['seconds']:.1f} s" for r in ok])
