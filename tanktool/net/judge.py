@@ -210,6 +210,12 @@ class Judge:
         c, n = self.config, shot.tank
         r = self.record(n)
         last = r.last
+        if last is None and r.alive:
+            # no state yet (the first may be lost or slower than the shot): a tank starts
+            # at a spawn point, so that is where its first shots may come from
+            if shot.t > now + c.ahead:
+                return "ahead"
+            return None if self.near_spawn(shot.x, shot.z) and self.on_surface(shot.x, shot.z) else "pose"
         if not r.alive or last is None or not last.alive:
             return "dead"
         if shot.t > now + c.ahead:
