@@ -7,6 +7,7 @@ import re
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 
@@ -346,19 +347,38 @@ def test_a_gltf_with_percent_encoded_uris_imports_and_its_bundle_imports_again(t
 # ----------------------------------------------------------------- BZFlag worlds from the wild
 
 def test_a_bzflag_world_as_bzflag_reads_it():
-    """_wallHeight 0 and a teleporter of border 0 are valid BZFlag; a mesh is built; a
-    group, its definition and a sphere are counted by name in what is left out."""
+    """_wallHeight 0 and a teleporter of border 0 are valid BZFlag; a mesh and a group
+    (an instance of a define) are built; a sphere is counted by name in what is left out."""
     from tanktool.formats.bzw import load_scene, parse_bzw
 
     path = ROOT / "tests" / "data" / "bzw" / "wild_world.bzw"
     world = parse_bzw(path)
     assert world.walls is False and world.wall_height == 0
     assert [o.kind for o in world.objects] == ["box"]          # the frameless teleporter has nothing solid
-    assert len(world.meshes) == 1 and len(world.meshes[0][1]) == 10   # 5 quads
+    assert len(world.meshes) == 2 and len(world.meshes[0][1]) == 10   # the mesh: 5 quads
     assert world.meshes[0][0][:, 1].min() == 40.0                      # shifted by 100 in y
-    assert sorted(world.left_out) == ["group (instance of a definition)", "group definition", "sphere"]
-    assert load_scene(path).metadata["left_out"] == [
-        "1 group (instance of a definition) (line 54)", "1 group definition (line 49)", "1 sphere (line 57)"]
+    house = world.meshes[1][0]                                         # define house's box, group shift 50 50 0
+    assert house.min(axis=0).tolist() == [46.0, 46.0, 0.0] and house.max(axis=0).tolist() == [54.0, 54.0, 4.0]
+    assert sorted(world.left_out) == ["sphere"]
+    assert load_scene(path).metadata["left_out"] == ["1 sphere (line 57)"]
+
+
+def test_groups_nest_and_errors_in_a_definition_name_their_own_line(tmp_path):
+    from tanktool.errors import FormatError
+    from tanktool.formats.bzw import parse_bzw
+
+    text = ("define post\n  box\n    size 1 1 3\n  end\nenddef\n"
+            "define pair\n  group post\n    shift -5 0 0\n  end\n  group post\n    shift 5 0 0\n  end\nenddef\n"
+            "group pair\n  spin 90 0 0 1\n  shift 0 0 1\nend\ngroup nothing\nend\n")
+    w = parse_bzw(tmp_path / "g.bzw", text=text)
+    centres = sorted(tuple(np.round(v.mean(axis=0), 6)) for v, _ in w.meshes)
+    assert centres == [(0.0, -5.0, 2.5), (0.0, 5.0, 2.5)]      # x -5 / +5 spun 90 deg to y, lifted 1
+    assert w.left_out == {"group of no definition": [18]}
+    with pytest.raises(FormatError, match=r"g\.bzw:3: 'size' expects 3 numbers"):
+        parse_bzw(tmp_path / "g.bzw", text=text.replace("size 1 1 3", "size 1 x 3"))
+    loop = "define a\n  group a\n  end\nenddef\ngroup a\nend\n"
+    with pytest.raises(FormatError, match="nested more than 8 deep"):
+        parse_bzw(tmp_path / "loop.bzw", text=loop)
 
 
 def test_import_never_says_left_out_nothing_when_objects_were_skipped(tmp_path):

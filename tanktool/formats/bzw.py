@@ -33,15 +33,16 @@ counter-clockwise seen from above):
   (default 1.12) at y = +-(size y + 1.5 border), size z high, and a crossbar
   ``border`` thick on top (default size 0.5 4.48 20.16), as BZFlag builds it.
 
-- ``mesh``: its vertices and polygon faces, shifted, scaled and spun as it says
-  (formats/bzw_mesh.py).
+- ``mesh``: its vertices and polygon faces, shifted, scaled and spun as it says;
+  ``group NAME``: the solids of ``define NAME`` ... ``enddef`` moved by the group's
+  shift / scale / spin (formats/bzw_mesh.py).
 
 Objects with ``drivethrough`` are left out (tanks pass through them).  Any other
-object (``link``, ``arc``, ``cone``, ``sphere``, ``group``, ``zone``, ...,
-``define``...``enddef``) is skipped with a warning naming its line, and so is an
-unknown property of a known object; the solid ones (``arc``, ``cone``, ``sphere``,
-``tetra``, ``group``, ``define``, drivethrough objects) are also counted, by kind
-with their lines, in what the import leaves out (``scene.metadata["left_out"]``).
+object (``link``, ``arc``, ``cone``, ``sphere``, ``zone``, ...) is skipped with a
+warning naming its line, and so is an unknown property of a known object; the solid
+ones (``arc``, ``cone``, ``sphere``, ``tetra``, a group of no definition,
+drivethrough objects) are also counted, by kind with their lines, in what the
+import leaves out (``scene.metadata["left_out"]``).
 ``options -set _wallHeight 0`` means no outer walls and a teleporter of ``border 0``
 has no frame (nothing solid), as in BZFlag.  Malformed numbers, a missing ``end`` or an
 ``end`` without an object raise :class:`FormatError` with the file and line.
@@ -59,7 +60,7 @@ import numpy as np
 
 from ..errors import FormatError
 from .bundle import read_input
-from .bzw_mesh import BzwMesh, _mesh_line
+from .bzw_mesh import BzwGroup, BzwMesh, _group_line, _mesh_line
 from .limits import MAX_MODEL_BYTES, MAX_OBJECTS
 
 #: warnings passed on per file (a file of a million unknown lines says so once)
@@ -140,8 +141,12 @@ class BzwWorld:
     objects: list[BzwObject] = field(default_factory=list)
     meshes: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)   # placed ``mesh`` objects
     warnings: list[str] = field(default_factory=list)
-    #: what the file holds but the arena does not: kind -> lines ("group": [40, 52])
+    #: what the file holds but the arena does not: kind -> lines ("sphere": [40, 52])
     left_out: dict[str, list[int]] = field(default_factory=dict)
+    #: ``define`` blocks: name -> (line, body lines); the parsed bodies; group nesting
+    defines: dict[str, tuple[int, list[str]]] = field(default_factory=dict)
+    parsed: dict[str, "BzwWorld"] = field(default_factory=dict)
+    depth: int = 0
 
     def leave_out(self, kind: str, line: int) -> None:
         self.left_out.setdefault(kind, []).append(line)
@@ -182,11 +187,14 @@ def _numbers(path: Path, lineno: int, key: str, args: list[str], count: int) -> 
     return vals
 
 
-def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
+def parse_bzw(path: str | os.PathLike, text: str | None = None, defines: dict | None = None,
+              depth: int = 0) -> BzwWorld:
     """Parse a ``.bzw`` file (or ``text`` named after ``path``) into a :class:`BzwWorld`.
 
     Raises FormatError naming the file and line for malformed input; unknown objects
-    and properties become ``warnings`` (strings ``file:line: ...``).
+    and properties become ``warnings`` (strings ``file:line: ...``).  ``defines`` and
+    ``depth``: the group definitions seen so far and the nesting, when the body of a
+    ``define`` is read for a ``group`` (formats/bzw_mesh.py).
     """
     path = Path(path)
     if text is None:
@@ -195,7 +203,9 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
             text = data.decode("utf-8")
         except UnicodeDecodeError:
             text = data.decode("latin-1")   # old maps are often Latin-1; keywords are ASCII
-    world = BzwWorld(path)
+    world = BzwWorld(path, depth=depth)
+    if defines is not None:
+        world.defines = defines
     warn = world.warnings.append
     current: BzwObject | None = None       # a known object being read
     in_world: int | None = None            # line of an open ``world`` block
@@ -204,7 +214,8 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
     in_define: int | None = None
     options: list[tuple[int, str]] | None = None   # tokens of an open ``options`` block, with lines
     options_line = 0
-    mesh: BzwMesh | None = None            # an open ``mesh`` block
+    mesh: BzwMesh | BzwGroup | None = None   # an open ``mesh`` or ``group`` block
+    define: tuple[str, list[str]] = ("", [])   # the open define's name and body lines
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = _strip(raw)
         if not line:
@@ -214,10 +225,15 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
         args = words[1:]
         if in_define is not None:
             if key == "enddef":
+                world.defines[define[0]] = (in_define, define[1])
                 in_define = None
+            else:
+                define[1].append(raw)
             continue
         if mesh is not None:
-            if _mesh_line(path, lineno, key, args, mesh, world):
+            done = (_group_line(path, lineno, key, args, mesh, world) if isinstance(mesh, BzwGroup)
+                    else _mesh_line(path, lineno, key, args, mesh, world))
+            if done:
                 mesh = None
             continue
         if options is not None:
@@ -254,17 +270,17 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
                     raise FormatError(f"{path}:{lineno}: more than {MAX_OBJECTS:,} meshes (a world this tool reads "
                                       f"has fewer)")
                 mesh = BzwMesh(lineno)
+            elif key == "group":
+                mesh = BzwGroup(lineno, " ".join(args).lower())
             elif key == "define":
-                in_define = lineno
-                world.leave_out("group definition", lineno)
-                warn(f"{path}:{lineno}: 'define' blocks (group definitions) are skipped")
+                in_define, define = lineno, (" ".join(args).lower(), [])
             elif key in ("enddef",):
                 raise FormatError(f"{path}:{lineno}: 'enddef' without 'define'")
             else:
                 skipping = (key, lineno)
                 skip_stack = []
                 if key in _SOLID_UNSUPPORTED:
-                    world.leave_out(key if key != "group" else "group (instance of a definition)", lineno)
+                    world.leave_out(key, lineno)
                 warn(f"{path}:{lineno}: unknown or unsupported object '{words[0]}' skipped")
             continue
         if key == "end":
@@ -308,7 +324,8 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
     for open_line, what in ((current.line if current else None, current.kind if current else ""),
                             (in_world, "world"), (skipping[1] if skipping else None, skipping[0] if skipping else ""),
                             (in_define, "define"), (options_line if options is not None else None, "options"),
-                            (mesh.line if mesh is not None else None, "mesh")):
+                            (mesh.line if mesh is not None else None,
+                             "group" if isinstance(mesh, BzwGroup) else "mesh")):
         if open_line is not None:
             closer = "enddef" if what == "define" else "end"
             raise FormatError(f"{path}:{open_line}: '{what}' is never closed (expected '{closer}' "
@@ -317,7 +334,7 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None) -> BzwWorld:
 
 
 #: solid objects this reader does not build: counted in what the import leaves out
-_SOLID_UNSUPPORTED = {"arc", "cone", "sphere", "tetra", "group"}
+_SOLID_UNSUPPORTED = {"arc", "cone", "sphere", "tetra"}
 
 
 def _set_size(world: BzwWorld, half: float, line: int, said: str) -> None:

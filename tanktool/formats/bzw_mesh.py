@@ -105,13 +105,20 @@ def _finish_mesh(path: Path, m: BzwMesh, world: Any) -> None:
     if not tris:
         world.leave_out("mesh without faces", m.line)
         return
-    v = np.array(m.vertices, dtype=np.float64)
-    for kind, t in m.transforms:
+    v = transform(np.array(m.vertices, dtype=np.float64), m.transforms)
+    if not np.isfinite(v).all():
+        raise FormatError(f"{path}:{m.line}: the mesh's transformed vertices are not finite")
+    world.meshes.append((v, np.array(tris, dtype=np.int64)))
+
+
+def transform(v: np.ndarray, transforms: list[tuple[str, tuple[float, ...]]]) -> np.ndarray:
+    """(n, 3) points after ``shift`` / ``scale`` / ``spin`` (degrees about an axis), in order."""
+    for kind, t in transforms:
         if kind == "shift":
             v = v + np.array(t)
         elif kind == "scale":
             v = v * np.array(t)
-        else:   # spin: degrees about an axis (Rodrigues)
+        else:   # spin (Rodrigues)
             axis = np.array(t[1:])
             norm = float(np.linalg.norm(axis))
             if norm > 0:
@@ -120,6 +127,67 @@ def _finish_mesh(path: Path, m: BzwMesh, world: Any) -> None:
                 kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
                 r = np.eye(3) + math.sin(a) * kx + (1 - math.cos(a)) * (kx @ kx)
                 v = v @ r.T
-    if not np.isfinite(v).all():
-        raise FormatError(f"{path}:{m.line}: the mesh's transformed vertices are not finite")
-    world.meshes.append((v, np.array(tris, dtype=np.int64)))
+    return v
+
+
+# ---------------------------------------------------------------- groups
+
+#: groups inside definitions inside groups ...: deeper than this is refused
+MAX_GROUP_DEPTH = 8
+
+
+@dataclass
+class BzwGroup:
+    """A ``group NAME`` block: an instance of ``define NAME``, moved by its transformations."""
+
+    line: int
+    name: str
+    transforms: list[tuple[str, tuple[float, ...]]] = field(default_factory=list)
+    drivethrough: bool = False
+
+
+def _group_line(path: Path, lineno: int, key: str, args: list[str], g: BzwGroup, world: Any) -> bool:
+    """One line inside a ``group`` block; True when its ``end`` closed it."""
+    if key in ("shift", "scale"):
+        g.transforms.append((key, _numbers(path, lineno, key, args, 3)))
+    elif key == "spin":
+        g.transforms.append((key, _numbers(path, lineno, key, args, 4)))
+    elif key in ("drivethrough", "passable"):
+        g.drivethrough = True
+    elif key == "end":
+        place_group(path, g, world)
+        return True
+    return False
+
+
+def place_group(path: Path, g: BzwGroup, world: Any) -> None:
+    """Every solid of the group's definition, moved by the group's transformations,
+    added to ``world.meshes`` (the definition is read once, with its own line numbers)."""
+    from .bzw import object_mesh, parse_bzw
+    from .limits import MAX_OBJECTS
+
+    if g.drivethrough:
+        world.leave_out("drivethrough group", g.line)
+        return
+    if g.name not in world.defines:
+        world.leave_out("group of no definition", g.line)
+        world.warnings.append(f"{path}:{g.line}: group {g.name!r}: no 'define {g.name}' before it")
+        return
+    if world.depth >= MAX_GROUP_DEPTH:
+        raise FormatError(f"{path}:{g.line}: groups nested more than {MAX_GROUP_DEPTH} deep")
+    sub = world.parsed.get(g.name)
+    if sub is None:
+        start, body = world.defines[g.name]
+        # padded with empty lines: errors in the body name the file's own line numbers
+        sub = parse_bzw(path, "\n" * start + "\n".join(body), defines=world.defines, depth=world.depth + 1)
+        world.parsed[g.name] = sub
+        world.warnings.extend(sub.warnings)
+        for kind, lines in sub.left_out.items():
+            world.left_out.setdefault(kind, []).extend(lines)
+    parts = [object_mesh(o) for o in sub.objects] + list(sub.meshes)
+    if len(world.meshes) + len(parts) > MAX_OBJECTS:
+        raise FormatError(f"{path}:{g.line}: the groups make more than {MAX_OBJECTS:,} objects "
+                          f"(a world this tool reads has fewer)")
+    for v, f in parts:
+        world.meshes.append((transform(v, g.transforms), f))
+
