@@ -329,8 +329,8 @@ LEVELS = {
     "rolling_terrain": rolling_terrain, "ramps_and_decks": ramps_and_decks, "bridge": bridge,
     "bumpy_floor": bumpy_floor, "tiny_room": tiny_room, "two_storeys": two_storeys, "hills": hills, "fort": fort,
     "corridor": corridor, "islands": islands, "narrow_deck": narrow_deck,
-    "town": town, "junkyard": junkyard, "fence_field": fence_field, "living_room": living_room, "stacked_floors": stacked_floors, "terraces": terraces,
-    "big_terrain": big_terrain,
+    "town": town, "junkyard": junkyard, "fence_field": fence_field, "living_room": living_room,
+    "stacked_floors": stacked_floors, "terraces": terraces, "big_terrain": big_terrain,
 }
 
 
