@@ -322,7 +322,11 @@ def import_arena(
         result = analyse_arena(mesh.vertices, mesh.faces, params, fleet, cut_height=height, tolerance=tolerance,
                                progress=progress)
     except ArenaError as e:
-        raise ArenaError(f"{model}: {e}") from None
+        # the same kind (a NoFitError keeps the --scale it suggests), the file named
+        err = ArenaError(f"{model}: {e}")
+        if hasattr(e, "scale"):
+            err = type(e)(f"{model}: {e}", e.scale)
+        raise err from None
     walls = result.walls.walls
     for line in result.walls.repairs.remarks():   # repaired walls, and what check would still find
         remark(f"{model}: {line}")

@@ -228,3 +228,28 @@ def test_default_name_from_an_awkward_file_stem(tmp_path, monkeypatch):
     assert load_arena(tmp_path / "my_arena_v2").name == "my_arena_v2"
     r = CliRunner().invoke(cli, ["import-arena", str(model), "--name", "bad/name"])
     assert r.exit_code == 2 and "arena name" in r.output
+
+
+def test_no_fit_names_a_scale_and_scale_auto_applies_it(tmp_path):
+    import re
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))
+    import make_levels
+
+    mesh = make_levels.level("corridor")
+    mesh.apply_scale(1 / 3.0)                       # a 2.5 m corridor: no bundled tank fits
+    model = make_levels.write_obj(mesh, tmp_path / "narrow.obj")
+    r = CliRunner().invoke(cli, ["import-arena", str(model), "-o", str(tmp_path / "a")])
+    assert r.exit_code == 2 and not (tmp_path / "a").exists()
+    (line,) = [ln for ln in r.output.splitlines() if ln.startswith("error:")]
+    m = re.search(r"needs a circle of ([\d.]+) m and the widest the walkable surface takes is ([\d.]+) m "
+                  r"\(at --scale ([\d.]+) light fits on (\d+) % of it\)", line)
+    assert m, line
+    assert float(m[2]) < float(m[1])                # never "needs 6.46, widest 6.50"
+    assert float(m[3]) > 1 and int(m[4]) >= 50
+    r = run("import-arena", str(model), "-o", str(tmp_path / "b"), "--scale", "auto")
+    assert r.exit_code == 0, r.output
+    assert f"--scale auto: no bundled tank fits at scale 1; importing at --scale {m[3]}" in r.output
+    assert read_toml(tmp_path / "b" / "arena.toml")["source"]["scale"] == float(m[3])
+    assert run("check", str(tmp_path / "b")).exit_code == 0

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from .options import force_option, name_option, out_option, progress, scale_option, up_option
+from .options import force_option, name_option, out_option, progress, up_option
 
 #: models with more faces than this get a progress bar
 PROGRESS_FACES = 100_000
@@ -42,7 +42,10 @@ def _stages(model: Path) -> tuple[str, ...] | None:
 @out_option
 @name_option
 @up_option
-@scale_option
+@click.option("--scale", "scale_text", default="1", show_default=True, metavar="S|auto",
+              help="Multiply the model's coordinates (after the axis conversion) to get metres; 'auto': the "
+                   "scale at which the smallest bundled tank fits most of the walkable surface, when none fits "
+                   "at 1.")
 @click.option("--height", type=float, default=1.0, show_default=True,
               help="Cut height above a flat floor, in metres: what crosses it is a wall.")
 @click.option("--cell", type=float, default=None, metavar="M",
@@ -63,7 +66,7 @@ def _stages(model: Path) -> tuple[str, ...] | None:
               help="Most heightfield cells the import may use (default: 4,000,000 + 200 per byte of the "
                    "model file, at most 40,000,000).")
 @force_option
-def import_arena(model: Path, out: Path | None, name: str | None, up: str | None, scale: float,
+def import_arena(model: Path, out: Path | None, name: str | None, up: str | None, scale_text: str,
                  height: float, cell: float | None, max_slope: float | None, climb: float | None,
                  headroom: float | None, tolerance: float, wall_height: float | None, wall_thickness: float | None,
                  max_cells: int | None, force: bool) -> None:
@@ -93,17 +96,19 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
         # non-fatal remarks (a .bzw's unknown objects) go to stderr, even under -q
         click.echo(f"warning: {message}", err=True)
 
-    from ..nav.arena_levels import describe_levels
+    from ..nav.arena_levels import NoFitError, describe_levels
 
     kw = dict(warn=warn, wall_height=wall_height, wall_thickness=wall_thickness, max_slope=max_slope,
               climb=climb, headroom=headroom, cell=cell, max_cells=max_cells)
-    stages = _stages(model)
-    if stages:
-        with progress(length=len(stages), label=f"importing {model.name}") as bar:
-            result = run(model, out, name, up, scale, height, tolerance, force, progress=lambda _s: bar.update(1),
-                         **kw)
-    else:
-        result = run(model, out, name, up, scale, height, tolerance, force, **kw)
+    auto = scale_text.strip().lower() == "auto"
+    scale = 1.0 if auto else _scale(scale_text)
+    try:
+        result = _run(run, model, out, name, up, scale, height, tolerance, force, kw)
+    except NoFitError as e:
+        if not auto or e.scale is None:
+            raise
+        echo(f"--scale auto: no bundled tank fits at scale 1; importing at --scale {e.scale:g}")
+        result = _run(run, model, out, name, up, e.scale, height, tolerance, force, kw)
     (x0, z0), (x1, z1) = result.walls.bounds
     thin = f" ({result.thin_walls} from thin walls)" if result.thin_walls else ""
     nlev = len(result.levels.levels)
@@ -125,6 +130,30 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
              f"at {g.cell:g} m, clearance {g.clearance:g} m ({g.clearance_source}): {valid:,} valid")
         echo(f"  holds at once: {_holds(result)}")
     echo(f"  wrote {result.path} in {result.seconds:.2f} s")
+
+
+def _scale(text: str) -> float:
+    """--scale S: a number in (0, 1e6]."""
+    import math
+
+    from ..errors import ArenaError
+
+    try:
+        v = float(text)
+    except ValueError:
+        v = math.nan
+    if not (math.isfinite(v) and 0 < v <= 1e6):
+        raise ArenaError(f"--scale must be a number in (0, 1e6] or 'auto', got {text!r}")
+    return v
+
+
+def _run(run, model, out, name, up, scale, height, tolerance, force, kw):
+    """One import, with a progress bar when the model is big."""
+    stages = _stages(model)
+    if stages:
+        with progress(length=len(stages), label=f"importing {model.name}") as bar:
+            return run(model, out, name, up, scale, height, tolerance, force, progress=lambda _s: bar.update(1), **kw)
+    return run(model, out, name, up, scale, height, tolerance, force, **kw)
 
 
 #: play's largest --bots: the count of tanks an arena holds is given up to this

@@ -232,7 +232,7 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
     # narrow for the heavy tank still plays with the light one; play refuses the others)
     tries = [(n, r, ln) for n, r, ln in fleet.sizes] or [(fleet.radius_of, fleet.radius, fleet.length)]
     found = None  # (grid, spawns, fleet) of the largest vehicle that fits
-    problem = ""
+    problem: str | tuple = ""
     why: dict[str, str] = {}  # vehicle -> why the arena is not for it
     for k, (name, radius, length) in enumerate(tries):
         if k and radius >= tries[k - 1][1]:
@@ -241,7 +241,7 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
         g = tank_grid(surface, lw, radius)
         g.climb = params.climb
         if not g.valid.any():
-            problem = problem or _no_fit(surface, name, radius)
+            problem = problem or (name, radius)   # the refusal is worked out only if it is needed
             why[name] = f"fits nowhere (it needs a circle of {2 * radius:.2f} m)"
             continue
         try:
@@ -259,10 +259,13 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
     step("grid")
     if found is None:
         if len(tries) == 1:
+            if isinstance(problem, tuple):
+                raise _no_fit(surface, lw, *problem, (vertices, faces, params))
             raise ArenaError(problem)
         name, radius, _ = tries[-1]
-        raise ArenaError(f"no place where any bundled tank fits (the largest bundled tank, {tries[0][0]}, nor "
-                         f"the smallest): {_no_fit(surface, name, radius)}")
+        nofit = _no_fit(surface, lw, name, radius, (vertices, faces, params))
+        raise NoFitError(f"no place where any bundled tank fits (the largest bundled tank, {tries[0][0]}, nor "
+                         f"the smallest): {nofit}", nofit.scale)
     grid, spawns, fleet = found
     too_big = [(n, why.get(n, "fits nowhere")) for n, r, _ in tries if r > fleet.radius]
     t["spawns"] = 0.0
@@ -284,10 +287,66 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
                        fleet, too_big)
 
 
-def _no_fit(surface: Surface, name: str, radius: float) -> str:
-    widest = 2 * float(np.nanmax(np.where(surface.main, surface.clearance, 0.0)))
-    return (f"no place where {name} fits: it needs a circle of {2 * radius:.2f} m, the walkable surface's "
-            f"widest spot is about {widest:.2f} m across (wrong --scale?)")
+class NoFitError(ArenaError):
+    """No bundled tank fits the model; ``scale`` is the --scale at which the smallest
+    fits most of its walkable surface (None: none found)."""
+
+    def __init__(self, message: str, scale: float | None = None) -> None:
+        super().__init__(message)
+        self.scale = scale
+
+
+#: the --scale values a refusal may suggest
+SCALES = (1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0, 12.0, 16.0, 20.0, 25.0, 30.0, 40.0, 50.0, 100.0)
+#: "fits most of it": the share of the walkable surface a suggested --scale gives the tank
+MOST = 0.5
+
+
+def widest_fit(surface: Surface, lw: LevelWalls, radius: float, steps: int = 7) -> float:
+    """The largest footprint radius below ``radius`` that fits somewhere (the same test
+    as the tank grid's: the surface's clearance and the exact distance to the walls),
+    to ``radius / 2**steps``; 0 when not even the smallest does."""
+    lo, hi = 0.0, float(radius)
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        if tank_grid(surface, lw, mid).valid.any():
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+#: a suggested scale is tried only while its heightfield stays this small (cells)
+MAX_TRY_CELLS = 4_000_000
+
+
+def scale_for(vertices: np.ndarray, faces: np.ndarray, params: WalkableParams,
+              radius: float) -> tuple[float, float] | None:
+    """(--scale, share of the walkable surface) at which a tank of ``radius`` fits on
+    most of the model's walkable surface: the smallest of ``SCALES`` whose surface,
+    found again at that scale (same slope, climb and headroom), keeps ``radius`` from
+    its edges on at least ``MOST`` of its area; None when none does."""
+    ext = np.ptp(vertices[:, [0, 2]], axis=0) if len(vertices) else np.zeros(2)
+    for s in SCALES:
+        if float(np.prod(ext * s / params.cell + 1)) > MAX_TRY_CELLS:
+            break
+        surf = walkable_surface(vertices * s, faces, params, radius)
+        clear = surf.clearance[surf.main]
+        if len(clear) and float(np.mean(clear >= radius)) >= MOST:
+            return s, float(np.mean(clear >= radius))
+    return None
+
+
+def _no_fit(surface: Surface, lw: LevelWalls, name: str, radius: float, model: tuple) -> NoFitError:
+    """The refusal when no tank fits: what it needs, the widest the surface takes (by the
+    same test, so always less), and the --scale at which it would fit (``model``:
+    vertices, faces, params)."""
+    widest = 2 * widest_fit(surface, lw, radius)
+    hint = scale_for(*model, radius)
+    scale = (f"at --scale {hint[0]:g} {name} fits on {100 * hint[1]:.0f} % of it" if hint is not None
+             else "wrong --scale?")
+    return NoFitError(f"no place where {name} fits: it needs a circle of {2 * radius:.2f} m and the widest the "
+                      f"walkable surface takes is {widest:.2f} m ({scale})", hint[0] if hint is not None else None)
 
 
 def _floor_y(lw: LevelWalls, surface: Surface) -> float:
