@@ -40,7 +40,7 @@ def _levels():
 
 
 @needs_kernels
-@pytest.mark.parametrize("name,V,F", _levels(), ids=lambda x: x if isinstance(x, str) else "")
+@pytest.mark.parametrize("name,V,F", [pytest.param(*lv, id=lv[0]) for lv in _levels()])
 def test_compiled_and_numpy_surfaces_are_identical(name, V, F):
     a, ga = _build(V, F, True)
     b, gb = _build(V, F, False)

@@ -26,7 +26,7 @@ import numpy as np
 from .span_filters import filter_masks
 
 #: levels with more columns than this are built in bands (by build_heightfield)
-TILE_COLUMNS = 2_000_000
+TILE_COLUMNS = 4_000_000
 #: columns a band holds, about (its rows: this over the grid's width)
 BAND_COLUMNS = 1_000_000
 
