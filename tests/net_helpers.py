@@ -14,14 +14,20 @@ LOOPBACK = "127.0.0.1"
 
 
 def pump(peers, seconds: float = 0.2, states: bool = False) -> list:
-    """Poll every open peer for ``seconds`` (bounded); optionally send a state each round."""
+    """Poll every open peer for ``seconds`` (bounded); optionally send states, 60 a
+    second each (twice the game's rate: more would be a member's flood, which the
+    peers drop unread, and would run the senders' numbers past the sequence window)."""
     events = []
     end = time.monotonic() + seconds
+    next_state = time.monotonic()
     while time.monotonic() < end:
+        send = states and time.monotonic() >= next_state
+        if send:
+            next_state += 1.0 / 60.0
         for p in peers:
             if p.closed:
                 continue
-            if states and p.number:
+            if send and p.number:
                 p.send_state(P.State(p.number, max(p.session_time(), 0.0), 1.0 * p.number, 2.0, 0.0,
                                      0.0, 0.0, 0.0, 100.0, True))
             events += [(p.number, e) for e in p.poll(0.002)]
