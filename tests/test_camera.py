@@ -13,7 +13,8 @@ from shapely.geometry import MultiPoint, box
 
 from tanktool.game.camera import Camera, arena_mesh
 from tanktool.game.meshes import load_model
-from tanktool.game.render3d import FOV_Y, look_at, perspective, tank_matrix
+from tanktool.game.matrices import look_at, perspective, tank_matrix
+from tanktool.game.render3d import FOV_Y
 from tanktool.game.session import GameSession, pose3d
 
 W, H = 1280, 720
