@@ -46,3 +46,22 @@ def make_app(tmp_path, monkeypatch):
     for a in apps:
         a.stop()
     pygame.display.quit()
+
+
+@pytest.fixture(scope="session")
+def imported_level(tmp_path_factory):
+    """``imported_level(name)``: the bundle of generated level ``name``
+    (tools/make_levels.py) imported once per session (per xdist worker) and shared by
+    every module that plays on it -- a 1-3 s import each, otherwise repeated by
+    test_sim_ground, test_levels_played and test_agent_levels.  Read it, do not change it."""
+    from level_helpers import import_level
+
+    base = tmp_path_factory.mktemp("imported-levels")
+    cache: dict[str, Path] = {}
+
+    def get(name: str) -> Path:
+        if name not in cache:
+            cache[name] = import_level(base, name)
+        return cache[name]
+
+    return get

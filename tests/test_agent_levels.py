@@ -173,9 +173,8 @@ def test_matches_on_levels_run_and_fight(name):
 
 
 @pytest.fixture(scope="module")
-def degenerate(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("degenerate")
-    return {name: load_match_arena(import_level(tmp, name)) for name in ("corridor", "narrow_deck", "islands", "bridge")}
+def degenerate(imported_level):
+    return {name: load_match_arena(imported_level(name)) for name in ("corridor", "narrow_deck", "islands", "bridge")}
 
 
 @pytest.mark.parametrize("name", ["corridor", "narrow_deck", "islands", "bridge"])

@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 import trimesh
 
-from level_helpers import import_level
 from tanktool.sim.ground import Ground
 from tanktool.sim.match import load_match_arena, load_tank_spec, run_match
 
@@ -28,9 +27,8 @@ def _surface_heights(mesh: trimesh.Trimesh, x: float, z: float) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def levels(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("levels")
-    return {name: import_level(tmp, name) for name in ("ramps_and_decks", "rolling_terrain")}
+def levels(imported_level):
+    return {name: imported_level(name) for name in ("ramps_and_decks", "rolling_terrain")}
 
 
 @pytest.mark.parametrize("name", ["ramps_and_decks", "rolling_terrain"])

@@ -20,20 +20,19 @@ from tanktool.sim.match import load_match_arena, load_tank_spec, run_match
 from tanktool.sim.world import World
 from tanktool.sim.weapons import fire
 
-from level_helpers import ROOT, import_level  # noqa: E402
+from level_helpers import ROOT  # noqa: E402
 
 GENERATED = ("rolling_terrain", "bridge", "two_storeys", "ramps_and_decks")
 
 
 @pytest.fixture(scope="module")
-def arenas(tmp_path_factory):
+def arenas(imported_level):
     """name -> ArenaInfo of the bundled arenas with a ground and the generated levels."""
     out = {}
     for name in ("hills", "fort"):
         out[name] = load_match_arena(ROOT / "arenas" / name)
-    base = tmp_path_factory.mktemp("levels")
     for name in GENERATED:
-        out[name] = load_match_arena(import_level(base, name))
+        out[name] = load_match_arena(imported_level(name))
     for name, info in out.items():
         assert info.ground is not None, name
     return out
