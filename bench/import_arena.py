@@ -3,7 +3,7 @@
 Four parts, each a table (or one JSON object with ``--json``):
 
 * **stages** (default): per level, the whole import as a match needs it --
-  ``tanktool.arena.import_arena`` and then, when the import did not write the grid,
+  ``tanktool.importer.import_arena`` and then, when the import did not write the grid,
   ``build-navgrid`` on the bundle -- timed per stage by wrapping the pipeline's own
   functions (bench/stage_profile.py: exclusive times, so the stages add up): load,
   fleet, rasterise, filters, heightfield (the rest of it), links, distance, regions,
@@ -129,7 +129,7 @@ def profile_one(spec: str, work: Path) -> dict:
     """The whole import of one level, per stage (runs in the child process)."""
     from stage_profile import Profile
 
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
     from tanktool.memory import keep_freed_memory
 
     keep_freed_memory()  # as the tanktool command does
@@ -165,7 +165,7 @@ def profile_one(spec: str, work: Path) -> dict:
 #: modules the import loads on first use: loaded before the clock starts (a cost of
 #: starting the command, reported as modules_seconds, not a stage of the work)
 PRELOAD = ("trimesh", "scipy.spatial", "scipy.ndimage", "scipy.sparse.csgraph", "shapely", "matplotlib.pyplot",
-           "tanktool.arena", "tanktool.nav.arena_levels", "tanktool.plots.arena", "tanktool.plots.navgrid",
+           "tanktool.arena", "tanktool.importer", "tanktool.nav.arena_levels", "tanktool.plots.arena", "tanktool.plots.navgrid",
            "tanktool.formats.materials", "tanktool.formats.models", "tanktool.nav.quadtree")
 
 

@@ -1,6 +1,6 @@
 """The one-step import against the two steps it replaced (issue 25), in one process.
 
-One step: ``tanktool.arena.import_arena`` writing every file a match needs (walls,
+One step: ``tanktool.importer.import_arena`` writing every file a match needs (walls,
 surface, layered navigation grid, quadtree, pictures, hashes).  Two steps: the same
 import without the grid (``grid=False``), then the ``build-navgrid`` command on the
 bundle.  Best of ``--repeat`` each, CPU time of this process (every thread; the
@@ -54,7 +54,7 @@ def run(repeat: int) -> list[dict]:
     """One row per level: CPU and wall seconds of each way, their ratios, the grid."""
     import import_arena as bench
 
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
 
     bench.import_cli()
     rows = []

@@ -108,7 +108,7 @@ def rebuild_grid(folder: Path, doc: dict[str, Any]) -> None:
 
 def reimport(folder: Path, doc: dict[str, Any]) -> None:
     """The bundle imported again from its source with the recorded parameters."""
-    from .arena import import_arena
+    from .importer import import_arena
 
     src, walls = doc["source"], doc.get("walls", {}) if isinstance(doc.get("walls"), dict) else {}
     import_arena(folder / src["file"], folder, name=doc.get("name"), up=src.get("up"),

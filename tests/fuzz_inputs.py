@@ -874,7 +874,7 @@ def _navgrid(path: Path) -> None:
 
 def _import_arena(path: Path) -> None:
     """The whole import (formats, then the wall geometry of geometry/walls.py)."""
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
 
     import_arena(path, path.parent / "bundle")
 

@@ -396,7 +396,7 @@ def test_zero_area_faces_raise_no_numpy_warning(tmp_path):
     in divide' from the heightfield: now the import is silent."""
     import warnings
 
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
 
     obj = tmp_path / "floor.obj"
     obj.write_text("v 0 0 0\nv 40 0 0\nv 40 0 40\nv 0 0 40\nv 20 0 20\nv 20 3 20\nv 20 0 0\n"

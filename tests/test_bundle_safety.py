@@ -238,7 +238,7 @@ def test_bundle_update_is_all_or_nothing(tmp_path):
 KILL_CHILD = textwrap.dedent("""
     import sys
     from pathlib import Path
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
     from tanktool.cli.main import cli
     model, out = Path(sys.argv[1]), Path(sys.argv[2])
     print("ready", flush=True)

@@ -10,7 +10,8 @@ import shapely
 import trimesh
 from click.testing import CliRunner
 
-from tanktool.arena import import_arena, load_arena
+from tanktool.arena import load_arena
+from tanktool.importer import import_arena
 from tanktool.cli.main import cli
 from tanktool.errors import ArenaError, FormatError
 from tanktool.formats.floorplan import extrude, load_scene, plan_walls, read_plan

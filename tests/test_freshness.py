@@ -62,7 +62,7 @@ def test_stale_grid_is_rebuilt(box: Path):
 
 def test_an_import_without_its_grid_is_an_error_in_check(tmp_path: Path):
     # a bundle imported before the one-step import had no grid and no hash of one
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
 
     out = tmp_path / "maze"
     import_arena(ROOT / "arenas" / "maze" / "maze.obj", out, grid=False)

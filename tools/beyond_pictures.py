@@ -76,7 +76,7 @@ def model_and_walls(bundle: Path, out: Path, title: str) -> None:
 
 
 def main(argv: list[str]) -> int:
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
     from tanktool.plots.match import save_match_picture
     from tanktool.sim.match import load_match_arena, load_tank_spec
     from tanktool.sim.replay import play_replay, read_replay, record_match, write_replay

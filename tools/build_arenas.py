@@ -22,7 +22,7 @@ sys.path.insert(0, str(ROOT))
 def rebuild(folder: Path, out: Path | None = None, navgrid: bool = True) -> None:
     """Re-import ``folder``'s source into ``out`` (default: the folder itself); without
     ``navgrid``, leave out the navigation files (quicker, for tests of the walls)."""
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
     from tanktool.formats.bundle import read_toml
 
     doc = read_toml(folder / "arena.toml")

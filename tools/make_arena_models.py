@@ -25,7 +25,7 @@ Each material gets a texture of tools/make_textures.py (its ``ARENA_TEXTURES``):
 .obj sources are given texture coordinates by ``make_textures.texture_obj`` after they
 are written, the .3ds one is written with them (box projection, in metres).
 
-Then each is run through ``import-arena`` (tanktool.arena.import_arena) into
+Then each is run through ``import-arena`` (tanktool.importer.import_arena) into
 ``arenas/<name>/``.  ``make arenas`` (tools/build_arenas.py) rebuilds the derived
 files of the bundles from these sources later without re-authoring them.
 """
@@ -263,7 +263,7 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     from make_textures import ARENA_TEXTURES, texture_obj
 
-    from tanktool.arena import import_arena
+    from tanktool.importer import import_arena
 
     for name in args.only or list(ARENAS):
         make, file_name, params = ARENAS[name]

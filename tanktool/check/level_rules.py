@@ -68,7 +68,7 @@ def load_grid(man: Manifest, bundle: Path, out: list[Diagnostic]):
 
 def _components(grid) -> np.ndarray:
     """Labels (L, nz, nx) of the grid's valid nodes joined by links (0: no node)."""
-    from ..nav.arena_levels import _components as comps
+    from ..nav.arena_levels import grid_components as comps
 
     return comps(grid)[0]
 

@@ -89,7 +89,7 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
       tanktool import-arena hills.obj --max-slope 30 --climb 0.5
       tanktool import-arena plan.dxf --wall-height 3 --wall-thickness 0.4
     """
-    from ..arena import import_arena as run
+    from ..importer import import_arena as run
     from .main import echo
 
     def warn(message: str) -> None:

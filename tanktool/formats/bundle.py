@@ -50,10 +50,14 @@ from .limits import MAX_DEPTH, MAX_MANIFEST_BYTES, MAX_MODEL_BYTES, nesting_dept
 # reading
 
 
-def _umask() -> int:
+def current_umask() -> int:
+    """The process's umask (read by setting it and putting it back)."""
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+_umask = current_umask      # the name this module's functions use
 
 
 def _open_regular(path: str | os.PathLike, label: str, expected: str) -> int:

@@ -21,9 +21,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import FormatError, VehicleError
-from ..geometry.spheres import SphereTree, read_spheres
 from .bundle import atomic_write_text, bundle_file, clean_stale, read_input, read_input_text, read_toml
 from .limits import MAX_SMALL_TEXT_BYTES
+from .spheres_txt import SphereTree, read_spheres
 
 HULL_MIN, HULL_MAX = 8, 16
 #: spheres a vehicle's sphere tree may have (import-vehicle makes a few dozen)

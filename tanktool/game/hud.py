@@ -381,7 +381,7 @@ def save_png(surface: "pygame.Surface", path: str | os.PathLike) -> Path:
     os.close(fd)
     try:
         pygame.image.save(surface, tmp)
-        from ..formats.bundle import _umask
+        from ..formats.bundle import current_umask as _umask
 
         os.chmod(tmp, 0o666 & ~_umask())      # mkstemp makes 0600; a picture is for everyone
         os.replace(tmp, path)

@@ -161,9 +161,9 @@ class Renderer3D:
         ref = self.session.vehicle_ref
         if ref is None:
             return box_tank_model(spec)
-        from ..sim.match import _bundle_dir
+        from ..sim.match import bundle_dir
 
-        folder = _bundle_dir(ref, "vehicles", ())
+        folder = bundle_dir(ref, "vehicles")
         return load_model(str(folder / "model.glb"))
 
     def _texture(self, batch: Batch) -> Any:

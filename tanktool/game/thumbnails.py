@@ -33,10 +33,10 @@ def _context(ctx: Any) -> Any:
 
 
 def _bundle(kind: str, ref: Any) -> Path | None:
-    from ..sim.match import _bundle_dir
+    from ..sim.match import bundle_dir
 
     try:
-        return _bundle_dir(ref, kind, ())
+        return bundle_dir(ref, kind)
     except Exception:  # an unknown name or a broken bundle: the menu says so when START is pressed
         return None
 

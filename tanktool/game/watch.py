@@ -51,7 +51,7 @@ class ModelWatch:
     def import_now(self) -> Path:
         """Import the model into a new scratch bundle; returns it.  Raises TanktoolError
         (one line naming the file) when the model cannot be imported."""
-        from ..arena import import_arena
+        from ..importer import import_arena
 
         self.imports += 1
         out = self.root / f"import{self.imports}"

@@ -90,7 +90,7 @@ def tank_grid(surface: Surface, lw: LevelWalls, radius: float) -> NavGrid:
     return grid_from_surface(surface, radius, origin, too_close=tc)
 
 
-def _components(grid: NavGrid) -> tuple[np.ndarray, int]:
+def grid_components(grid: NavGrid) -> tuple[np.ndarray, int]:
     """Component labels (L, nz, nx) of a grid's valid nodes over its links (0: none)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -146,7 +146,7 @@ def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarra
     """Spawn points ``[x, z, heading, y]`` where the largest tank fits (see the module
     docstring); the clearance is the radius plus SPAWN_MARGIN, at least SPAWN_CLEARANCE
     when that leaves ``count`` candidates."""
-    labels, k = _components(grid)
+    labels, k = grid_components(grid)
     if k == 0:
         raise ArenaError("no place where the largest bundled tank fits")
     sizes = np.bincount(labels.ravel(), minlength=k + 1)

@@ -85,6 +85,12 @@ def arena_dir(ref: str | Path) -> Path:
     return _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
 
 
+def bundle_dir(ref: str | Path, kind: str) -> Path:
+    """The folder of a bundle of ``kind`` ("arenas" or "vehicles") given by path or
+    bundled name (ArenaError / VehicleError when none)."""
+    return _bundle_dir(ref, kind, ())
+
+
 def default_arena() -> str | None:
     """The first bundled arena that exists, or None."""
     from ..content import bundled_dir

@@ -1,0 +1,253 @@
+"""``import-arena``'s pipeline: a model in, a complete arena bundle out (walls,
+walkable surface, layered navigation grid, quadtree, pictures, hashes).
+
+It reads the model (formats/), analyses its levels (nav/arena_levels.py), draws the
+pictures (plots/) and writes the grid files as build-navgrid does (grid_files.py):
+a front-end layer module.  Reading a bundle back is ``tanktool.arena``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import shutil
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from . import __version__
+from .arena import MANIFEST, MIN_SPAWNS, NAVGRID_DEFAULTS, walkable_params
+from .errors import ArenaError
+from .formats.limits import check_cells
+from .formats.walls_txt import WallList
+
+
+# ---------------------------------------------------------------------------
+# building a bundle
+
+
+@dataclass
+class ImportResult:
+    """What :func:`import_arena` wrote, for the command's summary."""
+
+    path: Path
+    name: str
+    walls: WallList
+    spawns: np.ndarray
+    floor_y: float
+    faces: int
+    thin_walls: int
+    seconds: float
+    warnings: list[str] = field(default_factory=list)   # non-fatal remarks (a .bzw's unknown objects)
+    levels: Any = None  # nav.arena_levels.ArenaLevels: levels, what was left out, the tank grid
+    params: Any = None  # the WalkableParams used
+    defaults: dict[str, str] = field(default_factory=dict)  # where each default came from
+    grid: Any = None    # grid_files.BuiltGrid: the navigation grid written with the bundle (None: not built)
+    model_left_out: list[str] = field(default_factory=list)  # what the model file held but was not built (.bzw)
+
+
+_NAME_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._-]*$")
+
+
+def _companion_files(model: Path) -> list[Path]:
+    """Files a model needs beside it: an .obj's material libraries, a .gltf's buffers."""
+    from .formats.materials import companion_files
+
+    return companion_files(model)
+
+
+def _beside(f: Path, model: Path) -> str:
+    """``f``'s name relative to the model's folder (posix), as the model names it."""
+    try:
+        return f.relative_to(model.parent).as_posix()
+    except ValueError:
+        return f.name
+
+
+def import_arena(
+    model: str | os.PathLike,
+    out: str | os.PathLike | None = None,
+    name: str | None = None,
+    up: str | None = None,
+    scale: float = 1.0,
+    height: float = 1.0,
+    tolerance: float = 0.01,
+    force: bool = False,
+    navgrid: dict[str, Any] | None = None,
+    progress: Callable[[str], None] | None = None,
+    warn: Callable[[str], None] | None = None,
+    wall_height: float | None = None,
+    wall_thickness: float | None = None,
+    max_slope: float | None = None,
+    climb: float | None = None,
+    headroom: float | None = None,
+    cell: float | None = None,
+    walkable: dict[str, Any] | None = None,
+    max_cells: int | None = None,
+    grid: bool = True,
+) -> ImportResult:
+    """Read ``model``, find its walkable levels, walls and spawns and write the arena
+    bundle ``out``.
+
+    ``out`` defaults to ``./<name>``; ``name`` to the model's file stem.  ``navgrid``
+    overrides the [navgrid] defaults and ``walkable`` the [walkable] ones (used when
+    rebuilding a bundled arena); ``grid`` (default) also builds the navigation files
+    build-navgrid writes (navgrid.npz, quadtree.npz, navgrid.png: ``grid_files``) with
+    the default clearance, so the bundle is ready to play; ``max_slope``, ``climb``, ``headroom`` and ``cell``
+    are the command's options.  ``warn`` also receives the non-fatal remarks collected
+    in ``ImportResult.warnings``.  ``wall_height`` / ``wall_thickness`` shape a .dxf/.svg
+    floor plan's walls.  Everything is written into a temporary folder renamed into
+    place at the end, so a failure leaves nothing behind.
+    """
+    import trimesh
+
+    from .fleet import bundled_fleet
+    from .formats.bundle import check_replaceable, sha256_file, staged_dir, write_toml
+    from .formats.materials import export_glb
+    from .formats.models import default_up, detect_format, load_scene
+    from .formats.walls_txt import write_walls
+    from .nav.arena_levels import analyse_arena, spawn_y_needed
+    from .plots.arena import save_preview
+
+    t0 = time.perf_counter()
+    model = Path(model)
+    fmt = detect_format(model)
+    if name is None:  # from the file stem, made a safe folder name ("my arena" -> "my_arena")
+        name = re.sub(r"[^A-Za-z0-9._-]+", "_", model.stem).strip("._-") or "arena"
+    if not _NAME_RE.match(name):
+        raise ArenaError(f"arena name {name!r}: use letters, digits, '.', '_' or '-'")
+    target = Path(out) if out is not None else Path.cwd() / name
+    check_replaceable(target, force, MANIFEST)  # before any work: only a bundle tanktool wrote is replaced
+    if not (math.isfinite(height) and height > 0):
+        raise ArenaError(f"--height must be a positive number of metres, got {height}")
+    if not (math.isfinite(tolerance) and 0 < tolerance < height):
+        raise ArenaError(f"--tolerance must be positive and below --height, got {tolerance}")
+
+    warnings: list[str] = []
+
+    def remark(message: str) -> None:
+        warnings.append(message)
+        if warn is not None:
+            warn(message)
+
+    fleet = bundled_fleet(warn=remark)
+    nav = dict(NAVGRID_DEFAULTS)
+    nav.update(navgrid or {})
+    params, where = walkable_params(cell if cell is not None else nav.get("cell"), max_slope, climb, headroom,
+                                    fleet, walkable)
+    if params.climb >= height:
+        raise ArenaError(f"--climb ({params.climb:g} m) must be below the cut --height ({height:g} m): "
+                         "what a tank climbs cannot also be a wall")
+    if wall_height is not None and not wall_height > height:
+        raise ArenaError(f"--wall-height ({wall_height:g}) must be above the cut --height ({height:g}), "
+                         f"or the walls would not be cut")
+    scene = load_scene(model, up=up, scale=scale, warn=remark, wall_height=wall_height,
+                       wall_thickness=wall_thickness, progress=progress)
+    if progress:
+        progress("read")
+    meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    if not meshes:
+        raise ArenaError(f"{model}: the model has no triangles")
+    mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
+    lo, hi = mesh.bounds
+    check_cells(str(model), float(hi[0] - lo[0]), float(hi[2] - lo[2]), params.cell, model.stat().st_size,
+                max_cells)  # before the heightfield: its cost follows the cells
+    try:
+        result = analyse_arena(mesh.vertices, mesh.faces, params, fleet, cut_height=height, tolerance=tolerance,
+                               progress=progress)
+    except ArenaError as e:
+        # the same kind (a NoFitError keeps the --scale it suggests), the file named
+        err = ArenaError(f"{model}: {e}")
+        if hasattr(e, "scale"):
+            err = type(e)(f"{model}: {e}", e.scale)
+        raise err from None
+    walls = result.walls.walls
+    for line in result.walls.repairs.remarks():   # repaired walls, and what check would still find
+        remark(f"{model}: {line}")
+    spawns = result.spawns
+    fits = result.fleet or fleet
+    if result.too_big:
+        remark(f"{model}: {'; '.join(f'{n} {w}' for n, w in result.too_big)}: the spawns and the navigation "
+               f"grid are for {fits.radius_of} (footprint radius {fits.radius:.2f} m), and play refuses the "
+               f"larger vehicles here")
+    if len(spawns) < MIN_SPAWNS:
+        remark(f"{model}: room for only {len(spawns)} spawn point(s) where the largest bundled tank that fits "
+               f"({fits.radius_of}) fits, at least {fits.length:.1f} m apart")
+
+    src_up = up or default_up(fmt)
+    nav["cell"] = float(params.cell)
+    bounds = walls.bounds
+    with_y = spawn_y_needed(result)
+    built = None
+    companions = _companion_files(model)
+    with staged_dir(target, force=force, manifest=MANIFEST) as tmp:
+        copied = [model, *companions]
+        for f in copied:  # where the model looks for it: a .gltf's "data/scene.bin" stays there
+            (tmp / _beside(f, model)).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(f, tmp / _beside(f, model))
+        glb, textures = export_glb(model, scene, tmp, extra=[target], warn=remark)   # textures copied in
+        (tmp / "model.glb").write_bytes(glb)
+        header = (f"arena {name}: walls of {model.name}, the boundaries of its walkable surface "
+                  f"(flat floors: cut {height:g} m above them)\n"
+                  f"made by tanktool {__version__} import-arena; normals point into free space")
+        write_walls(tmp / "walls.txt", walls, header=header)
+        lv = result.levels
+        title = (f"{name}: {len(lv)} level{'s' if len(lv) != 1 else ''}, {len(walls)} walls + 4 auxiliary, "
+                 f"{len(spawns)} spawns, {bounds[1, 0] - bounds[0, 0]:.0f} x {bounds[1, 1] - bounds[0, 1]:.0f} m")
+        save_preview(tmp / "preview.png", walls, spawns, title, result.free, levels=result)
+        if progress:
+            progress("files")
+        doc = {
+            "name": name,
+            "tool_version": __version__,
+            "bounds": [[_r(bounds[0, 0]), _r(bounds[0, 1])], [_r(bounds[1, 0]), _r(bounds[1, 1])]],
+            "floor_y": _r(result.floor_y),
+            "spawns": [[_r(x), _r(z), _r(h, 6), _r(y)] if with_y else [_r(x), _r(z), _r(h, 6)]
+                       for x, z, h, y in spawns],
+            "source": {"file": model.name, "sha256": sha256_file(tmp / model.name), "up": src_up,
+                       "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness),
+                       **({"companions": [_beside(f, model) for f in companions]} if companions else {})},
+            "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
+            "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
+                      "count": len(walls)},
+            "walkable": params.as_toml(),
+            "vehicles": {"largest": fits.radius_of, "radius": _r(fits.radius),
+                         "too_big": [n for n, _ in result.too_big]},
+            "levels": [{"level": x.level, "area": _r(x.area, 1), "y": [_r(x.y_lo, 3), _r(x.y_hi, 3)],
+                        "regions": x.regions} for x in lv],
+            "navgrid": nav,
+            "derived": {f: sha256_file(tmp / f) for f in ("walls.txt", "model.glb", "preview.png")},
+        }
+        write_toml(tmp / MANIFEST, doc)
+        if grid:  # the same files, built the same way, as build-navgrid on the bundle
+            from .grid_files import build_grid, open_target, render_picture, stage_grid_files
+
+            staged = open_target(tmp)
+            built = build_grid(staged, warn=remark, fleet=fits)
+            write_toml(tmp / MANIFEST, stage_grid_files(tmp, staged, built, render_picture(built, staged)))
+            if progress:
+                progress("navgrid")
+    return ImportResult(target, name, walls, spawns, result.floor_y, len(mesh.faces), result.walls.thin_walls,
+                        time.perf_counter() - t0, warnings, result, params, where, built,
+                        list(scene.metadata.get("left_out", [])))
+
+
+def _plan_source(fmt: str, wall_height: float | None, wall_thickness: float | None) -> dict[str, float]:
+    """[source] keys of a floor plan: the wall height and thickness it was built with."""
+    from .formats.models import PLAN_FORMATS
+
+    if fmt not in PLAN_FORMATS:
+        return {}
+    from .formats.floorplan import DEFAULT_WALL_HEIGHT, DEFAULT_WALL_THICKNESS
+
+    return {"wall_height": float(DEFAULT_WALL_HEIGHT if wall_height is None else wall_height),
+            "wall_thickness": float(DEFAULT_WALL_THICKNESS if wall_thickness is None else wall_thickness)}
+
+
+def _r(v: float, nd: int = 4) -> float:
+    v = round(float(v), nd)
+    return 0.0 if v == 0.0 else v  # no "-0.0" in the manifest
