@@ -8,8 +8,6 @@
  *
  *   link_spans(col, floor, ceil, start, nz, nx, headroom, climb, out)
  *       col, floor, ceil, start: int64; out: int64 (n, 4), filled in place
- *   ledge_scan(s_col, bot, top, start, smin, smax, ceil, nz, nx, headroom, climb, minh, asmin, asmax)
- *       all int64; minh, asmin, asmax updated in place (Recast's rcFilterLedgeSpans)
  *   chamfer(link, dist, limit)
  *       link: int64 (n, 4); dist: int32 (n,), the starting values, relaxed in place
  *   raster(tri, abc, nz, nx, ch, max_steps, row_lo, row_hi, steep) -> (col, tri, smin, smax) as int64 bytes
@@ -17,6 +15,8 @@
  *       (heightfield._cells_exact) instead of their planes (_cells_plane; abc unused)
  *       tri: float64 (n, 9) x0 x1 x2 z0 z1 z2 y0 y1 y2 in grid units (y in metres);
  *       abc: float64 (n, 3) the plane y = A + B x + C z of each triangle
+ *   filters(col, smin, smax, walk, nz, nx, headroom, climb, w3, lifted, ledge, steep, low)
+ *       int64 spans, bool walk; the five bool outputs of span_filters.filter_masks
  *   components(link, label)
  *       link: int64 (n, 4); label: int64 (n,) written: the smallest span of each component
  *   merge_spans(key, thr, col, smin, smax, walk, flat, top_walk) -> count
@@ -97,69 +97,6 @@ done:
 }
 
 #define OPEN ((i64)1 << 15)
-
-static PyObject *ledge_scan(PyObject *self, PyObject *args) {
-    Py_buffer scol, bot, top, start, smin, smax, ceil_, minh, asmin, asmax;
-    i64 nz, nx, headroom, climb;
-    if (!PyArg_ParseTuple(args, "y*y*y*y*y*y*y*LLLLw*w*w*", &scol, &bot, &top, &start, &smin, &smax, &ceil_, &nz,
-                          &nx, &headroom, &climb, &minh, &asmin, &asmax))
-        return NULL;
-    Py_ssize_t n = scol.len / 8, spans = smin.len / 8;
-    PyObject *ret = NULL;
-    if (!need(&bot, n, 8, "bot") || !need(&top, n, 8, "top") || !need(&start, nz * nx + 1, 8, "start") ||
-        !need(&smax, spans, 8, "smax") || !need(&ceil_, spans, 8, "ceil") || !need(&minh, n, 8, "minh") ||
-        !need(&asmin, n, 8, "asmin") || !need(&asmax, n, 8, "asmax"))
-        goto done;
-    {
-        const i64 *c = scol.buf, *b = bot.buf, *t = top.buf, *st = start.buf, *lo = smin.buf, *hi = smax.buf,
-                  *ce = ceil_.buf;
-        i64 *mh = minh.buf, *amn = asmin.buf, *amx = asmax.buf;
-        Py_BEGIN_ALLOW_THREADS
-        for (Py_ssize_t s = 0; s < n; ++s) {
-            const i64 i = c[s] / nx, j = c[s] % nx, bs = b[s], ts = t[s];
-            i64 m = mh[s], a0 = amn[s], a1 = amx[s];
-            for (int d = 0; d < 4; ++d) {
-                const i64 ii = i + DI[d], jj = j + DJ[d];
-                if (!(ii >= 0 && ii < nz && jj >= 0 && jj < nx)) {  /* off the grid: a drop */
-                    m = min64(m, -climb - bs);
-                    continue;
-                }
-                const i64 nc = ii * nx + jj, k0 = st[nc], k1 = st[nc + 1];
-                /* the floor below the neighbour's first span (open sky over an empty column) */
-                const i64 ntop0 = k1 > k0 ? lo[k0] : OPEN;
-                if (min64(ts, ntop0) - max64(bs, -climb) > headroom) m = min64(m, -climb - bs);
-                for (i64 k = k0; k < k1; ++k) {
-                    const i64 nb = hi[k];
-                    if (min64(ts, ce[k]) - max64(bs, nb) > headroom) {
-                        m = min64(m, nb - bs);
-                        if (nb - bs <= climb && bs - nb <= climb) {
-                            a0 = min64(a0, nb);
-                            a1 = max64(a1, nb);
-                        }
-                    }
-                }
-            }
-            mh[s] = m;
-            amn[s] = a0;
-            amx[s] = a1;
-        }
-        Py_END_ALLOW_THREADS
-    }
-    ret = Py_None;
-    Py_INCREF(ret);
-done:
-    PyBuffer_Release(&scol);
-    PyBuffer_Release(&bot);
-    PyBuffer_Release(&top);
-    PyBuffer_Release(&start);
-    PyBuffer_Release(&smin);
-    PyBuffer_Release(&smax);
-    PyBuffer_Release(&ceil_);
-    PyBuffer_Release(&minh);
-    PyBuffer_Release(&asmin);
-    PyBuffer_Release(&asmax);
-    return ret;
-}
 
 /* the value at span a, 0 off the edge (a < 0: the sentinel of chamfer_clearance) */
 static inline int32_t at(const int32_t *dist, i64 a) { return a < 0 ? 0 : dist[a]; }
@@ -621,11 +558,112 @@ done:
     return ret;
 }
 
+/* ------------------------------------------------------------------ the three filters */
+
+/* span_filters.filter_masks in one pass per filter: low hanging obstacles lifted,
+ * ledges and steep spans (every floor of the four neighbour columns), too little headroom.  col, smin,
+ * smax: int64 spans sorted by (column, bottom); walk: bool; the five outputs bool. */
+static PyObject *filters(PyObject *self, PyObject *args) {
+    Py_buffer col, smin, smax, walk, w3, lifted, ledge, steep, low;
+    i64 nz, nx, headroom, climb;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*LLLLw*w*w*w*w*", &col, &smin, &smax, &walk, &nz, &nx, &headroom, &climb,
+                          &w3, &lifted, &ledge, &steep, &low))
+        return NULL;
+    const Py_ssize_t n = col.len / 8;
+    PyObject *ret = NULL;
+    i64 *start = NULL, *ceil_ = NULL;
+    if (!need(&smin, n, 8, "smin") || !need(&smax, n, 8, "smax") || !need(&walk, n, 1, "walk") ||
+        !need(&w3, n, 1, "w3") || !need(&lifted, n, 1, "lifted") || !need(&ledge, n, 1, "ledge") ||
+        !need(&steep, n, 1, "steep") || !need(&low, n, 1, "low"))
+        goto done;
+    start = malloc((nz * nx + 1) * sizeof(i64));
+    ceil_ = malloc((n ? n : 1) * sizeof(i64));
+    if (!start || !ceil_) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    {
+        const i64 *C = col.buf, *lo = smin.buf, *hi = smax.buf;
+        const char *W = walk.buf;
+        char *out = w3.buf, *lif = lifted.buf, *led = ledge.buf, *stp = steep.buf, *lw = low.buf;
+        Py_BEGIN_ALLOW_THREADS
+        /* column starts and each span's ceiling (the next span's bottom in its column) */
+        Py_ssize_t k = 0;
+        for (i64 c = 0; c < nz * nx; ++c) {
+            start[c] = k;
+            while (k < n && C[k] == c) ++k;
+        }
+        start[nz * nx] = n;
+        for (Py_ssize_t i = 0; i < n; ++i) ceil_[i] = (i + 1 < n && C[i + 1] == C[i]) ? lo[i + 1] : OPEN;
+        for (Py_ssize_t i = 0; i < n; ++i) {
+            /* 1. walkable from the walkable span below (its flag before this pass) */
+            int w = W[i] != 0;
+            if (!w && i > 0 && W[i - 1] && C[i - 1] == C[i]) {
+                const i64 d = hi[i] - hi[i - 1];
+                if (d <= climb && -d <= climb) w = 1;
+            }
+            lif[i] = w && !W[i];
+            out[i] = (char)w;
+            led[i] = stp[i] = lw[i] = 0;
+        }
+        for (Py_ssize_t s = 0; s < n; ++s) {
+            if (!out[s]) continue;
+            /* 2. ledges and steep spans (span_filters._ledge_scan) */
+            const i64 i = C[s] / nx, j = C[s] % nx, bs = hi[s], ts = ceil_[s];
+            i64 m = OPEN, a0 = bs, a1 = bs;
+            for (int d = 0; d < 4; ++d) {
+                const i64 ii = i + DI[d], jj = j + DJ[d];
+                if (!(ii >= 0 && ii < nz && jj >= 0 && jj < nx)) {
+                    m = min64(m, -climb - bs);
+                    continue;
+                }
+                const i64 nc = ii * nx + jj, k0 = start[nc], k1 = start[nc + 1];
+                const i64 ntop0 = k1 > k0 ? lo[k0] : OPEN;
+                if (min64(ts, ntop0) - max64(bs, -climb) > headroom) m = min64(m, -climb - bs);
+                for (i64 q = k0; q < k1; ++q) {
+                    const i64 nb = hi[q];
+                    if (min64(ts, ceil_[q]) - max64(bs, nb) > headroom) {
+                        m = min64(m, nb - bs);
+                        if (nb - bs <= climb && bs - nb <= climb) {
+                            a0 = min64(a0, nb);
+                            a1 = max64(a1, nb);
+                        }
+                    }
+                }
+            }
+            if (m < -climb) led[s] = 1;
+            else if (a1 - a0 > climb) stp[s] = 1;
+        }
+        for (Py_ssize_t s = 0; s < n; ++s) {
+            /* 3. too little headroom, of what the ledge filter left */
+            const int w2 = out[s] && !led[s] && !stp[s];
+            lw[s] = w2 && (ceil_[s] - hi[s]) <= headroom;
+            out[s] = w2 && !lw[s];
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    free(start);
+    free(ceil_);
+    PyBuffer_Release(&col);
+    PyBuffer_Release(&smin);
+    PyBuffer_Release(&smax);
+    PyBuffer_Release(&walk);
+    PyBuffer_Release(&w3);
+    PyBuffer_Release(&lifted);
+    PyBuffer_Release(&ledge);
+    PyBuffer_Release(&steep);
+    PyBuffer_Release(&low);
+    return ret;
+}
+
 static PyMethodDef methods[] = {
     {"link_spans", link_spans, METH_VARARGS, "links between open spans (see nav/kernels.py)"},
-    {"ledge_scan", ledge_scan, METH_VARARGS, "the ledge filter's scan of neighbour columns"},
     {"chamfer", chamfer, METH_VARARGS, "chamfer distance relaxed to its fixed point, in place"},
     {"raster", raster, METH_VARARGS, "spans of triangles, as heightfield._cells_plane / _cells_exact"},
+    {"filters", filters, METH_VARARGS, "Recast's three span filters, as span_filters.filter_masks"},
     {"components", components, METH_VARARGS, "component labels (smallest span index), in place"},
     {"merge_spans", merge_spans, METH_VARARGS, "the merged spans of sorted packed keys"},
     {NULL, NULL, 0, NULL},

@@ -66,6 +66,12 @@ def filter_spans(hf_col, smin, smax, walk, shape, headroom: int, climb: int):
 def filter_masks(hf_col, smin, smax, walk, shape, headroom: int, climb: int):
     """The filters' result per span: (walkable after all three, lifted by the first,
     a ledge, too steep, too low)."""
+    kern = active()
+    if kern is not None:  # the three filters in one pass each (tanktool/_kernels.c)
+        out = [np.empty(len(hf_col), dtype=bool) for _ in range(5)]
+        kern.filters(i64(hf_col), i64(smin), i64(smax), np.ascontiguousarray(walk, dtype=bool), shape[0], shape[1],
+                     int(headroom), int(climb), *out)
+        return tuple(out)
     ceil = _next_in_column(hf_col, smin, OPEN)
     # 1. low hanging obstacles: walkable from the span below (its flag before this pass)
     w = walk.copy()
@@ -98,9 +104,9 @@ def _ledge_scan(hf_col, smin, smax, ceil, s_idx, shape, headroom: int, climb: in
     """For each span ``s_idx``: the lowest reachable neighbour floor relative to its own
     (minh) and the range of the neighbour floors within the climb (asmin, asmax), over
     every floor of each neighbour column, the empty space below a column's first span
-    counting as a floor at -climb (a drop to the bottom of the world).  The compiled
-    kernel when built (one pass), else numpy, neighbour spans visited k-th by k-th (the
-    k-th pass only sees columns with more than k spans: few beyond two)."""
+    counting as a floor at -climb (a drop to the bottom of the world).  Neighbour spans
+    are visited k-th by k-th (the k-th pass only sees columns with more than k spans:
+    few beyond two); the compiled filters (tanktool/_kernels.c) do this in one pass."""
     nz, nx = shape
     start = column_starts(hf_col, nz * nx)
     bot = smax[s_idx]
@@ -108,11 +114,6 @@ def _ledge_scan(hf_col, smin, smax, ceil, s_idx, shape, headroom: int, climb: in
     minh = np.full(len(s_idx), OPEN, dtype=np.int64)
     asmin = bot.astype(np.int64)
     asmax = bot.astype(np.int64)
-    kern = active()
-    if kern is not None:
-        kern.ledge_scan(i64(hf_col[s_idx]), i64(bot), i64(top), i64(start), i64(smin), i64(smax), i64(ceil), nz, nx,
-                     int(headroom), int(climb), minh, asmin, asmax)
-        return minh, asmin, asmax
     count = np.diff(start)
     for ncol in neighbour_columns(hf_col[s_idx], shape):
         off = ncol < 0
