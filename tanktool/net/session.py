@@ -198,11 +198,18 @@ class NetMatch:
         now = self.peer.session_time()
         for ev in events:
             if ev.kind == "state":
+                n = ev.body.tank
+                was_alive = self.judge.alive(n)
                 shown = self.judge.state(ev.body, now)
                 if shown is not None:
-                    self.remotes.setdefault(ev.body.tank, RemoteTank()).push(shown)
+                    self.remotes.setdefault(n, RemoteTank()).push(shown)
+                    if shown.alive and not was_alive:
+                        # a respawn: the spawn protection its own world gives it, here too
+                        # (the host decides hits; a shot of its own ends it only there)
+                        self.world.protected_until[n - 1] = self.world.t + self.world.rules.spawn_protection
             elif ev.kind == "shot":
                 if self.judge.shot(ev.body, now) is None:
+                    self.world.protected_until[ev.body.tank - 1] = -math.inf     # firing ends it
                     self._score(ev.body.tank).shots += 1
                     self._remote_shot(ev.body)
             elif ev.kind == "hit":
