@@ -55,3 +55,13 @@ def test_the_crosshair_marks_where_the_shell_stops(arena, gravity, spot):
     miss = _segment_distance(aim.impact, a, b)
     assert miss < 0.35, (aim.impact, a, b)
     assert math.dist(aim.muzzle, aim.impact) > 3.0     # it flew somewhere, not a shot into its own hull
+
+
+def test_the_hit_point_stops_where_the_world_drops_a_shell():
+    from tanktool.game.aim import _leaves
+
+    s = GameSession("box", bots=1, seed=1, player=True)
+    (x0, z0), (x1, z1) = s.world.bounds
+    assert _leaves(s.world, 30.0, 30.0, 10.0, 0.0) == pytest.approx((x1 + 1.0 - 30.0) / 10.0)
+    assert _leaves(s.world, 30.0, 30.0, 0.0, -5.0) == pytest.approx((30.0 - (z0 - 1.0)) / 5.0)
+    assert _leaves(s.world, 30.0, 30.0, 0.0, 0.0) == math.inf

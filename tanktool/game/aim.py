@@ -4,7 +4,7 @@ The shell is made by the simulation's own ``sim.weapons.fire`` (the same speed, 
 point, pitch, drift with the tank's velocity, and first wall on its line or, on an arena
 with relief, the time its flight first meets the model, as a real shot), then followed
 as the rules fly it (straight by default, spent at their range) until it meets that
-wall, the model or the ground; tanks on the way are
+wall, the model or the ground, or leaves the arena's bounds; tanks on the way are
 tested against their footprint circle and height.  Nothing here changes the world.
 """
 
@@ -67,6 +67,8 @@ def predict(world: Any, tank: Any, floor_y: float = 0.0) -> Aim:
         t_wall = s.wall_dist / vh if vh > 0 and math.isfinite(s.wall_dist) else math.inf
         t_end = min(t_ground, t_wall, t_spent)
 
+    t_end = min(t_end, _leaves(world, x0, z0, s.vx, s.vz))     # the world drops shells that leave it
+
     def at(t: float) -> tuple[float, float, float]:
         return x0 + s.vx * t, y0 + s.vy * t - 0.5 * g * t * t, z0 + s.vz * t
 
@@ -86,3 +88,16 @@ def predict(world: Any, tank: Any, floor_y: float = 0.0) -> Aim:
         if target is not None:
             break
     return Aim((x0, y0, z0), aim, at(t_end), target, t_end)
+
+
+def _leaves(world: Any, x: float, z: float, vx: float, vz: float) -> float:
+    """Seconds until a shell at (x, z) flying (vx, vz) leaves the world's bounds (with
+    the 1 m the world allows before it drops a shell); inf if it never does."""
+    (x0, z0), (x1, z1) = (tuple(map(float, row)) for row in world.bounds)
+    t = math.inf
+    for p, v, lo, hi in ((x, vx, x0 - 1.0, x1 + 1.0), (z, vz, z0 - 1.0, z1 + 1.0)):
+        if v > 1e-12:
+            t = min(t, (hi - p) / v)
+        elif v < -1e-12:
+            t = min(t, (lo - p) / v)
+    return max(t, 0.0)
