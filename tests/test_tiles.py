@@ -57,3 +57,18 @@ def test_bands_on_worker_processes_give_the_whole_build():
 def test_bands_cover_the_rows_once():
     assert bands(10, 5, 4) == [(0, 4), (4, 8), (8, 10)]
     assert bands(3, 2_000_000) == [(0, 1), (1, 2), (2, 3)]
+
+
+def test_a_daemonic_worker_builds_its_bands_in_turn():
+    """A pool worker (daemonic: it may not start processes) importing a large level."""
+    import multiprocessing as mp
+
+    V, F = _mesh("two_storeys")
+    whole = build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9)
+    with mp.get_context("fork").Pool(1) as pool:
+        counts = pool.apply(_tiled_counts, (V, F))
+    assert counts == whole.counts
+
+
+def _tiled_counts(V, F):
+    return build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9, band_rows=16, workers=2).counts

@@ -105,13 +105,10 @@ def build_tiled(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, w
     if workers is None:
         workers = min(len(todo), os.cpu_count() or 1)
     try:
-        if workers > 1 and len(todo) > 1 and "fork" in _start_methods():
-            import multiprocessing as mp
-            from concurrent.futures import ProcessPoolExecutor
-
-            with ProcessPoolExecutor(workers, mp_context=mp.get_context("fork")) as pool:
-                results = list(pool.map(_band, *zip(*todo)))
-        else:
+        results = None
+        if workers > 1 and len(todo) > 1 and _can_fork():
+            results = _on_workers(todo, workers)
+        if results is None:
             results = [_band(a, b) for a, b in todo]
     finally:
         _JOB.clear()
@@ -123,7 +120,23 @@ def build_tiled(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, w
     return spans, counts
 
 
-def _start_methods() -> list[str]:
+def _can_fork() -> bool:
+    """Forked workers are possible: the platform forks, and this process is not itself
+    a daemonic pool worker (those may not have children: a match server's or a
+    tournament's worker importing a large level builds its bands in turn)."""
     import multiprocessing as mp
 
-    return mp.get_all_start_methods()
+    return "fork" in mp.get_all_start_methods() and not mp.current_process().daemon
+
+
+def _on_workers(todo: list[tuple[int, int]], workers: int) -> list | None:
+    """The bands on forked worker processes; None when no pool can be started."""
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    try:
+        pool = ProcessPoolExecutor(workers, mp_context=mp.get_context("fork"))
+    except (OSError, ValueError):
+        return None
+    with pool:
+        return list(pool.map(_band, *zip(*todo)))
