@@ -122,6 +122,12 @@ def check_arena(bundle: Path, vehicles: list[VehicleSize], model_rules: bool = T
         return out, info
     name = man.get("", "name")
     info.name = name if isinstance(name, str) and name else bundle.name
+    # vehicles import-arena found too big for the arena ([vehicles] too_big) are refused
+    # by play there: the spawns and the grid are for the others, and judged by them
+    fits = man.table("vehicles")
+    too_big = fits.get("too_big") if isinstance(fits, dict) else None
+    if isinstance(too_big, list):
+        vehicles = [v for v in vehicles if v.name not in too_big] or vehicles
     # a bundle import-arena made (its [source] and the [walkable] surface it found) plays
     # on its grid: without it a match would run as if the arena were flat (issue 25), so
     # a missing grid is an error, as in play (tanktool/freshness.py)
