@@ -102,8 +102,8 @@ class TermsMixin:
         if err not in (0, errno.EINPROGRESS, errno.EWOULDBLOCK):
             sock.close()
             return
-        link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now,  # type: ignore[attr-defined]
-                    addr=addr)
+        reader = P.StreamReader(self.dropped)                       # type: ignore[attr-defined]
+        link = Link(sock, reader, Bucket(TCP_RATE, TCP_BURST, now), now, addr=addr)
         link.probe = True
         self.probes.append(link)
         self.sel.register(sock, 1, link)                            # type: ignore[attr-defined]
