@@ -253,3 +253,19 @@ def test_no_fit_names_a_scale_and_scale_auto_applies_it(tmp_path):
     assert f"--scale auto: no bundled tank fits at scale 1; importing at --scale {m[3]}" in r.output
     assert read_toml(tmp_path / "b" / "arena.toml")["source"]["scale"] == float(m[3])
     assert run("check", str(tmp_path / "b")).exit_code == 0
+
+
+def test_spawns_stay_by_the_geometry_not_on_the_empty_plane_around_it(tmp_path):
+    # a small town of blocks in the middle of a 300 m ground plane of two triangles
+    plane = trimesh.Trimesh([[0, 0, 0], [300, 0, 0], [300, 0, 300], [0, 0, 300]], [[0, 2, 1], [0, 3, 2]])
+    parts = [plane] + [_box(120 + 20 * k, 120 + 20 * m, 128 + 20 * k, 128 + 20 * m, 0, 6)
+                       for k in range(3) for m in range(3)]
+    trimesh.util.concatenate(parts).export(tmp_path / "town.obj")
+    r = run("-q", "import-arena", str(tmp_path / "town.obj"), "-o", str(tmp_path / "town"))
+    assert r.exit_code == 0, r.output
+    sp = np.asarray(read_toml(tmp_path / "town" / "arena.toml")["spawns"])[:, :2]
+    from tanktool.fleet import bundled_fleet
+
+    margin = bundled_fleet().length + 1e-6
+    assert len(sp) >= 2
+    assert ((sp >= 120 - margin) & (sp <= 168 + margin)).all(), sp

@@ -141,11 +141,33 @@ def ground_under(height: np.ndarray, node: tuple[int, int, int], cell: float, ra
     return slope, float(np.abs(A @ coef - y).max())
 
 
+def focus_box(vertices: np.ndarray, faces: np.ndarray, margin: float) -> np.ndarray | None:
+    """[[xmin, zmin], [xmax, zmax]] of the model's geometry other than a ground plane
+    around it (flat faces spanning half the model or more: a town's 2 km plane), grown
+    by ``margin``; None when there is no such plane or nothing else."""
+    if len(faces) == 0:
+        return None
+    tri = vertices[faces]
+    lo, hi = tri.min(axis=1), tri.max(axis=1)
+    total = vertices[:, [0, 2]].max(axis=0) - vertices[:, [0, 2]].min(axis=0)
+    flat = (hi[:, 1] - lo[:, 1]) <= 1e-6
+    span = hi[:, [0, 2]] - lo[:, [0, 2]]
+    plane = flat & (span >= 0.5 * total).any(axis=1)
+    if not plane.any() or plane.all():
+        return None
+    rest = tri[~plane].reshape(-1, 3)[:, [0, 2]]
+    box = np.array([rest.min(axis=0) - margin, rest.max(axis=0) + margin])
+    if np.prod(box[1] - box[0]) >= 0.5 * float(np.prod(total)):
+        return None               # the other geometry covers most of it: no empty plane to avoid
+    return box
+
+
 def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarray,
-                  count: int = SPAWN_COUNT) -> np.ndarray:
+                  count: int = SPAWN_COUNT, focus: np.ndarray | None = None) -> np.ndarray:
     """Spawn points ``[x, z, heading, y]`` where the largest tank fits (see the module
     docstring); the clearance is the radius plus SPAWN_MARGIN, at least SPAWN_CLEARANCE
-    when that leaves ``count`` candidates."""
+    when that leaves ``count`` candidates.  With ``focus`` (``focus_box``), only the
+    candidates inside it, when there are enough (not on the empty plane around a town)."""
     labels, k = grid_components(grid)
     if k == 0:
         raise ArenaError("no place where the largest bundled tank fits")
@@ -174,11 +196,17 @@ def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarra
         if len(pts) >= count:
             break
     pts, ys, level = chosen
+    if focus is not None and len(pts):
+        inside = ((pts >= focus[0]) & (pts <= focus[1])).all(axis=1)
+        if inside.sum() >= min(count, len(pts)) or inside.sum() >= 2:
+            pts, ys, level = pts[inside], ys[inside], level[inside]
     if len(pts) == 0:
         raise ArenaError(f"no place where the largest bundled tank fits: {fleet.radius_of} (footprint radius "
                          f"{fleet.radius:.2f} m) needs {floor_c:.2f} m from every wall for a spawn point")
     region = shapely.union_all([r.free for r in lw.regions])
     start = np.asarray(shapely.get_coordinates(shapely.centroid(region))[0])
+    if focus is not None:
+        start = 0.5 * (focus[0] + focus[1])
     node = grid.nodes_of(pts)
     climb = surface_climb(grid)
 
@@ -245,7 +273,7 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
             why[name] = f"fits nowhere (it needs a circle of {2 * radius:.2f} m)"
             continue
         try:
-            sp = choose_spawns(lw, g, fl, lw.walls.bounds, spawn_count)
+            sp = choose_spawns(lw, g, fl, lw.walls.bounds, spawn_count, focus_box(vertices, faces, fl.length))
         except ArenaError as e:
             problem = problem or str(e)
             why[name] = "has room for no spawn point"
