@@ -357,6 +357,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
                 R = shapely.union_all([R, *exact_parts])
             R = shapely.set_precision(R, tolerance)
             R = _drop_slivers(R, tolerance)
+            R = _fill_sliver_holes(R, tolerance, cell)
             if R.is_empty:
                 continue
             R = shapely.simplify(R, tolerance, preserve_topology=True)
@@ -565,6 +566,27 @@ def _region_labels(cells: np.ndarray, same: np.ndarray) -> tuple[np.ndarray, int
     labels = np.zeros(cells.shape, dtype=np.int64)
     labels[ci, cj] = lab + 1
     return labels, int(n)
+
+
+def _fill_sliver_holes(R, tolerance: float, cell: float):
+    """Holes narrower than the walls' tolerance and shorter than a cell are round-off
+    where a cell corner meets the exact cut of a steep face (a pyramid's foot), not
+    solid: filled, so they do not become walls a few centimetres long.  A real thin
+    solid is longer than a cell or wider than the tolerance and stays."""
+    parts = shapely.get_parts(R)
+    changed, out = False, []
+    for p in parts:
+        holes = [shapely.Polygon(h) for h in p.interiors]
+        keep = [h for h in holes
+                if h.length / 2 >= 1.5 * cell or not shapely.buffer(h, -2 * tolerance, quad_segs=1).is_empty]
+        if len(keep) < len(holes):
+            changed = True
+            p = shapely.Polygon(p.exterior, [h.exterior for h in keep])
+        out.append(p)
+    if not changed:
+        return R
+    # the other parts exactly as they were (a union would node them again)
+    return out[0] if len(out) == 1 else shapely.MultiPolygon(out)
 
 
 def _drop_slivers(R, tolerance: float):
