@@ -20,9 +20,21 @@ from typing import Iterator
 
 import numpy as np
 
+#: the kernels' interface this code calls (TANKTOOL_KERNELS_ABI in tanktool/_kernels.c)
+ABI = 1
+
 try:  # built by setup.py when a compiler was there
     from .. import _kernels as _compiled
 except ImportError:  # pragma: no cover - depends on the install
+    _compiled = None
+if _compiled is not None and getattr(_compiled, "ABI", None) != ABI:
+    # a build left from older sources (an editable install is not rebuilt by a pull):
+    # its functions may take other arguments, so the numpy code is used until it is rebuilt
+    import warnings
+
+    warnings.warn(f"{_compiled.__file__} was built from other sources than this tanktool; "
+                  "using the numpy code (rebuild: pip install -e . or make install)", RuntimeWarning,
+                  stacklevel=1)
     _compiled = None
 
 _enabled = os.environ.get("TANKTOOL_NO_KERNELS", "") in ("", "0")
