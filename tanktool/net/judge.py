@@ -18,7 +18,11 @@ A **state** is taken when, against the tank's last valid state:
   plus ``jitter`` (so a sender cannot claim time that did not pass), and the straight
   line between them crosses no wall (flat and one-level arenas);
 - a tank the host declared dead comes back only ``respawn_delay`` after its death
-  (less ``respawn_slack``) and within ``spawn_radius`` of a spawn point.
+  (less ``respawn_slack``) and within ``spawn_radius`` of a place the simulation's own
+  spawn rules could put it: a spawn point, or one of the free places
+  :mod:`..sim.extra_spawns` gives the arena for the vehicle when more tanks play than it
+  has spawn points (as many as a match has players, whatever number of tanks the
+  judge's world was built with).  Anywhere else it is a teleport disguised as a respawn.
 
 A state that fails is **corrected**: the tank stays at its last valid pose, standing
 still, and the correction is counted.  A tank corrected more than ``kick_rate`` times a
@@ -41,7 +45,7 @@ from collections import Counter
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from .protocol import Shot, State
+from .protocol import MAX_PLAYERS, Shot, State
 
 
 @dataclass(frozen=True)
@@ -90,6 +94,7 @@ class Judge:
         self.records: dict[int, _Record] = {}
         self.corrections: Counter = Counter()            # reason -> count (all tanks)
         self.refused_shots: Counter = Counter()
+        self._places: list[tuple[float, float]] | None = None
 
     # ------------------------------------------------------------------ limits
     def _spec(self, n: int) -> Any:
@@ -135,9 +140,28 @@ class Judge:
             return False
         return bool(self.world.walls.blocked(ax, az, bx, bz))
 
+    def spawn_places(self) -> list[tuple[float, float]]:
+        """Where a tank may (re)spawn: the world's spawn points, then the free places
+        sim/extra_spawns picks after them for the world's largest vehicle (as World does),
+        up to ``MAX_PLAYERS`` (or the world's tank count if larger) places in all.  The
+        picks are farthest-point sampling, so continuing from a world already extended
+        for fewer tanks gives the same places a world built for more would have."""
+        if self._places is None:
+            from ..sim.extra_spawns import places
+
+            w = self.world
+            out = [(float(s[0]), float(s[1])) for s in w.spawns]
+            need = max(MAX_PLAYERS, len(w.tanks)) - len(out)
+            if need > 0 and w.tanks:
+                big = max((t.spec for t in w.tanks), key=lambda s: s.radius)
+                out += [(x, z) for x, z, _h, _y in places(w, need, big.radius, big.box[2] - big.box[0])]
+            self._places = out
+        return self._places
+
     def near_spawn(self, x: float, z: float) -> bool:
+        """Within ``spawn_radius`` of a place a tank may (re)spawn at."""
         r = self.config.spawn_radius
-        return any(math.hypot(x - sx, z - sz) <= r for sx, sz, *_ in self.world.spawns)
+        return any(math.hypot(x - sx, z - sz) <= r for sx, sz in self.spawn_places())
 
     # ------------------------------------------------------------------ states
     def _fault(self, n: int, s: State, now: float) -> str | None:

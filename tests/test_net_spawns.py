@@ -1,0 +1,114 @@
+"""The judge and spawning beyond the spawn points (issues 25 and 27): when more tanks play
+than an arena has spawn points, a tank (re)spawns at a free place of the ground
+(sim/extra_spawns.py); every peer's judge takes a respawn there -- whatever number of
+tanks its own world was built with -- and still corrects one anywhere else."""
+
+from __future__ import annotations
+
+import math
+import random
+
+import numpy as np
+import pytest
+
+from tanktool.net import protocol as P
+from tanktool.net.judge import Judge
+from tanktool.net.session import NET_RULES
+from tanktool.net.simnet import SimNet
+from tanktool.sim.driver import ScriptedDriver
+from tanktool.sim.match import load_match_arena, load_tank_spec
+from tanktool.sim.world import World
+
+STATE_DT = 1.0 / 30.0
+
+
+def _world(arena: str, tanks: int, seed: int = 0) -> World:
+    """A world on ``arena`` cut to its first 2 spawn points."""
+    info = load_match_arena(arena)
+    spec = load_tank_spec("light")
+    return World(info.walls, [spec] * tanks, info.spawns[:2], seed=seed, bounds=info.bounds, ground=info.ground,
+                 rules=NET_RULES)
+
+
+def _state(t, now: float) -> P.State:
+    return P.State(t.index + 1, now, t.x, t.z, math.remainder(t.heading, 2 * math.pi), t.vx, t.vz, t.omega, t.hp,
+                   t.alive)
+
+
+def _respawn(judge: Judge, x: float, z: float, t0: float = 1.0) -> P.State | None:
+    """Tank 2 seen alive at a spawn point, killed by the host, then back at (x, z)."""
+    sx, sz, _ = judge.world.spawns[1]
+    judge.state(P.State(2, t0, sx, sz, 0.0, 0.0, 0.0, 0.0, 100.0, True), t0)
+    judge.hit(2, 0.0, True, t0 + 0.1)
+    t = t0 + 0.2 + judge.world.respawn_delay
+    return judge.state(P.State(2, t, x, z, 0.0, 0.0, 0.0, 0.0, 100.0, True), t)
+
+
+@pytest.mark.parametrize("arena", ["maze", "fort"])
+def test_a_respawn_at_every_free_place_is_taken_and_elsewhere_corrected(arena):
+    """The judge's world was built for the 4 tanks that play; the players' worlds for 8
+    (a network match's slots), so a tank may come back at any of 6 free places."""
+    places = _world(arena, 8).spawns
+    for x, z, _ in places:
+        judge = Judge(_world(arena, 4))
+        s = _respawn(judge, x, z)
+        assert s is not None and s.alive and (s.x, s.z) == (x, z), (x, z, judge.report())
+        assert judge.corrections == {}
+    # a teleport disguised as a respawn: on the ground, but far from every place
+    judge = Judge(_world(arena, 4))
+    g = judge.world.ground
+    (x0, z0), (x1, z1) = judge.world.bounds
+    far = [(float(x), float(z)) for x in np.arange(x0 + 1.0, x1, 1.0) for z in np.arange(z0 + 1.0, z1, 1.0)
+           if g.locate(x, z) >= 0 and min(math.hypot(x - px, z - pz) for px, pz, _ in places) > 5.0]
+    assert far
+    x, z = far[len(far) // 2]
+    s = _respawn(judge, x, z)
+    assert s is not None and not s.alive and (s.x, s.z) != (x, z)
+    assert judge.corrections == {"respawn": 1}
+    # nor a first shot from there before any state (a tank starts at a spawn place)
+    assert judge.shot(P.Shot(3, 1.0, x, z, 0.0, 0.0, 0.0), 1.0) == "pose"
+    assert judge.shot(P.Shot(4, 1.0, places[5][0], places[5][1], 0.0, 0.0, 0.0), 1.0) is None
+
+
+def test_six_honest_tanks_on_two_spawn_points_are_never_corrected():
+    """Six scripted tanks fight for 40 s on box cut to 2 spawn points, in worlds of a
+    network match's 8 slots (2 empty); their states (UDP: 50-200 ms, 5 % lost), shots
+    and the host's hits (TCP) reach a judge whose world was built for the 6.  Tanks die
+    and come back at free places; none is corrected."""
+    seed = 4
+    w = _world("box", P.MAX_PLAYERS, seed=seed)
+    for t in w.tanks[6:]:                     # empty slots, as net/session.py keeps them
+        t.alive, t.respawn_at = False, math.inf
+    judge = Judge(_world("box", 6, seed=seed))
+    drivers = [ScriptedDriver(random.Random(seed * 10 + k)) for k in range(len(w.tanks))]
+    udp = SimNet(seed=seed, delay=0.05, jitter=0.15, loss=0.05, reorder=0.05)
+    tcp = SimNet(seed=seed + 100, delay=0.05, jitter=0.15)
+    next_state, judged, extra_respawns = 0.0, 0, 0
+    while w.t < 40.0:
+        poses = {t.index: (t.x, t.z, t.heading, t.vx, t.vz) for t in w.tanks}
+        events = w.step(None, [d(w, t) if t.alive else None for d, t in zip(drivers, w.tanks)])
+        for ev in events:
+            n = ev.tank + 1
+            if ev.kind == "shot":
+                tcp.send(n, 0, P.Shot(n, w.t, *poses[ev.tank]))
+            elif ev.kind == "hit":
+                victim = w.tanks[ev.other]
+                tcp.send(0, 0, ("hit", ev.other + 1, victim.hp, not victim.alive, w.t))
+            elif ev.kind == "respawn":
+                extra_respawns += min(math.hypot(ev.x - x, ev.z - z) for x, z, _ in w.spawns[:2]) > 2.0
+        if w.t >= next_state:
+            next_state += STATE_DT
+            for t in w.tanks[:6]:
+                udp.send(t.index + 1, 0, _state(t, w.t))
+        for net in (udp, tcp):
+            net.advance(w.dt)
+        for _, _, m in tcp.deliver():
+            if isinstance(m, P.Shot):
+                assert judge.shot(m, tcp.now) is None, (m, judge.record(m.tank))
+            else:
+                _, victim, hp, killed, t_hit = m
+                judge.hit(victim, hp, killed, t_hit)
+        for _, _, s in udp.deliver():
+            judged += judge.state(s, udp.now) is not None
+    assert judge.corrections == {} and judge.refused_shots == {}, judge.report()
+    assert judged > 2000 and extra_respawns >= 1
