@@ -219,17 +219,16 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
     Returns (grid, mask of nodes that exist, for the picture)."""
     import numpy as np
 
-    from .formats.models import load_model
     from .nav.arena_levels import walls_too_close
     from .nav.walkable import grid_from_surface, surface_layers, walkable_surface
 
-    mesh = load_model(target.model, up="y")
+    vertices, faces = _model_triangles(target.model)
     origin = np.asarray(bounds, dtype=np.float64)[0]
     seeds = None
     if target.spawns is not None:  # [x, z] and the spawn's height when the manifest has it
         sp = np.asarray(target.spawns, dtype=np.float64)
         seeds = sp[:, [0, 1, 3]] if sp.shape[1] >= 4 else sp[:, :2]
-    surface = walkable_surface(mesh.vertices, mesh.faces, params, clearance, origin_xz=origin, shape=shape,
+    surface = walkable_surface(vertices, faces, params, clearance, origin_xz=origin, shape=shape,
                                seeds=seeds)
     if not surface.main.any():
         raise ArenaError(f"{target.model}: no walkable surface (max slope {params.max_slope:g} deg, "
@@ -239,6 +238,24 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
     grid = grid_from_surface(surface, clearance, origin, seeds=target.spawns, too_close=tc)
     exists = surface_layers(surface)[0]
     return grid, (exists[0] if grid.levels == 1 else None)
+
+
+def _model_triangles(model: Path) -> tuple[Any, Any]:
+    """The bundle model's vertices and faces in the world frame, all objects joined as
+    ``load_model`` joins them (in order, faces offset), without joining their materials:
+    packing the textures into one atlas took more time than the surface on a textured arena."""
+    import numpy as np
+    import trimesh
+
+    from .formats.models import load_scene
+
+    meshes = [m for m in load_scene(model, up="y").dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
+    if not meshes:
+        raise ArenaError(f"{model}: the model has no triangles")
+    starts = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
+    vertices = np.vstack([np.asarray(m.vertices, dtype=np.float64) for m in meshes])
+    faces = np.vstack([np.asarray(m.faces, dtype=np.int64) + k for m, k in zip(meshes, starts)])
+    return vertices, faces
 
 
 def render_picture(built: BuiltGrid, target: Target, fmt: str = "png", annotate: str = "both",
