@@ -112,3 +112,40 @@ def test_six_honest_tanks_on_two_spawn_points_are_never_corrected():
             judged += judge.state(s, udp.now) is not None
     assert judge.corrections == {} and judge.refused_shots == {}, judge.report()
     assert judged > 2000 and extra_respawns >= 1
+
+
+class _Peer:
+    """What NetMatch reads of its peer while it is built."""
+
+    def __init__(self, number: int) -> None:
+        self.number = number
+
+    def session_time(self) -> float:
+        return 0.0
+
+    def players(self) -> list:
+        return []
+
+
+@pytest.mark.parametrize("arena", ["box", "maze"])
+def test_each_player_starts_at_its_own_place_whatever_the_seeds(arena):
+    """Peers choose their seeds independently (the window's and ``play``'s own): player n
+    starts at the n-th spawn place on every peer, so no two players start on the same
+    one (a member joining on the host's tank pushed it metres away)."""
+    from tanktool.net.session import NetMatch
+
+    info = load_match_arena(arena)
+    if arena == "maze":
+        info.spawns = info.spawns[:2]             # 6 of the 8 start at free places
+    spec = load_tank_spec("light")
+    starts = {}
+    for n in range(1, P.MAX_PLAYERS + 1):
+        for seed in (0, 4, 11):
+            m = NetMatch(_Peer(n), info, spec, seed=seed)
+            x, z, h = m.world.spawns[n - 1]
+            t = m.world.tanks[n - 1]
+            assert t is m.me and t.position == pytest.approx((x, z)) and t.heading == h
+            starts.setdefault(n, t.position)
+            assert t.position == pytest.approx(starts[n])
+    xz = np.array(list(starts.values()))
+    assert np.hypot(*(xz[:, None] - xz[None]).transpose(2, 0, 1))[np.triu_indices(len(xz), 1)].min() > 3.0

@@ -105,6 +105,8 @@ class NetMatch:
         self.world = World(self.arena.walls, [self.spec] * P.MAX_PLAYERS, self.arena.spawns, seed=self.seed,
                            names=names, bounds=self.arena.bounds, ground=getattr(self.arena, "ground", None),
                            rules=NET_RULES)
+        for t in self.world.tanks:
+            self._start(t)
         self.me = self.world.tanks[self.peer.number - 1]
         self.judge = Judge(self.world)
         self.kicked: list[dict[str, Any]] = []
@@ -136,6 +138,17 @@ class NetMatch:
     def _absent(t: Any) -> None:
         t.alive = False
         t.respawn_at = math.inf      # only its own peer brings it back
+
+    def _start(self, t: Any) -> None:
+        """Put tank ``t`` at its player number's own spawn place (player n at the n-th):
+        the World shuffles its tanks' places with the peer's own seed, and peers choose
+        seeds independently, so a member would else start where another peer's tank
+        stands (both worlds then push the tanks apart: the host's own tank jumped metres
+        when a member joined).  The same on every peer, a different place per number."""
+        k = t.index % len(self.world.spawns)
+        x, z, h = self.world.spawns[k]
+        t.place(x, z, h)
+        self.world.stand(t, self.world.spawn_y[k])
 
     def _local(self) -> list[int]:
         return self.peer.speaks_for()
