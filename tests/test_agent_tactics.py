@@ -84,7 +84,9 @@ def alone(name, seed):
     w = bundled(name, 2)
     me, enemy = w.tanks
     enemy.alive, enemy.respawn_at = False, math.inf
-    return w, me, enemy, driver(Agent("normal"), seed)
+    agent = driver(Agent("normal"), seed)
+    agent.bot.memory.met = True      # it has met the enemy before: a watch is worth holding
+    return w, me, enemy, agent
 
 
 def drive(w, agent, me, seconds):
@@ -141,6 +143,34 @@ def test_alone_in_the_box_an_agent_holds_a_vantage_and_sweeps_its_cone():
     assert 0.4 < swing < 2 * SWEEP + 0.4                  # it sweeps, about the vantage's way
 
 
+def test_until_a_first_contact_it_goes_looking_instead_of_watching():
+    """Nobody seen or heard yet: a corner that sees the whole box is no place to wait
+    (two watchers draw); after FIRST_CONTACT_PATIENCE it explores, and keeps exploring."""
+    w, me, _, agent = alone("box", 2)
+    agent.bot.memory.met = False
+    watching = 0
+    for k in range(int(12.0 / w.dt)):
+        w.step(None, [agent(w, me), IDLE])
+        watching += w.t > 4.0 and agent.bot.state == "watch"
+    assert watching == 0 and me.distance > 20.0 and not agent.bot.memory.met
+
+
+def test_the_first_demo_fights(tmp_path):
+    """play --headless --seconds 10 --bots 2 with the default seed: both bots go out,
+    meet and shoot (issue 30's first demo; it stood still and silent before)."""
+    import json
+
+    from click.testing import CliRunner
+
+    from tanktool.cli.main import cli
+
+    out = tmp_path / "r.json"
+    r = CliRunner().invoke(cli, ["play", "--headless", "--seconds", "10", "--bots", "2", "--report", str(out)])
+    assert r.exit_code == 0, r.output
+    for t in json.loads(out.read_text())["tanks"]:
+        assert t["shots"] >= 1 and t["distance"] >= 15.0, t
+
+
 def test_an_enemy_coming_into_the_watched_box_is_seen_and_attacked():
     w, me, enemy, agent = alone("box", 2)
     drive(w, agent, me, 15.0)
@@ -169,6 +199,7 @@ def test_the_watch_gives_way_to_exploring_what_has_gone_unseen():
     agent, drv = set_up(w)
     watch = agent.machine.states["watch"]
     agent.machine.state, agent.machine.since = watch, 0.0
+    agent.memory.met = True
     cov = agent.nav.coverage
     cov.seen[:] = 0.0                          # all seen at t=0
 

@@ -77,7 +77,7 @@ TRANSITIONS = tuple(Transition(*row) for row in (
     (_ROAM, "leading", "ambush", "kills above deaths"),
     (("ambush",), "done", "wander", "not leading any more"),
     (("wander",), "vantage", "watch", "an arena with a vantage point"),
-    (("watch",), "done", "wander", "part of the arena unseen: explore"),
+    (("watch",), "done", "wander", "part of the arena unseen, or nobody met yet: explore"),
 ))
 
 
@@ -326,7 +326,7 @@ def _vantage(a: Agent, view: "View", p: "Percept") -> Any:
     if not a.watches or a.nav.vantages.top < WATCH_COVER:  # type: ignore[union-attr]
         return False
     if a.exploring:
-        if a.stale(view.t):
+        if a.stale(view.t) or not a.memory.met:    # still looking for a first contact
             return False
         a.exploring = False
     return True

@@ -44,6 +44,10 @@ WATCH_COVER = 0.4
 WATCH_PER_M = 0.004
 #: watch this long [s] before going to look at what has not been seen for a minute
 WATCH_STINT = 30.0
+#: ... but while nobody has been seen or heard yet, after this [s]: holding a corner
+#: that sees the whole arena waits for tanks that may be waiting too (two watchers
+#: would draw), so until a first contact the agent goes and looks
+FIRST_CONTACT_PATIENCE = 1.0
 #: ... if more than this fraction of the arena's blocks has not been seen for a minute
 STALE = 0.1
 #: a watching agent sweeps its cone this far either side of the vantage's way [rad],
@@ -155,7 +159,9 @@ class Watch(State["Agent"]):
         v = nav.vantages
         if self.ambush and not p.leading:
             return None
-        if not self.ambush and (agent.stale(t) and t - agent.machine.since > WATCH_STINT):
+        if not self.ambush and (agent.stale(t) and t - agent.machine.since > WATCH_STINT
+                                or not agent.memory.met
+                                and t - agent.machine.since > FIRST_CONTACT_PATIENCE):
             agent.exploring = True
             return None
         h = agent.memory.heard

@@ -52,6 +52,8 @@ class AgentMemory:
         self.faced_t = self.faced_at = -math.inf     # the noise it last turned to: heard at, turned at
         self.last_seen: dict[int, Sighting] = {}   # the view's memory (the same dict)
         self.heard: Heard | None = None
+        #: an enemy has been seen or heard since the match began (it outlives a death)
+        self.met = False
 
     def reset(self) -> None:
         """It died: the fight is over (what it knows of the map stays)."""
@@ -62,6 +64,7 @@ class AgentMemory:
     def digest(self, view: "View", level: "Difficulty") -> Percept:
         t, me = view.t, view.me
         self.last_seen, self.heard = view.memory.last_seen, view.memory.heard
+        self.met = self.met or bool(self.last_seen) or self.heard is not None
         hit, killed = self._events(view)
         self.hits = [h for h in self.hits if t - h < HITS_KEPT]
         for o in view.seen:
