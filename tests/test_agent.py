@@ -136,7 +136,7 @@ def test_search_plan_goals_are_valid_reachable_nodes():
     plan = SearchPlan(g, 90.0, 90.0)
     assert len(plan.goals) >= 8
     for x, z in plan.goals:
-        assert g.valid[g.node_of(x, z)]
+        assert g.is_valid(g.node_of(x, z))
     # the first goal is next to the estimate
     assert math.hypot(plan.goals[0][0] - 90.0, plan.goals[0][1] - 90.0) < 8.0
 

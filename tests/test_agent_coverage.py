@@ -28,7 +28,7 @@ def test_views_blocks_and_line_of_sight_match_the_walls():
     assert len(v) > 50 and v.k == 4
     # every representative point is a valid node inside its block
     for c, (i, j) in enumerate(v.nodes):
-        assert grid.valid[i, j] and v.cell_of[i, j] == c
+        assert grid.valid[0, i, j] and v.cell_of[i, j] == c
     # the pairwise sight agrees with the walls' own test, both ways
     rng = np.random.default_rng(0)
     for a, b in rng.integers(0, len(v), size=(200, 2)):

@@ -51,7 +51,7 @@ def test_the_fort_agent_grid_is_layered_and_reaches_the_roof(fort):
     g = agent_grid(w, 1.0, w.tanks[0].spec.radius + 0.5)
     lay = g.layers
     assert lay is not None and lay.levels == 2
-    v = lay.layered("valid")
+    v = lay.valid
     assert v[1].sum() > 200 and v[0].sum() > 1000        # the roof and the yard
     assert np.array_equal(g.valid, v.any(axis=0))         # the projection
     # links only between valid nodes, and some from level 0 up to level 1 (the ramps)
@@ -59,7 +59,7 @@ def test_the_fort_agent_grid_is_layered_and_reaches_the_roof(fort):
     assert ((link[0] == 1) & v[0][..., None]).any()
     assert not (link[~v] >= 0).any()
     # heights: the roof at 5 m, the yard at 0
-    h = lay.layered("height")
+    h = lay.height
     assert np.allclose(h[1][v[1]], 5.0, atol=0.15)
 
 

@@ -93,7 +93,7 @@ def test_bare_walls_file_svg_table_and_region(tmp_path, monkeypatch):
     assert len(lines) == 12 * 8  # nodes with 2 <= x <= 8 and 2 <= z <= 6 at 0.5 m
     g = NavGrid.load(tmp_path / "yard.navgrid.npz")
     i, j, x, z, v, reach, ri, ci, rt, ct = lines[0].split()
-    assert float(x) >= 2 and float(z) >= 2 and int(ri) == g.row_index[int(i), int(j)]
+    assert float(x) >= 2 and float(z) >= 2 and int(ri) == g.row_index[0, int(i), int(j)]
     # walls.txt itself keeps the plain names
     write_walls(tmp_path / "walls.txt", w)
     assert run(tmp_path / "walls.txt", "--clearance", 0.6, "--annotate", "none").exit_code == 0

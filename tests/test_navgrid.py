@@ -1,3 +1,4 @@
+import io
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ from tanktool.nav.navgrid import (
     classify,
     format_table,
     free_space,
+    grid_from_mask,
     grid_shape,
     node_coords,
     open_ends,
@@ -55,7 +57,7 @@ def test_node_positions_and_lookup():
     i, j = 8, 12
     assert set(g.neighbours4(i, j)) == {(8, 13), (9, 12), (8, 11), (7, 12)}
     # next to the wall: the node beyond is invalid, so it is not a neighbour
-    row = np.flatnonzero(g.valid[8])
+    row = np.flatnonzero(g.valid[0][8])
     assert (8, row[0] - 1) not in g.neighbours4(8, row[0])
 
 
@@ -146,12 +148,12 @@ def test_clearance_is_exact_distance():
     d2 = _min_dist2(w, X, Z)
     assert np.array_equal(too_close(w.segments, origin, cell, shape, r), d2 < r * r)
     g = build_navgrid(w, cell, r)
-    assert np.array_equal(g.valid, free_space(w, origin, cell, shape) & (d2 >= r * r))
+    assert np.array_equal(g.valid[0], free_space(w, origin, cell, shape) & (d2 >= r * r))
     # nodes exactly at the clearance count as valid: distance >= clearance
     box = box_arena(10, 10, margin=1)
     g = build_navgrid(box, cell=0.5, clearance=0.75)
     i = g.shape[0] // 2
-    xs = g.node_x[g.valid[i]]
+    xs = g.node_x[g.valid[0][i]]
     assert xs.min() == pytest.approx(0.75) and xs.max() == pytest.approx(9.25)
 
 
@@ -165,10 +167,10 @@ def test_shared_edges_cancel_and_courtyards_are_free():
     w = assemble(loops, (-1, -1, 31, 31))
     assert len(open_ends(w)) == 0
     g = build_navgrid(w, cell=0.5, clearance=0.0)
-    assert not g.valid[g.node_of(9.9, 7.3)] and not g.valid[g.node_of(10.2, 7.3)]
-    assert g.valid[g.node_of(23.1, 23.3)]       # courtyard
-    assert not g.valid[g.node_of(19.3, 19.6)]   # the block around it
-    assert g.valid[g.node_of(2.2, 2.3)] and not g.valid[g.node_of(-0.6, 5.1)]
+    assert not g.valid[0][g.node_of(9.9, 7.3)] and not g.valid[0][g.node_of(10.2, 7.3)]
+    assert g.valid[0][g.node_of(23.1, 23.3)]       # courtyard
+    assert not g.valid[0][g.node_of(19.3, 19.6)]   # the block around it
+    assert g.valid[0][g.node_of(2.2, 2.3)] and not g.valid[0][g.node_of(-0.6, 5.1)]
 
 
 def test_open_ends_find_loose_and_flipped_walls():
@@ -225,12 +227,12 @@ def test_unreachable_regions_from_spawns():
     w = assemble(loops, (-1, -1, 23, 11))
     spawns = np.array([[5.0, 5.0, 0.0]])
     g = build_navgrid(w, cell=0.5, clearance=1.0, spawns=spawns)
-    left = g.valid & (g.node_x[None, :] < 11)
-    assert np.array_equal(g.reachable, left)
-    assert g.valid.sum() > left.sum() > 0
+    left = g.valid[0] & (g.node_x[None, :] < 11)
+    assert np.array_equal(g.reachable[0], left)
+    assert g.valid[0].sum() > left.sum() > 0
     # a spawn inside the clearance band snaps to the nearest valid node
     g2 = build_navgrid(w, cell=0.5, clearance=1.0, spawns=np.array([[21.7, 5.0, 0.0]]))
-    assert g2.reachable.sum() == g.valid.sum() - left.sum()
+    assert g2.reachable[0].sum() == g.valid[0].sum() - left.sum()
     # no spawns: every valid node is reachable
     assert np.array_equal(build_navgrid(w, 0.5, 1.0).reachable, g.valid)
 
@@ -257,6 +259,24 @@ def test_save_load_round_trip(tmp_path):
         assert np.array_equal(getattr(h, f), getattr(g, f))
 
 
+def test_one_level_grid_is_layered_in_memory_and_two_dimensional_on_file(tmp_path):
+    """In memory every grid is (L, nz, nx), L = 1 here; the file keeps (nz, nx) arrays
+    (bundled arenas' bytes and hashes do not change), and a (nz, nx) file reads as L = 1."""
+    g = build_navgrid(random_arena(1), 0.5, 0.6, spawns=np.array([[10.0, 10.0]]))
+    assert g.levels == 1 and g.valid.shape == (1, *g.shape) and g.heights().shape == g.valid.shape
+    assert g.links().shape == (1, *g.shape, 4) and all(len(n) == 3 and n[0] == 0 for n in g.spawn_nodes)
+    data = g.to_bytes()
+    with np.load(io.BytesIO(data)) as z:
+        for f in ("valid", "row_index", "row_total", "col_index", "col_total", "reachable", "height"):
+            assert z[f].shape == g.shape, f
+    p = tmp_path / "g.npz"
+    g.save(p)
+    h = NavGrid.load(p)
+    assert h.valid.shape == (1, *g.shape) and h.to_bytes() == data
+    hand = grid_from_mask(np.ones((3, 4), bool))
+    assert hand.valid.shape == hand.row_index.shape == hand.reachable.shape == (1, 3, 4)
+
+
 def test_load_rejects_bad_files(tmp_path):
     p = tmp_path / "x.npz"
     np.savez(p, origin=np.zeros(2))
@@ -278,7 +298,7 @@ def test_table_one_node_a_line():
     assert len(body) == g.valid.size
     i, j, x, z, v, r, ri, ci, rt, ct = body[g.nx * 2 + 3].split()
     assert (int(i), int(j)) == (2, 3) and float(x) == g.centre(2, 3)[0]
-    assert int(v) == g.valid[2, 3] and (int(ri), int(rt)) == (g.row_index[2, 3], g.row_total[2, 3])
+    assert int(v) == g.valid[0, 2, 3] and (int(ri), int(rt)) == (g.row_index[0, 2, 3], g.row_total[0, 2, 3])
     region = format_table(g, np.array([[0, 0], [2, 1.0]]))
     assert len([ln for ln in region.splitlines() if not ln.startswith("#")]) == 2
 

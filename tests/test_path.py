@@ -20,9 +20,9 @@ def _steps_ok(g, path):
     for (a, b), (c, d) in zip(path, path[1:]):
         di, dj = c - a, d - b
         assert max(abs(di), abs(dj)) == 1
-        assert g.valid[c, d]
+        assert g.valid[0][c, d]
         if di and dj:  # no corner cutting
-            assert g.valid[a + di, b] and g.valid[a, b + dj]
+            assert g.valid[0][a + di, b] and g.valid[0][a, b + dj]
 
 
 def _dijkstra_cost(valid, s, t):
@@ -47,14 +47,14 @@ def _dijkstra_cost(valid, s, t):
 def test_astar_is_optimal_and_never_cuts_corners():
     g = build_navgrid(block_maze(5, n=4), cell=1.0, clearance=0.6)
     rng = np.random.default_rng(2)
-    nodes = np.argwhere(g.valid)
+    nodes = np.argwhere(g.valid[0])
     for _ in range(6):
         s, t = (tuple(map(int, nodes[k])) for k in rng.choice(len(nodes), 2, replace=False))
         p = astar(g, s, t)
         assert p[0] == s and p[-1] == t
         _steps_ok(g, p)
         cost = sum(math.hypot(c - a, d - b) for (a, b), (c, d) in zip(p, p[1:]))
-        assert cost == pytest.approx(_dijkstra_cost(g.valid, s, t))
+        assert cost == pytest.approx(_dijkstra_cost(g.valid[0], s, t))
 
 
 def test_corner_is_not_cut():
@@ -102,7 +102,7 @@ def test_grid_line_of_sight():
 
 def test_smoothing_on_the_grid_keeps_line_of_sight():
     g = build_navgrid(random_arena(3), cell=0.5, clearance=1.0)
-    nodes = np.argwhere(g.reachable)
+    nodes = np.argwhere(g.reachable[0])
     s, t = tuple(map(int, nodes[0])), tuple(map(int, nodes[-1]))
     p = astar(g, s, t)
     sm = smooth_path(g, p)
@@ -117,7 +117,7 @@ def test_smoothing_against_the_quadtree_respects_clearance():
     r = 0.9
     g = build_navgrid(w, cell=0.5, clearance=r)
     q = WallQuadtree.build(w.segments, w.bounds)
-    nodes = np.argwhere(g.reachable)
+    nodes = np.argwhere(g.reachable[0])
     p = astar(g, tuple(map(int, nodes[5])), tuple(map(int, nodes[-5])))
     pts = g.centres(np.array(p))
     sm = smooth_path(q, pts, clearance=r * 0.99)
@@ -159,7 +159,7 @@ def test_find_path_in_world_coordinates():
     w = block_maze(3, n=4)
     g = build_navgrid(w, cell=0.5, clearance=1.0)
     q = WallQuadtree.build(w.segments, w.bounds)
-    free = g.centres(np.argwhere(g.valid))
+    free = g.centres(np.argwhere(g.valid[0]))
     start, goal = tuple(free[0]), tuple(free[-1])
     for pts in (find_path(g, start, goal), find_path(g, start, goal, quadtree=q)):
         assert np.allclose(pts[0], start) and np.allclose(pts[-1], goal) and len(pts) >= 2
@@ -173,7 +173,7 @@ def test_find_path_in_world_coordinates():
     # thick): no valid node within 4 cells, so no path
     from scipy.ndimage import binary_dilation
 
-    near_valid = binary_dilation(g.valid, iterations=5, structure=np.ones((3, 3), bool))
+    near_valid = binary_dilation(g.valid[0], iterations=5, structure=np.ones((3, 3), bool))
     deep = np.argwhere(~near_valid)
     assert len(deep)
     assert find_path(g, g.centre(*deep[len(deep) // 2]), goal).shape == (0, 2)

@@ -44,16 +44,16 @@ def test_nodes_ahead_mapping_for_all_four_headings():
         #######
     """))
     # node (2, 2): row run j=1..5 (index 2 of 5), column run i=1..3 (index 2 of 3)
-    assert (g.row_index[2, 2], g.row_total[2, 2], g.col_index[2, 2], g.col_total[2, 2]) == (2, 5, 2, 3)
+    assert (g.row_index[0, 2, 2], g.row_total[0, 2, 2], g.col_index[0, 2, 2], g.col_total[0, 2, 2]) == (2, 5, 2, 3)
     assert nodes_ahead(g, (2, 2), "+x") == 3  # row_total - row_index
     assert nodes_ahead(g, (2, 2), "-x") == 1  # row_index - 1
     assert nodes_ahead(g, (2, 2), "+z") == 1  # col_total - col_index
     assert nodes_ahead(g, (2, 2), "-z") == 1  # col_index - 1
     # the counts equal a walk to the wall
     for h, (di, dj) in {"+x": (0, 1), "-x": (0, -1), "+z": (1, 0), "-z": (-1, 0)}.items():
-        for node in zip(*np.nonzero(g.valid)):
+        for node in zip(*np.nonzero(g.valid[0])):
             n, (i, j) = 0, node
-            while g.valid[i + di, j + dj]:
+            while g.valid[0][i + di, j + dj]:
                 i, j, n = i + di, j + dj, n + 1
             assert nodes_ahead(g, node, h) == n
     assert nodes_ahead(g, (0, 0), "+x") == 0
@@ -148,7 +148,7 @@ def test_grid_shaped_like_the_paper_figure():
     hijo1, hijo2, hijo3 = kids["right"], kids["ahead"], kids["left"]
     assert (hijo1.node, hijo2.node, hijo3.node) == ((2, 7), (2, 6), (2, 5))
     table = {
-        name: (int(g.row_index[c.node]), int(g.col_index[c.node]), int(g.row_total[c.node]), int(g.col_total[c.node]))
+        name: (int(g.row_index[0][c.node]), int(g.col_index[0][c.node]), int(g.row_total[0][c.node]), int(g.col_total[0][c.node]))
         for name, c in (("HIJO 1", hijo1), ("HIJO 2", hijo2), ("HIJO 3", hijo3))
     }
     # renglon, columna, total renglones, total columnas: a row of 10 as in the paper
@@ -192,11 +192,11 @@ def test_agent_walk_on_bundled_arenas(folder):
     arena = load_arena(folder)
     g = build_navgrid(arena.walls, 1.0, 2.0, spawns=arena.spawns)
     assert g.spawn_nodes
-    for spawn, node in zip(arena.spawns, g.spawn_nodes):
+    for spawn, node in zip(arena.spawns, (n[1:] for n in g.spawn_nodes)):
         h = heading_from_angle(spawn[2])
         for _ in range(150):
             nxt = choose_next(g, node, h)
-            assert nxt is not None and g.valid[nxt] and g.reachable[nxt]
+            assert nxt is not None and g.valid[0][nxt] and g.reachable[0][nxt]
             ahead = {c.node for c in children(g, node, h)}
             di, dj = nxt[0] - node[0], nxt[1] - node[1]
             assert nxt in ahead or (abs(di) + abs(dj) == 1 and not ahead)

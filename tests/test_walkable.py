@@ -278,7 +278,7 @@ def test_a_five_column_file_from_before_reads_as_one_block():
     assert not w.layered and w.level.tolist() == [0, 0] and w.region.tolist() == [0, 0]
 
 
-def test_layered_navgrid_round_trips_and_one_level_keeps_two_dimensions(tmp_path):
+def test_layered_navgrid_round_trips_and_one_level_file_keeps_two_dimensions(tmp_path):
     V, F = mesh_of("bridge")
     s = walkable_surface(V, F, PARAMS, 1.0)
     g = grid_from_surface(s, 1.0, s.hf.origin[[0, 2]])
@@ -289,9 +289,14 @@ def test_layered_navgrid_round_trips_and_one_level_keeps_two_dimensions(tmp_path
     V, F = mesh_of("bumpy_floor")
     s = walkable_surface(V, F, PARAMS, 1.0)
     g = grid_from_surface(s, 1.0, s.hf.origin[[0, 2]])
-    assert g.valid.ndim == 2 and g.height.shape == g.valid.shape and g.link.shape == g.valid.shape + (4,)
-    with np.load(tmp_path / "g.npz") as z:
+    # in memory one level is (1, nz, nx); its file keeps (nz, nx)
+    assert g.valid.shape == (1, *g.shape) and g.height.shape == g.valid.shape and g.link.shape == g.valid.shape + (4,)
+    g.save(tmp_path / "one.npz")
+    with np.load(tmp_path / "one.npz") as z:
         assert {"origin", "cell", "shape", "valid", "height", "link", "row_index"} <= set(z.files)
+        assert z["valid"].shape == g.shape and z["link"].shape == (*g.shape, 4)
+    back = NavGrid.load(tmp_path / "one.npz")
+    assert back.levels == 1 and np.array_equal(back.link, g.link) and np.array_equal(back.valid, g.valid)
 
 
 def test_import_and_build_navgrid_on_a_two_level_model(tmp_path):

@@ -78,7 +78,7 @@ def spawn_nodes(grid, spawns: np.ndarray, ys: np.ndarray) -> list[tuple[int, int
     level there), within one cell; None where there is none."""
     from ..nav.navgrid import nearest_valid_node3
 
-    valid = grid.layered("valid")
+    valid = grid.valid
     height = grid.heights()
     out = []
     for (x, z), y in zip(spawns[:, :2], ys):
@@ -103,8 +103,8 @@ def level_rules(man: Manifest, bundle: Path, spawns: np.ndarray, ys: np.ndarray,
     grid = load_grid(man, bundle, out)
     if grid is None:
         return out
-    valid = grid.layered("valid")
-    usable = valid & grid.layered("reachable")
+    valid = grid.valid
+    usable = valid & grid.reachable
     if not usable.any():
         out.append(diag("A309", mpath, man.lines.table("navgrid"),
                         f"the navigation grid has no node a tank can use: {int(valid.sum()):,} valid, none reachable "

@@ -147,9 +147,9 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
         f"({t_build * 1000:.0f} ms)"
     )
     if params is not None:
-        hv = grid.heights()[grid.layered("valid")]
+        hv = grid.heights()[grid.valid]
         if grid.levels > 1:
-            per = ", ".join(f"level {k}: {int(v.sum()):,}" for k, v in enumerate(grid.layered("valid")))
+            per = ", ".join(f"level {k}: {int(v.sum()):,}" for k, v in enumerate(grid.valid))
             echo(f"  {per}")
         if len(hv):
             echo(f"  heights y {hv.min():.2f} .. {hv.max():.2f}; walkable: {params.describe()}")

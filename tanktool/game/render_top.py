@@ -170,7 +170,7 @@ class TopView:
             text(surf, str(e), (self.size[0] // 2, 20), 18, anchor="midtop")
             return surf
         nz, nx = grid.shape
-        valid = grid.layered("valid").any(axis=0)       # on a layered grid: valid on any level
+        valid = grid.valid.any(axis=0)                  # valid on any level
         rgba = np.zeros((nz, nx, 4), np.uint8)
         rgba[valid] = (90, 230, 120, 90)
         rgba[~valid] = (230, 60, 60, 40)

@@ -97,7 +97,7 @@ def grid_components(grid: NavGrid) -> tuple[np.ndarray, int]:
 
     from .navgrid import STEPS
 
-    valid = grid.layered("valid")
+    valid = grid.valid
     link = grid.links()
     L, nz, nx = valid.shape
     ids = np.full(valid.shape, -1, dtype=np.int64)

@@ -56,17 +56,25 @@ Node = tuple[int, int]
 STEPS: dict[str, Node] = {"+x": (0, 1), "+z": (1, 0), "-x": (0, -1), "-z": (-1, 0)}
 
 
+def _node3(n: tuple) -> tuple[int, int, int]:
+    """A node as ``(level, i, j)``; an ``(i, j)`` is on level 0."""
+    return (0, int(n[0]), int(n[1])) if len(n) == 2 else (int(n[0]), int(n[1]), int(n[2]))
+
+
 @dataclass
 class NavGrid:
-    """A navigation grid.  Per-node arrays have shape ``(nz, nx)`` on a one-level
-    arena and ``(L, nz, nx)`` on an arena of L levels (node ``(level, i, j)``).
+    """A navigation grid.  Per-node arrays have shape ``(L, nz, nx)`` in memory, on every
+    arena: L levels (node ``(level, i, j)``), L = 1 on a flat one.  Arrays given as
+    ``(nz, nx)`` (a hand-made mask, a file of one level) gain the level axis on
+    construction; :meth:`to_bytes` writes a one-level grid's arrays as ``(nz, nx)``
+    (docs/formats.md), so such files keep their bytes.
 
     row_index / row_total: 1-based position of the node in its row run of valid
     nodes, and that run's length (0 for invalid nodes); col_* the same for columns.
     Runs are counted per level and break where two neighbours are not linked.
     height: world y of the walkable surface at each node (NaN where there is none);
     a node may be invalid (a tank does not fit there) and still have a height.
-    link: ``valid.shape + (4,)`` int8, the level of the node reached by each step of
+    link: ``(L, nz, nx, 4)`` int8, the level of the node reached by each step of
     STEPS (+x, +z, -x, -z), -1 where the step is blocked (a wall, a drop-off, a slope
     too steep, another level out of the climb), between nodes of the surface valid or
     not.  None on grids made from walls alone: then neighbours on the same level are
@@ -83,34 +91,36 @@ class NavGrid:
     col_total: np.ndarray
     reachable: np.ndarray
     clearance: float = float("nan")  # how it was built; kept in arena.toml, not in the npz
-    spawn_nodes: list[Node] = field(default_factory=list)
+    spawn_nodes: list[tuple[int, int, int]] = field(default_factory=list)  # (level, i, j)
     height: np.ndarray | None = None
     link: np.ndarray | None = None
-    layers: "NavGrid | None" = None  # a 2-D projection's layered grid (the agents' on a ground); not saved
+    layers: "NavGrid | None" = None  # a one-level projection's layered grid (the agents' on a ground); not saved
+
+    def __post_init__(self) -> None:
+        # one representation in memory: a (nz, nx) array is level 0 of (1, nz, nx)
+        if np.ndim(self.valid) == 2:
+            for k in _FIELDS + ("height",):
+                a = getattr(self, k)
+                if a is not None:
+                    setattr(self, k, np.asarray(a)[None])
+            if self.link is not None:
+                self.link = np.asarray(self.link)[None]
+        self.spawn_nodes = [_node3(n) for n in self.spawn_nodes]
 
     # ------------------------------------------------------------ levels
     @property
     def levels(self) -> int:
-        """Number of levels (1 for a flat grid with 2-D arrays)."""
-        return 1 if self.valid.ndim == 2 else int(self.valid.shape[0])
-
-    def layered(self, name: str) -> np.ndarray:
-        """A per-node array as ``(L, nz, nx)`` (a view: a one-level grid gains an axis)."""
-        a = getattr(self, name)
-        return a[None] if self.valid.ndim == 2 else a
+        """Number of levels (1 on a flat arena)."""
+        return int(self.valid.shape[0])
 
     def links(self) -> np.ndarray:
         """``(L, nz, nx, 4)`` levels reached by each step (-1: blocked), derived from
         validity when the grid has no ``link`` array."""
-        if self.link is not None:
-            return self.link[None] if self.valid.ndim == 2 else self.link
-        return links_from_valid(self.layered("valid"))
+        return self.link if self.link is not None else links_from_valid(self.valid)
 
     def heights(self) -> np.ndarray:
         """``(L, nz, nx)`` surface heights (0 at valid nodes of a grid without heights)."""
-        if self.height is not None:
-            return self.layered("height")
-        return np.where(self.layered("valid"), 0.0, np.nan)
+        return self.height if self.height is not None else np.where(self.valid, 0.0, np.nan)
 
     # ------------------------------------------------------------ geometry
     @property
@@ -157,16 +167,17 @@ class NavGrid:
     def inside(self, i: int, j: int) -> bool:
         return 0 <= i < self.nz and 0 <= j < self.nx
 
-    def is_valid(self, node: Node) -> bool:
+    def is_valid(self, node: Node, level: int = 0) -> bool:
+        """Whether node (i, j) of ``level`` is inside the grid and valid."""
         i, j = node
-        return self.inside(i, j) and bool(self.valid[i, j])
+        return self.inside(i, j) and bool(self.valid[level, i, j])
 
-    def neighbours4(self, i: int, j: int) -> list[Node]:
-        """The valid 4-neighbours of (i, j), in the order +x, +z, -x, -z."""
+    def neighbours4(self, i: int, j: int, level: int = 0) -> list[Node]:
+        """The valid 4-neighbours of (i, j) on ``level``, in the order +x, +z, -x, -z."""
         out = []
         for di, dj in STEPS.values():
             a, b = i + di, j + dj
-            if self.inside(a, b) and self.valid[a, b]:
+            if self.inside(a, b) and self.valid[level, a, b]:
                 out.append((a, b))
         return out
 
@@ -182,16 +193,18 @@ class NavGrid:
         atomic_write_bytes(path, self.to_bytes())
 
     def to_bytes(self) -> bytes:
+        """The npz bytes; a one-level grid's arrays are written as ``(nz, nx)`` (the
+        2002 grids' format, unchanged since before levels existed)."""
         buf = io.BytesIO()
-        extra = {}
-        extra["height"] = np.asarray(self.heights() if self.valid.ndim == 3 else self.heights()[0], dtype=np.float32)
+        arrays = {k: getattr(self, k) for k in _FIELDS}
+        arrays["height"] = np.asarray(self.heights(), dtype=np.float32)
         if self.link is not None:
-            extra["link"] = np.asarray(self.link, dtype=np.int8)
+            arrays["link"] = np.asarray(self.link, dtype=np.int8)
+        if self.levels == 1:
+            arrays = {k: a[0] for k, a in arrays.items()}
         np.savez_compressed(
             buf, origin=np.asarray(self.origin, dtype=np.float64),
-            cell=np.array(float(self.cell)), shape=np.array(self.shape, dtype=np.int64),
-            valid=self.valid, row_index=self.row_index, row_total=self.row_total,
-            col_index=self.col_index, col_total=self.col_total, reachable=self.reachable, **extra,
+            cell=np.array(float(self.cell)), shape=np.array(self.shape, dtype=np.int64), **arrays,
         )
         return buf.getvalue()
 
@@ -234,7 +247,7 @@ class NavGrid:
         v = arrays["valid"]
         if v.ndim == 3 and v.shape[1:] == shape and 1 <= v.shape[0] <= MAX_LEVELS:
             full = v.shape
-        elif v.shape == shape:
+        elif v.shape == shape:  # one level, stored as (nz, nx) (NavGrid adds the level axis)
             full = shape
         else:
             raise FormatError(f"{path}: valid has shape {v.shape}, expected {shape} or (levels, {shape[0]}, {shape[1]})")
@@ -246,8 +259,9 @@ class NavGrid:
             arrays["reachable"] = arrays["valid"].copy()
         height = arrays.get("height")
         link = arrays.get("link")
-        if link is not None and ((link < -1) | (link >= (1 if v.ndim == 2 else v.shape[0]))).any():
-            raise FormatError(f"{path}: link holds levels outside -1 .. {(1 if v.ndim == 2 else v.shape[0]) - 1}")
+        levels = 1 if v.ndim == 2 else v.shape[0]
+        if link is not None and ((link < -1) | (link >= levels)).any():
+            raise FormatError(f"{path}: link holds levels outside -1 .. {levels - 1}")
         return cls(
             origin, cell, shape, arrays["valid"].astype(bool),
             *(arrays[k].astype(np.int32) for k in ("row_index", "row_total", "col_index", "col_total")),
@@ -690,19 +704,24 @@ def build_navgrid(
     else:
         valid = classify(walls, origin, cell, shape, clearance, progress=progress)
     ri, rt, ci, ct = runs(valid)
-    grid = NavGrid(origin, float(cell), shape, valid, ri, rt, ci, ct, valid, float(clearance))
     seeds: list[Node] = []
+    reachable = valid.copy()
     if spawns is not None and len(spawns):
         reach = int(math.ceil(clearance / cell)) + 2
         for s in np.asarray(spawns, dtype=np.float64).reshape(len(spawns), -1):
-            n = nearest_valid_node(valid, grid.node_of(s[0], s[1]), reach)
+            n = nearest_valid_node(valid, _node_at(origin, cell, shape, s[0], s[1]), reach)
             if n is not None:
                 seeds.append(n)
-        grid.reachable = reachable_from(valid, seeds) if seeds else np.zeros_like(valid)
-    else:
-        grid.reachable = valid.copy()
-    grid.spawn_nodes = seeds
-    return grid
+        reachable = reachable_from(valid, seeds) if seeds else np.zeros_like(valid)
+    # the (nz, nx) arrays of the 2002 classifier are level 0 of the grid
+    return NavGrid(origin, float(cell), shape, valid, ri, rt, ci, ct, reachable, float(clearance), spawn_nodes=seeds)
+
+
+def _node_at(origin: np.ndarray, cell: float, shape: tuple[int, int], x: float, z: float) -> Node:
+    """The node whose cell holds (x, z), clamped into a grid of ``shape`` (NavGrid.node_of)."""
+    j = math.floor((x - float(origin[0])) / cell)
+    i = math.floor((z - float(origin[1])) / cell)
+    return (min(max(i, 0), shape[0] - 1), min(max(j, 0), shape[1] - 1))
 
 
 def grid_from_mask(valid: np.ndarray, origin: tuple[float, float] = (0.0, 0.0), cell: float = 1.0) -> NavGrid:
@@ -733,8 +752,8 @@ def format_table(grid: NavGrid, region: np.ndarray | None = None) -> str:
         "# i j x z valid reachable renglon columna total_renglones total_columnas",
     ]
     cols = [
-        i, j, x, z, grid.valid[i, j].astype(int), grid.reachable[i, j].astype(int),
-        grid.row_index[i, j], grid.col_index[i, j], grid.row_total[i, j], grid.col_total[i, j],
+        i, j, x, z, grid.valid[0, i, j].astype(int), grid.reachable[0, i, j].astype(int),
+        grid.row_index[0, i, j], grid.col_index[0, i, j], grid.row_total[0, i, j], grid.col_total[0, i, j],
     ]
     body = [
         f"{a} {b} {c:.4f} {d:.4f} {e} {f} {g} {h} {k} {m}"

@@ -37,9 +37,10 @@ def astar(grid: NavGrid, start: Node, goal: Node, passable: np.ndarray | None = 
     A diagonal step needs both orthogonal neighbours it passes valid (no corner
     cutting).  Step costs 1 and sqrt(2); the octile distance is the heuristic, so the
     path is optimal.  Returns ``[]`` when either end is not passable or no path exists.
-    ``passable`` defaults to ``grid.valid``.
+    ``passable`` (nz, nx) defaults to the valid nodes of the grid's level 0 (the 2002
+    planner: one level; :func:`astar_layered` plans across levels).
     """
-    ok = grid.valid if passable is None else passable
+    ok = grid.valid[0] if passable is None else passable
     nz, nx = ok.shape
     (si, sj), (gi, gj) = start, goal
     for i, j in (start, goal):
@@ -104,7 +105,7 @@ def grid_line_of_sight(grid: NavGrid, a: Node, b: Node, passable: np.ndarray | N
     passes exactly through a cell corner, both cells beside the corner must be
     passable too (no corner cutting, as in :func:`astar`).
     """
-    ok = grid.valid if passable is None else passable
+    ok = grid.valid[0] if passable is None else passable   # level 0, as astar
     nz, nx = ok.shape
     (z, x), (bi, bj) = a, b
     if not (0 <= z < nz and 0 <= x < nx and 0 <= bi < nz and 0 <= bj < nx):
@@ -155,7 +156,7 @@ def smooth_path(
         if not nodes_given:
             raise TypeError("smoothing against a NavGrid takes a list of nodes")
         nodes = [tuple(map(int, n)) for n in path]
-        ok = obstacles.valid
+        ok = obstacles.valid[0]
         keep = [0]
         while keep[-1] < len(nodes) - 1:
             a = keep[-1]
@@ -197,8 +198,8 @@ def find_path(
     """
     from .navgrid import nearest_valid_node
 
-    s = nearest_valid_node(grid.valid, grid.node_of(*start), snap)
-    g = nearest_valid_node(grid.valid, grid.node_of(*goal), snap)
+    s = nearest_valid_node(grid.valid[0], grid.node_of(*start), snap)
+    g = nearest_valid_node(grid.valid[0], grid.node_of(*goal), snap)
     if s is None or g is None:
         return np.zeros((0, 2))
     nodes = astar(grid, s, g)
@@ -226,7 +227,7 @@ def layered_moves(grid: NavGrid) -> tuple[np.ndarray, list[tuple[int, int, float
     cutting, and no cutting between levels)."""
     from .navgrid import STEPS
 
-    valid = grid.layered("valid")
+    valid = grid.valid
     link = grid.links().astype(np.int64)
     L, nz, nx = valid.shape
     n = valid.size
@@ -270,7 +271,7 @@ def astar_layered(grid: NavGrid, start: Node3, goal: Node3) -> list[Node3]:
     decks), 8-connected along the grid's links; ``[]`` when there is none.  The octile
     distance over (i, j) is the heuristic (a change of level costs nothing extra), so
     the path is optimal."""
-    valid = grid.layered("valid")
+    valid = grid.valid
     L, nz, nx = valid.shape
     for n in (start, goal):
         if not (0 <= n[0] < L and 0 <= n[1] < nz and 0 <= n[2] < nx):

@@ -82,7 +82,7 @@ def nodes_ahead(grid: NavGrid, node: Node, heading: str) -> int:
     i, j = node
     if not grid.is_valid(node):
         return 0
-    return run_ahead(grid.row_index[i, j], grid.col_index[i, j], grid.row_total[i, j], grid.col_total[i, j], heading)
+    return run_ahead(grid.row_index[0, i, j], grid.col_index[0, i, j], grid.row_total[0, i, j], grid.col_total[0, i, j], heading)
 
 
 @dataclass(frozen=True)

@@ -463,11 +463,5 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
         reachable = layered_reachable(valid, link, seeds_n) if seeds_n else np.zeros_like(valid)
     else:
         reachable = valid.copy()
-    arrays = [valid, ri, rt, ci, ct, reachable]
-    if L == 1:
-        arrays = [a[0] for a in arrays]
-        height, link = height[0], link[0]
-    grid = NavGrid(np.asarray(origin_xz, dtype=np.float64), float(cell), (nz, nx), *arrays, float(clearance),
-                   height=height, link=link)
-    grid.spawn_nodes = [n[1:] if L == 1 else n for n in seeds_n]
-    return grid
+    return NavGrid(np.asarray(origin_xz, dtype=np.float64), float(cell), (nz, nx), valid, ri, rt, ci, ct, reachable,
+                   float(clearance), spawn_nodes=seeds_n, height=height, link=link)

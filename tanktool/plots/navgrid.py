@@ -30,26 +30,27 @@ MIN_LABEL_PT = {"rows": 15.0, "cols": 15.0, "both": 20.0}
 
 
 def level_view(grid: Any, level: int) -> Any:
-    """One level of a grid as a one-level NavGrid (its 2-D arrays)."""
+    """One level of a grid as a one-level NavGrid."""
     from ..nav.navgrid import NavGrid
 
     if grid.levels == 1:
         return grid
-    arrays = [grid.layered(k)[level] for k in ("valid", "row_index", "row_total", "col_index", "col_total",
-                                                "reachable")]
-    return NavGrid(grid.origin, grid.cell, grid.shape, *arrays, grid.clearance,
-                   height=grid.heights()[level], link=grid.links()[level])
+    lv = slice(level, level + 1)
+    arrays = [getattr(grid, k)[lv] for k in ("valid", "row_index", "row_total", "col_index", "col_total", "reachable")]
+    links = np.where(grid.links()[lv] == level, 0, -1).astype(np.int8)   # steps to other levels leave this view
+    return NavGrid(grid.origin, grid.cell, grid.shape, *arrays, grid.clearance, height=grid.heights()[lv], link=links)
 
 
 def node_states(grid: Any, free: np.ndarray | None = None) -> np.ndarray:
-    """(nz, nx) int codes 0..3 in the order of :data:`STATE_COLOURS`."""
+    """(nz, nx) int codes 0..3 of a one-level grid's nodes, in the order of :data:`STATE_COLOURS`."""
     s = np.zeros(grid.shape, dtype=np.int8)
     if free is not None:
         s[free] = 1
     else:  # without the free mask, invalid nodes are all one colour
         s[:] = 1
-    s[grid.valid] = 3
-    s[grid.reachable & grid.valid] = 2
+    valid = grid.valid[0]
+    s[valid] = 3
+    s[grid.reachable[0] & valid] = 2
     return s
 
 
@@ -77,7 +78,7 @@ def _draw_panel(ax, grid, walls, free, quadtree, spawns, annotate, view, j0, j1,
         # no dots on solid ground (clutter) nor under labels (the label marks the node)
         dot = states[i0:i1, j0:j1] > 0
         if labelling:
-            dot &= ~grid.valid[i0:i1, j0:j1]
+            dot &= ~grid.valid[0, i0:i1, j0:j1]
         ax.scatter(xs[dot], zs[dot], s=min(max(1.0, (cell_pt * 0.12) ** 2), 9.0), c="#00000055", lw=0, zorder=1)
         gx = grid.origin[0] + np.arange(j0, j1 + 1) * grid.cell
         gz = grid.origin[1] + np.arange(i0, i1 + 1) * grid.cell
@@ -113,14 +114,14 @@ def _draw_panel(ax, grid, walls, free, quadtree, spawns, annotate, view, j0, j1,
     if labelling:
         # "12/34" is five characters of about 0.6 em: fill most of the cell's width
         font = min(11.0, cell_pt / 4.0)
-        ii, jj = np.nonzero(grid.valid[i0:i1, j0:j1])
+        ii, jj = np.nonzero(grid.valid[0, i0:i1, j0:j1])
         ii, jj = ii + i0, jj + j0
         for i, j in zip(ii.tolist(), jj.tolist()):
             x, z = grid.centre(i, j)
             if not (view[0, 0] <= x <= view[1, 0] and view[0, 1] <= z <= view[1, 1]):
                 continue  # a label must not spill over the axes
-            r = f"{grid.row_index[i, j]}/{grid.row_total[i, j]}"
-            c = f"{grid.col_index[i, j]}/{grid.col_total[i, j]}"
+            r = f"{grid.row_index[0, i, j]}/{grid.row_total[0, i, j]}"
+            c = f"{grid.col_index[0, i, j]}/{grid.col_total[0, i, j]}"
             text = {"rows": r, "cols": c, "both": f"{r}\n{c}"}[annotate]
             ax.text(x, z, text, ha="center", va="center", fontsize=font, color="#10301a", linespacing=0.95,
                     zorder=4, clip_on=True)

@@ -34,15 +34,10 @@ def _candidates(world: "World", radius: float) -> tuple[np.ndarray, np.ndarray]:
     from .agents.navigation import strict_grid
 
     grid = strict_grid(world, CELL, radius)
-    layered = grid.layers if grid.layers is not None else None
-    g = layered if layered is not None else grid
-    ok = np.asarray(g.valid) & np.asarray(g.reachable)
-    if ok.ndim == 2:
-        ii, jj = np.nonzero(ok)
-        ys = np.full(len(ii), np.nan)
-    else:
-        ll, ii, jj = np.nonzero(ok)
-        ys = np.asarray(g.heights(), dtype=np.float64)[ll, ii, jj]
+    g = grid.layers if grid.layers is not None else grid
+    ll, ii, jj = np.nonzero(np.asarray(g.valid) & np.asarray(g.reachable))
+    # a grid of the walls alone (a flat ground) has no heights
+    ys = np.asarray(g.height, dtype=np.float64)[ll, ii, jj] if g.height is not None else np.full(len(ii), np.nan)
     pts = np.stack([g.origin[0] + (jj + 0.5) * g.cell, g.origin[1] + (ii + 0.5) * g.cell], axis=1)
     return pts.astype(np.float64), ys
 

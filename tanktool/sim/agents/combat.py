@@ -249,7 +249,7 @@ class Evade(State["Agent"]):
         i, j = grid.node_of(me.x, me.z)
         r = int(25.0 / grid.cell)
         i0, j0 = max(i - r, 0), max(j - r, 0)
-        a, b = grid.valid[i0:i + r + 1, j0:j + r + 1].nonzero()
+        a, b = grid.valid[0, i0:i + r + 1, j0:j + r + 1].nonzero()
         if len(a) == 0:
             return None
         best, best_d = None, math.inf
@@ -377,10 +377,8 @@ class Hunt(State["Agent"]):
             from scipy.ndimage import distance_transform_edt
 
             g = agent.nav.grid
-            valid = np.asarray(g.layers.valid if g.layers is not None else g.valid, dtype=bool)
-            if valid.ndim == 3:   # a layered grid: each level's own free space
-                free = np.stack([distance_transform_edt(m) for m in valid]) * g.cell
-            else:
-                free = distance_transform_edt(valid) * g.cell
+            valid = np.asarray((g.layers if g.layers is not None else g).valid, dtype=bool)
+            free = np.stack([distance_transform_edt(m) for m in valid]) * g.cell   # each level's own free space
+            free = free if g.layers is not None else free[0]   # the flat sight table's nodes are (i, j)
             self._room = np.array([free[tuple(n)] for n in agent.nav.views.nodes])
         return self._room

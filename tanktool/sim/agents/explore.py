@@ -112,7 +112,7 @@ class Wander(State["Agent"]):
             route.clear()                      # pushed off the route: start again here
             agent.walker = None
         if agent.walker is None:
-            n = nearest_valid_node(grid.valid, grid.node_of(x, z), 6)
+            n = nearest_valid_node(grid.valid[0], grid.node_of(x, z), 6)
             if n is None:
                 return agent.back_off()
             agent.walker = (n, heading_from_angle(me.heading))

@@ -66,7 +66,7 @@ def surface_clearance(ground: "Ground", limit: float) -> np.ndarray:
 
 
 def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: list) -> NavGrid:
-    """The projection grid (2-D, see the module docstring) of the layered agent grid,
+    """The projection grid (one level, see the module docstring) of the layered agent grid,
     which it carries as ``.layers``; ``spawns`` are (x, z, y or None)."""
     fine = ground.cell
     k = max(int(round(cell / fine)), 1)
@@ -115,7 +115,7 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
     layered.spawn_nodes = seeds
     proj = valid.any(axis=0)
     a, b, c, e = runs(proj)
-    grid = NavGrid(origin, step, (NZ, NX), proj, a, b, c, e, proj.copy(), float(clearance))
-    grid.spawn_nodes = [n[1:] for n in seeds]
+    grid = NavGrid(origin, step, (NZ, NX), proj, a, b, c, e, proj.copy(), float(clearance),
+                   spawn_nodes=[(0, *n[1:]) for n in seeds])
     grid.layers = layered
     return grid

@@ -98,7 +98,7 @@ def _make_grid(world: "World", cell: float, clearance: float) -> NavGrid:
     valid = reachable_from(free, seeds) if seeds else free
     grid = grid_from_mask(valid, origin, cell)
     grid.clearance = float(clearance)
-    grid.spawn_nodes = seeds
+    grid.spawn_nodes = [(0, *n) for n in seeds]
     return grid
 
 
@@ -140,7 +140,7 @@ class Memory:
             steps = int(math.ceil(0.5 * self.region / grid.cell))
             for key in range(len(self.last)):
                 cx, cz = self.centre(key)
-                n = nearest_valid_node(grid.valid, grid.node_of(cx, cz), steps)
+                n = nearest_valid_node(grid.valid[0], grid.node_of(cx, cz), steps)
                 if n is not None:
                     gx, gz = grid.centre(*n)
                     if self.key(gx, gz) == key:
@@ -251,7 +251,7 @@ def leaf_goal(grid: NavGrid, r: Rect) -> tuple[float, float] | None:
     x0, z0, x1, z1 = r
     cx, cz = 0.5 * (x0 + x1), 0.5 * (z0 + z1)
     steps = int(math.ceil(max(x1 - x0, z1 - z0) / (2 * grid.cell)))
-    n = nearest_valid_node(grid.valid, grid.node_of(cx, cz), steps)
+    n = nearest_valid_node(grid.valid[0], grid.node_of(cx, cz), steps)
     if n is None:
         return None
     gx, gz = grid.centre(*n)
@@ -266,7 +266,7 @@ def leaf_goals_layered(grid: NavGrid, r: Rect, y: float | None) -> list[tuple[fl
     x0, z0, x1, z1 = r
     cx, cz = 0.5 * (x0 + x1), 0.5 * (z0 + z1)
     steps = int(math.ceil(max(x1 - x0, z1 - z0) / (2 * grid.cell)))
-    valid, height = grid.layered("valid"), grid.layered("height")
+    valid, height = grid.valid, grid.height
     out = []
     for lv in range(valid.shape[0]):
         n = nearest_valid_node(valid[lv], grid.node_of(cx, cz), steps)
@@ -290,13 +290,13 @@ class SearchPlan:
         layers = grid.layers
         self.goals: list[tuple[float, ...]] = []
         if layers is not None:
-            first3 = nearest_valid_node3(layers.layered("valid"), layers.layered("height"), layers.node_of(x, z), y,
+            first3 = nearest_valid_node3(layers.valid, layers.height, layers.node_of(x, z), y,
                                          int(math.ceil(6.0 / grid.cell)))
             if first3 is not None:
                 lv, i, j = first3
-                self.goals = [(*layers.centre(i, j), float(layers.layered("height")[first3]))]
+                self.goals = [(*layers.centre(i, j), float(layers.height[first3]))]
         else:
-            first = nearest_valid_node(grid.valid, grid.node_of(x, z), int(math.ceil(6.0 / grid.cell)))
+            first = nearest_valid_node(grid.valid[0], grid.node_of(x, z), int(math.ceil(6.0 / grid.cell)))
             self.goals = [grid.centre(*first)] if first is not None else []
         for r in search_order((bx0, bz0, bx1, bz1), x, z, leaf):
             if layers is not None:
@@ -335,7 +335,7 @@ def _plan_layered(grid: NavGrid, start: tuple[float, ...], goal: tuple[float, ..
     level the corners the grid's line of sight lets it cut."""
     from ...nav.path import astar_layered, grid_line_of_sight
 
-    valid, height = grid.layered("valid"), grid.layered("height")
+    valid, height = grid.valid, grid.height
     ends = []
     for p in (start, goal):
         y = float(p[2]) if len(p) > 2 and p[2] is not None and math.isfinite(p[2]) else None

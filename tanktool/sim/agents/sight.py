@@ -73,7 +73,7 @@ class Views:
                  solids=None) -> None:
         layers = grid.layers
         base = layers if layers is not None else grid
-        valid = np.asarray(base.layered("valid"), dtype=bool)   # (L, nz, nx): L = 1 on a flat grid
+        valid = np.asarray(base.valid, dtype=bool)   # (L, nz, nx): L = 1 on a flat grid
         L, nz, nx = valid.shape
         k = max(int(round(block / grid.cell)), 1)
         while True:
@@ -88,7 +88,7 @@ class Views:
         self.grid = grid
         self.layers = layers
         self.shape = (bz, bx)
-        height = base.layered("height") if layers is not None else None
+        height = base.height if layers is not None else None
         pts, nodes, ys = [], [], []
         index = np.full((L, bz, bx), -1, dtype=np.int64)     # block -> cell number
         for lv, bi, bj in zip(*np.nonzero(has)):
@@ -154,7 +154,7 @@ class Views:
             c = int(self.cell_of[n])
             if c >= 0:
                 return c
-            m = nearest_valid_node(self.grid.valid, n, 6)
+            m = nearest_valid_node(self.grid.valid[0], n, 6)
             return int(self.cell_of[m]) if m is not None else -1
         lay = self.layers
         i, j = lay.node_of(x, z)
@@ -167,7 +167,7 @@ class Views:
                     best, best_d = c, d
         if best >= 0:
             return best
-        m3 = nearest_valid_node3(lay.layered("valid"), self._height, (i, j), y, 6)
+        m3 = nearest_valid_node3(lay.valid, self._height, (i, j), y, 6)
         return int(self.cell_of[m3]) if m3 is not None else -1
 
     def path_distances(self, start: int) -> np.ndarray:
