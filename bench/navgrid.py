@@ -117,7 +117,7 @@ def run_case(name: str, walls: WallList, cell: float, clearance: float, spawn, b
     X, Z = np.meshgrid(node_coords(origin[0], cell, shape[1]), node_coords(origin[1], cell, shape[0]))
     t_shp, inside = timed(lambda: shapely.contains_xy(poly, X, Z), max(1, repeat // 3))
     # compare with shapely away from the walls (on-wall nodes are invalid anyway)
-    off_wall = grid.valid | ~free  # valid nodes, and those that are not free at all
+    off_wall = grid.valid[0] | ~free  # valid nodes, and those that are not free at all
     shp_disagree = int((inside[off_wall] != free[off_wall]).sum())
 
     k = min(sample, n)
@@ -126,7 +126,7 @@ def run_case(name: str, walls: WallList, cell: float, clearance: float, spawn, b
     t0 = time.perf_counter()
     ref = classify_reference(walls, origin, cell, shape, clearance, nodes=nodes)
     t_ref = (time.perf_counter() - t0) / k * n
-    ref_disagree = int((ref != grid.valid[nodes[:, 0], nodes[:, 1]]).sum())
+    ref_disagree = int((ref != grid.valid[0, nodes[:, 0], nodes[:, 1]]).sum())
 
     return {
         "case": name, "nodes": n, "shape": list(shape), "walls": len(walls), "open_ends": int(len(open_ends(walls))),
