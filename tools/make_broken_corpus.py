@@ -442,8 +442,7 @@ def write_grid(bundle: Path, valid: np.ndarray, reachable: np.ndarray | None = N
     reach = v.copy() if reachable is None else np.asarray(reachable, dtype=bool).reshape(v.shape)
     h = np.where(v, 0.0, np.nan) if height is None else np.where(v, height, np.nan)
     arrays = [v, ri, rt, ci, ct, reach & v]
-    if v.shape[0] == 1:
-        arrays, h, link = [a[0] for a in arrays], h[0], link[0]
+    # to_bytes writes a one-level grid as (nz, nx), the corpus's bytes as before
     grid = NavGrid(np.array(GRID_ORIGIN), GRID_CELL, GRID_SHAPE, *arrays, 2.5, height=h, link=link)
     (bundle / "navgrid.npz").write_bytes(grid.to_bytes())
     doc = read_toml(bundle / "arena.toml")

@@ -57,8 +57,7 @@ def grid_numbers(arena: str = "paper2002") -> dict[str, np.ndarray]:
     out = {"walls": np.asarray(bundle.walls.all_segments(), dtype=np.float64),
            "origin": np.asarray(grid.origin, dtype=np.float64), "cell": np.float64(grid.cell)}
     for key in GRID_KEYS:
-        a = np.asarray(getattr(grid, key))
-        out[key] = a[0] if a.ndim == 3 else a     # level 0 of a layered grid
+        out[key] = np.asarray(getattr(grid, key))[0]     # level 0 (a NavGrid is (L, nz, nx))
     return out
 
 
