@@ -82,7 +82,8 @@ def nodes_ahead(grid: NavGrid, node: Node, heading: str) -> int:
     i, j = node
     if not grid.is_valid(node):
         return 0
-    return run_ahead(grid.row_index[0, i, j], grid.col_index[0, i, j], grid.row_total[0, i, j], grid.col_total[0, i, j], heading)
+    n = (0, i, j)   # the 2002 heuristic runs on level 0 (a flat grid's only one)
+    return run_ahead(grid.row_index[n], grid.col_index[n], grid.row_total[n], grid.col_total[n], heading)
 
 
 @dataclass(frozen=True)
