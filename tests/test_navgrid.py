@@ -303,6 +303,24 @@ def test_table_one_node_a_line():
     assert len([ln for ln in region.splitlines() if not ln.startswith("#")]) == 2
 
 
+def test_table_of_a_layered_grid_has_every_level():
+    from tanktool.nav.navgrid import layered_runs, links_from_valid
+
+    v = np.zeros((2, 3, 4), dtype=bool)
+    v[0] = True
+    v[1, 1, 1:3] = True   # a deck of two nodes over the middle row
+    link = links_from_valid(v)
+    g = NavGrid(np.zeros(2), 1.0, (3, 4), v, *layered_runs(v, link), v.copy(), link=link)
+    text = format_table(g)
+    assert "levels 2" in text and "# level i j x z valid" in text
+    body = [ln.split() for ln in text.splitlines() if not ln.startswith("#")]
+    assert len(body) == v.size and [b[0] for b in body] == ["0"] * 12 + ["1"] * 12
+    deck = [b for b in body if b[0] == "1" and b[5] == "1"]
+    assert [(b[1], b[2], b[7], b[9]) for b in deck] == [("1", "1", "1", "2"), ("1", "2", "2", "2")]
+    one = format_table(build_navgrid(box_arena(4, 3, margin=1), cell=1.0, clearance=0.4))
+    assert "levels" not in one and "# i j x z valid" in one
+
+
 def test_walls_without_aux_use_their_extent():
     w = box_arena(8, 8)
     bare = WallList(w.segments, w.direction, None)

@@ -735,28 +735,35 @@ def grid_from_mask(valid: np.ndarray, origin: tuple[float, float] = (0.0, 0.0), 
 def format_table(grid: NavGrid, region: np.ndarray | None = None) -> str:
     """The 2002-style table, one node a line: position, validity and the four numbers.
 
-    ``region`` ``[[x0, z0], [x1, z1]]`` keeps only the nodes inside it.
+    ``region`` ``[[x0, z0], [x1, z1]]`` keeps only the nodes inside it.  On a grid of
+    several levels every line starts with the node's level (level by level); a
+    one-level grid's table is the 2002 one, without that column.
     """
-    i, j = np.nonzero(np.ones(grid.shape, dtype=bool))
+    lv, i, j = np.nonzero(np.ones(grid.valid.shape, dtype=bool))
     x = grid.node_x[j]
     z = grid.node_z[i]
     if region is not None:
         r = np.asarray(region, dtype=np.float64).reshape(2, 2)
         keep = (x >= r[0, 0]) & (x <= r[1, 0]) & (z >= r[0, 1]) & (z <= r[1, 1])
-        i, j, x, z = i[keep], j[keep], x[keep], z[keep]
+        lv, i, j, x, z = lv[keep], i[keep], j[keep], x[keep], z[keep]
+    many = grid.levels > 1
     head = [
         "# tanktool navigation grid: one node a line (the 2002 'malla' table)",
-        f"# origin {grid.origin[0]:g} {grid.origin[1]:g}  cell {grid.cell:g}  shape nz={grid.nz} nx={grid.nx}",
+        f"# origin {grid.origin[0]:g} {grid.origin[1]:g}  cell {grid.cell:g}  shape nz={grid.nz} nx={grid.nx}"
+        + (f"  levels {grid.levels}" if many else ""),
         "# renglon/columna = 1-based index of the node in its row/column run of valid nodes,",
         "# total = that run's length (0 for invalid nodes); rows run along +x, columns along +z",
-        "# i j x z valid reachable renglon columna total_renglones total_columnas",
+        "# " + ("level " if many else "") + "i j x z valid reachable renglon columna total_renglones total_columnas",
     ]
+    n = (lv, i, j)
     cols = [
-        i, j, x, z, grid.valid[0, i, j].astype(int), grid.reachable[0, i, j].astype(int),
-        grid.row_index[0, i, j], grid.col_index[0, i, j], grid.row_total[0, i, j], grid.col_total[0, i, j],
+        i, j, x, z, grid.valid[n].astype(int), grid.reachable[n].astype(int),
+        grid.row_index[n], grid.col_index[n], grid.row_total[n], grid.col_total[n],
     ]
     body = [
         f"{a} {b} {c:.4f} {d:.4f} {e} {f} {g} {h} {k} {m}"
         for a, b, c, d, e, f, g, h, k, m in zip(*(c.tolist() for c in cols))
     ]
+    if many:
+        body = [f"{a} {line}" for a, line in zip(lv.tolist(), body)]
     return "\n".join(head + body) + "\n"
