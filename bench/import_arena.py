@@ -47,6 +47,8 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(ROOT / "bench"))
 
+from stage_profile import SURFACE_HOOKS  # noqa: E402
+
 DUNGEON = ROOT / "tests" / "data" / "arenas_obj" / "dungeon.obj"
 BUNDLED = ("box", "maze", "paper2002", "fort", "hills")
 #: terrain vertex spacing (m)
@@ -57,14 +59,7 @@ HOOKS = [
     ("load", "tanktool.formats.models:load_scene"),
     ("load", "tanktool.formats.models:load_model"),
     ("fleet", "tanktool.fleet:bundled_fleet"),
-    ("rasterise", "tanktool.geometry.heightfield:rasterize"),
-    ("filters", "tanktool.geometry.heightfield:filter_spans"),
-    ("heightfield", "tanktool.geometry.heightfield:build_heightfield"),
-    ("links", "tanktool.nav.walkable:link_spans"),
-    ("distance", "tanktool.nav.walkable:chamfer_clearance"),
-    ("regions", "tanktool.nav.walkable:components"),
-    ("levels", "tanktool.nav.walkable:stack_levels"),
-    ("surface", "tanktool.nav.walkable:build_surface"),
+    *SURFACE_HOOKS,
     ("surface", "tanktool.nav.walkable:walkable_surface"),
     ("thin walls", "tanktool.geometry.walls:thin_walls"),
     ("walls", "tanktool.nav.level_walls:level_walls"),

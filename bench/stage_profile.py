@@ -130,3 +130,16 @@ class Profile:
         for owner, name, raw in reversed(self._undo):
             setattr(owner, name, raw)
         self._undo.clear()
+
+
+#: the walkable surface's stages, as bench/walkable.py and bench/import_arena.py time them
+SURFACE_HOOKS = [
+    ("rasterise", "tanktool.geometry.heightfield:rasterize"),
+    ("filters", "tanktool.geometry.heightfield:filter_spans"),
+    ("heightfield", "tanktool.geometry.heightfield:build_heightfield"),
+    ("links", "tanktool.nav.walkable:link_spans"),
+    ("distance", "tanktool.nav.walkable:chamfer_clearance"),
+    ("regions", "tanktool.nav.walkable:components"),
+    ("levels", "tanktool.nav.walkable:stack_levels"),
+    ("surface", "tanktool.nav.walkable:build_surface"),
+]

@@ -47,6 +47,8 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tools"))
 sys.path.insert(0, str(ROOT / "bench"))
 
+from stage_profile import SURFACE_HOOKS  # noqa: E402
+
 from tanktool.errors import TanktoolError  # noqa: E402
 from tanktool.memory import keep_freed_memory  # noqa: E402
 from tanktool.nav.walkable import WalkableParams, grid_from_surface, walkable_surface  # noqa: E402
@@ -108,14 +110,7 @@ def ours(V: np.ndarray, F: np.ndarray, repeat: int):
 
 #: our stages, timed by wrapping the pipeline's functions (bench/stage_profile.py)
 STAGE_HOOKS = [
-    ("rasterise", "tanktool.geometry.heightfield:rasterize"),
-    ("filters", "tanktool.geometry.heightfield:filter_spans"),
-    ("heightfield", "tanktool.geometry.heightfield:build_heightfield"),
-    ("links", "tanktool.nav.walkable:link_spans"),
-    ("distance", "tanktool.nav.walkable:chamfer_clearance"),
-    ("regions", "tanktool.nav.walkable:components"),
-    ("levels", "tanktool.nav.walkable:stack_levels"),
-    ("surface", "tanktool.nav.walkable:build_surface"),
+    *SURFACE_HOOKS,
     ("heights", "tanktool.nav.walkable:snap_heights"),
     ("heights", "tanktool.geometry.heightfield:flat_heights"),
     ("grid", "tanktool.nav.navgrid:layered_runs"),

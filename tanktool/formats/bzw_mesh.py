@@ -76,16 +76,23 @@ def _mesh_line(path: Path, lineno: int, key: str, args: list[str], m: BzwMesh, w
         m.face, m.face_line = [], lineno
     elif key == "drawinfo":
         m.drawinfo = 1
-    elif key in ("shift", "scale"):
-        m.transforms.append((key, _numbers(path, lineno, key, args, 3)))
-    elif key == "spin":
-        m.transforms.append((key, _numbers(path, lineno, key, args, 4)))
+    elif key in TRANSFORMS:
+        m.transforms.append(_transform(path, lineno, key, args))
     elif key in ("drivethrough", "passable"):
         m.drivethrough = True
     elif key == "end":
         _finish_mesh(path, m, world)
         return True
     return False
+
+
+#: a mesh's or a group's transformations and how many numbers each takes
+TRANSFORMS = {"shift": 3, "scale": 3, "spin": 4}
+
+
+def _transform(path: Path, lineno: int, key: str, args: list[str]) -> tuple[str, tuple[float, ...]]:
+    """One ``shift``/``scale``/``spin`` line of a mesh or a group, its numbers checked."""
+    return key, _numbers(path, lineno, key, args, TRANSFORMS[key])
 
 
 def _finish_mesh(path: Path, m: BzwMesh, world: Any) -> None:
@@ -148,10 +155,8 @@ class BzwGroup:
 
 def _group_line(path: Path, lineno: int, key: str, args: list[str], g: BzwGroup, world: Any) -> bool:
     """One line inside a ``group`` block; True when its ``end`` closed it."""
-    if key in ("shift", "scale"):
-        g.transforms.append((key, _numbers(path, lineno, key, args, 3)))
-    elif key == "spin":
-        g.transforms.append((key, _numbers(path, lineno, key, args, 4)))
+    if key in TRANSFORMS:
+        g.transforms.append(_transform(path, lineno, key, args))
     elif key in ("drivethrough", "passable"):
         g.drivethrough = True
     elif key == "end":
