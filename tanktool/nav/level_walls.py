@@ -36,7 +36,7 @@ import numpy as np
 import shapely
 
 from ..formats.walls_txt import WallList, aux_rectangle
-from ..geometry import contours
+from ..geometry import contours, slivers
 from ..geometry import walls as cut
 from ..geometry.wall_pairs import Repairs, pair_tolerance, repair_walls
 from ..geometry.heightfield import FLAT_GAP, flat_heights
@@ -356,8 +356,8 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
             if exact_parts:
                 R = shapely.union_all([R, *exact_parts])
             R = shapely.set_precision(R, tolerance)
-            R = _drop_slivers(R, tolerance)
-            R = _fill_sliver_holes(R, tolerance, cell)
+            R = slivers.drop_slivers(R, tolerance)
+            R = slivers.fill_sliver_holes(R, tolerance, cell)
             if R.is_empty:
                 continue
             R = shapely.simplify(R, tolerance, preserve_topology=True)
@@ -566,47 +566,3 @@ def _region_labels(cells: np.ndarray, same: np.ndarray) -> tuple[np.ndarray, int
     labels = np.zeros(cells.shape, dtype=np.int64)
     labels[ci, cj] = lab + 1
     return labels, int(n)
-
-
-def _fill_sliver_holes(R, tolerance: float, cell: float):
-    """Holes narrower than the walls' tolerance and shorter than a cell are round-off
-    where a cell corner meets the exact cut of a steep face (a pyramid's foot), not
-    solid: filled, so they do not become walls a few centimetres long.  A real thin
-    solid is longer than a cell or wider than the tolerance and stays."""
-    parts = shapely.get_parts(R)
-    changed, out = False, []
-    for p in parts:
-        holes = [shapely.Polygon(h) for h in p.interiors]
-        keep = [h for h in holes
-                if h.length / 2 >= 1.5 * cell or not shapely.buffer(h, -2 * tolerance, quad_segs=1).is_empty]
-        if len(keep) < len(holes):
-            changed = True
-            p = shapely.Polygon(p.exterior, [h.exterior for h in keep])
-        out.append(p)
-    if not changed:
-        return R
-    # the other parts exactly as they were (a union would node them again)
-    return out[0] if len(out) == 1 else shapely.MultiPolygon(out)
-
-
-def _drop_slivers(R, tolerance: float):
-    """Parts of a region narrower than the walls' tolerance everywhere (round-off
-    between exact and cell outlines) are not space."""
-    parts = shapely.get_parts(R)
-    if len(parts) == 0:
-        return shapely.Polygon()
-    keep = ~shapely.is_empty(shapely.buffer(parts, -2 * tolerance, quad_segs=1))
-    if not keep.any():
-        return shapely.Polygon()
-    R = shapely.union_all(parts[keep])
-    # and slivers within a part (a pillar that touches a wall in the model, a few mm
-    # off): an opening by half the tolerance closes them, so the pillar's walls meet
-    # the wall instead of leaving a gap or a crossing
-    # (in floating point: a buffer keeps its input's precision grid, and on that grid a
-    # half-tolerance erosion rounds everything away)
-    half = tolerance / 2
-    opened = shapely.buffer(shapely.buffer(shapely.set_precision(R, 0.0), -half, join_style="mitre"), half,
-                            join_style="mitre")
-    opened = shapely.set_precision(opened, tolerance)
-    # where nothing closed, the region as it was (the same walls in the same order)
-    return R if shapely.equals(opened, R) else opened
