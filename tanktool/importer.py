@@ -103,30 +103,14 @@ def import_arena(
     floor plan's walls.  Everything is written into a temporary folder renamed into
     place at the end, so a failure leaves nothing behind.
     """
-    import trimesh
-
     from .fleet import bundled_fleet
-    from .formats.bundle import check_replaceable, sha256_file, staged_dir, write_toml
-    from .formats.materials import export_glb
+    from .formats.bundle import staged_dir, write_toml
     from .formats.models import default_up, detect_format, load_scene
-    from .formats.walls_txt import write_walls
-    from .nav.arena_levels import analyse_arena, spawn_y_needed
-    from .plots.arena import save_preview
 
     t0 = time.perf_counter()
     model = Path(model)
     fmt = detect_format(model)
-    if name is None:  # from the file stem, made a safe folder name ("my arena" -> "my_arena")
-        name = re.sub(r"[^A-Za-z0-9._-]+", "_", model.stem).strip("._-") or "arena"
-    if not _NAME_RE.match(name):
-        raise ArenaError(f"arena name {name!r}: use letters, digits, '.', '_' or '-'")
-    target = Path(out) if out is not None else Path.cwd() / name
-    check_replaceable(target, force, MANIFEST)  # before any work: only a bundle tanktool wrote is replaced
-    if not (math.isfinite(height) and height > 0):
-        raise ArenaError(f"--height must be a positive number of metres, got {height}")
-    if not (math.isfinite(tolerance) and 0 < tolerance < height):
-        raise ArenaError(f"--tolerance must be positive and below --height, got {tolerance}")
-
+    name, target = _check_options(model, out, name, force, height, tolerance)
     warnings: list[str] = []
 
     def remark(message: str) -> None:
@@ -139,33 +123,92 @@ def import_arena(
     nav.update(navgrid or {})
     params, where = walkable_params(cell if cell is not None else nav.get("cell"), max_slope, climb, headroom,
                                     fleet, walkable)
-    if params.climb >= height:
-        raise ArenaError(f"--climb ({params.climb:g} m) must be below the cut --height ({height:g} m): "
-                         "what a tank climbs cannot also be a wall")
-    if wall_height is not None and not wall_height > height:
-        raise ArenaError(f"--wall-height ({wall_height:g}) must be above the cut --height ({height:g}), "
-                         f"or the walls would not be cut")
+    _check_heights(params.climb, height, wall_height)
     scene = load_scene(model, up=up, scale=scale, warn=remark, wall_height=wall_height,
                        wall_thickness=wall_thickness, progress=progress)
     if progress:
         progress("read")
+    mesh = _one_mesh(model, scene, params.cell, max_cells)
+    result = _analyse(model, mesh, params, fleet, height, tolerance, progress)
+    fits = _remark_fit(model, result, fleet, remark)
+    src_up = up or default_up(fmt)
+    nav["cell"] = float(params.cell)
+    companions = _companion_files(model)
+    with staged_dir(target, force=force, manifest=MANIFEST) as tmp:
+        textures = _stage_files(tmp, model, companions, scene, target, name, height, result, remark)
+        if progress:
+            progress("files")
+        source = {"up": src_up, "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness)}
+        doc = _manifest(tmp, model, companions, name, source, textures, height, tolerance, params, fits,
+                        result, nav)
+        write_toml(tmp / MANIFEST, doc)
+        # the same files, built the same way, as build-navgrid on the bundle
+        built = _stage_grid(tmp, fits, remark, progress) if grid else None
+    return ImportResult(target, name, result.walls.walls, result.spawns, result.floor_y, len(mesh.faces),
+                        result.walls.thin_walls, time.perf_counter() - t0, warnings, result, params, where, built,
+                        list(scene.metadata.get("left_out", [])))
+
+
+def _check_options(model: Path, out: str | os.PathLike | None, name: str | None, force: bool, height: float,
+                   tolerance: float) -> tuple[str, Path]:
+    """The arena's name and folder, checked with the cut's numbers before any work."""
+    from .formats.bundle import check_replaceable
+
+    if name is None:  # from the file stem, made a safe folder name ("my arena" -> "my_arena")
+        name = re.sub(r"[^A-Za-z0-9._-]+", "_", model.stem).strip("._-") or "arena"
+    if not _NAME_RE.match(name):
+        raise ArenaError(f"arena name {name!r}: use letters, digits, '.', '_' or '-'")
+    target = Path(out) if out is not None else Path.cwd() / name
+    check_replaceable(target, force, MANIFEST)  # before any work: only a bundle tanktool wrote is replaced
+    if not (math.isfinite(height) and height > 0):
+        raise ArenaError(f"--height must be a positive number of metres, got {height}")
+    if not (math.isfinite(tolerance) and 0 < tolerance < height):
+        raise ArenaError(f"--tolerance must be positive and below --height, got {tolerance}")
+    return name, target
+
+
+def _check_heights(climb: float, height: float, wall_height: float | None) -> None:
+    """The climb and a floor plan's wall height against the cut height."""
+    if climb >= height:
+        raise ArenaError(f"--climb ({climb:g} m) must be below the cut --height ({height:g} m): "
+                         "what a tank climbs cannot also be a wall")
+    if wall_height is not None and not wall_height > height:
+        raise ArenaError(f"--wall-height ({wall_height:g}) must be above the cut --height ({height:g}), "
+                         f"or the walls would not be cut")
+
+
+def _one_mesh(model: Path, scene: Any, cell: float, max_cells: int | None) -> Any:
+    """The scene's triangles as one mesh, its grid size checked."""
+    import trimesh
+
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
     if not meshes:
         raise ArenaError(f"{model}: the model has no triangles")
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
     lo, hi = mesh.bounds
-    check_cells(str(model), float(hi[0] - lo[0]), float(hi[2] - lo[2]), params.cell, model.stat().st_size,
+    check_cells(str(model), float(hi[0] - lo[0]), float(hi[2] - lo[2]), cell, model.stat().st_size,
                 max_cells)  # before the heightfield: its cost follows the cells
+    return mesh
+
+
+def _analyse(model: Path, mesh: Any, params: Any, fleet: Any, height: float, tolerance: float,
+             progress: Callable[[str], None] | None) -> Any:
+    """analyse_arena on the mesh, its errors naming the file."""
+    from .nav.arena_levels import analyse_arena
+
     try:
-        result = analyse_arena(mesh.vertices, mesh.faces, params, fleet, cut_height=height, tolerance=tolerance,
-                               progress=progress)
+        return analyse_arena(mesh.vertices, mesh.faces, params, fleet, cut_height=height, tolerance=tolerance,
+                             progress=progress)
     except ArenaError as e:
         # the same kind (a NoFitError keeps the --scale it suggests), the file named
         err = ArenaError(f"{model}: {e}")
         if hasattr(e, "scale"):
             err = type(e)(f"{model}: {e}", e.scale)
         raise err from None
-    walls = result.walls.walls
+
+
+def _remark_fit(model: Path, result: Any, fleet: Any, remark: Callable[[str], None]) -> Any:
+    """Remark on repaired walls, vehicles too big and too few spawns; the fleet the arena is for."""
     for line in result.walls.repairs.remarks():   # repaired walls, and what check would still find
         remark(f"{model}: {line}")
     spawns = result.spawns
@@ -177,63 +220,76 @@ def import_arena(
     if len(spawns) < MIN_SPAWNS:
         remark(f"{model}: room for only {len(spawns)} spawn point(s) where the largest bundled tank that fits "
                f"({fits.radius_of}) fits, at least {fits.length:.1f} m apart")
+    return fits
 
-    src_up = up or default_up(fmt)
-    nav["cell"] = float(params.cell)
+
+def _stage_files(tmp: Path, model: Path, companions: list[Path], scene: Any, target: Path, name: str,
+                 height: float, result: Any, remark: Callable[[str], None]) -> Any:
+    """Copy the model in and write model.glb, walls.txt and preview.png; the textures export_glb copied."""
+    from .formats.materials import export_glb
+    from .formats.walls_txt import write_walls
+    from .plots.arena import save_preview
+
+    walls, spawns = result.walls.walls, result.spawns
     bounds = walls.bounds
-    with_y = spawn_y_needed(result)
-    built = None
-    companions = _companion_files(model)
-    with staged_dir(target, force=force, manifest=MANIFEST) as tmp:
-        copied = [model, *companions]
-        for f in copied:  # where the model looks for it: a .gltf's "data/scene.bin" stays there
-            (tmp / _beside(f, model)).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(f, tmp / _beside(f, model))
-        glb, textures = export_glb(model, scene, tmp, extra=[target], warn=remark)   # textures copied in
-        (tmp / "model.glb").write_bytes(glb)
-        header = (f"arena {name}: walls of {model.name}, the boundaries of its walkable surface "
-                  f"(flat floors: cut {height:g} m above them)\n"
-                  f"made by tanktool {__version__} import-arena; normals point into free space")
-        write_walls(tmp / "walls.txt", walls, header=header)
-        lv = result.levels
-        title = (f"{name}: {len(lv)} level{'s' if len(lv) != 1 else ''}, {len(walls)} walls + 4 auxiliary, "
-                 f"{len(spawns)} spawns, {bounds[1, 0] - bounds[0, 0]:.0f} x {bounds[1, 1] - bounds[0, 1]:.0f} m")
-        save_preview(tmp / "preview.png", walls, spawns, title, result.free, levels=result)
-        if progress:
-            progress("files")
-        doc = {
-            "name": name,
-            "tool_version": __version__,
-            "bounds": [[_r(bounds[0, 0]), _r(bounds[0, 1])], [_r(bounds[1, 0]), _r(bounds[1, 1])]],
-            "floor_y": _r(result.floor_y),
-            "spawns": [[_r(x), _r(z), _r(h, 6), _r(y)] if with_y else [_r(x), _r(z), _r(h, 6)]
-                       for x, z, h, y in spawns],
-            "source": {"file": model.name, "sha256": sha256_file(tmp / model.name), "up": src_up,
-                       "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness),
-                       **({"companions": [_beside(f, model) for f in companions]} if companions else {})},
-            "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
-            "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
-                      "count": len(walls)},
-            "walkable": params.as_toml(),
-            "vehicles": {"largest": fits.radius_of, "radius": _r(fits.radius),
-                         "too_big": [n for n, _ in result.too_big]},
-            "levels": [{"level": x.level, "area": _r(x.area, 1), "y": [_r(x.y_lo, 3), _r(x.y_hi, 3)],
-                        "regions": x.regions} for x in lv],
-            "navgrid": nav,
-            "derived": {f: sha256_file(tmp / f) for f in ("walls.txt", "model.glb", "preview.png")},
-        }
-        write_toml(tmp / MANIFEST, doc)
-        if grid:  # the same files, built the same way, as build-navgrid on the bundle
-            from .grid_files import build_grid, open_target, render_picture, stage_grid_files
+    for f in [model, *companions]:  # where the model looks for it: a .gltf's "data/scene.bin" stays there
+        (tmp / _beside(f, model)).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(f, tmp / _beside(f, model))
+    glb, textures = export_glb(model, scene, tmp, extra=[target], warn=remark)   # textures copied in
+    (tmp / "model.glb").write_bytes(glb)
+    header = (f"arena {name}: walls of {model.name}, the boundaries of its walkable surface "
+              f"(flat floors: cut {height:g} m above them)\n"
+              f"made by tanktool {__version__} import-arena; normals point into free space")
+    write_walls(tmp / "walls.txt", walls, header=header)
+    lv = result.levels
+    title = (f"{name}: {len(lv)} level{'s' if len(lv) != 1 else ''}, {len(walls)} walls + 4 auxiliary, "
+             f"{len(spawns)} spawns, {bounds[1, 0] - bounds[0, 0]:.0f} x {bounds[1, 1] - bounds[0, 1]:.0f} m")
+    save_preview(tmp / "preview.png", walls, spawns, title, result.free, levels=result)
+    return textures
 
-            staged = open_target(tmp)
-            built = build_grid(staged, warn=remark, fleet=fits)
-            write_toml(tmp / MANIFEST, stage_grid_files(tmp, staged, built, render_picture(built, staged)))
-            if progress:
-                progress("navgrid")
-    return ImportResult(target, name, walls, spawns, result.floor_y, len(mesh.faces), result.walls.thin_walls,
-                        time.perf_counter() - t0, warnings, result, params, where, built,
-                        list(scene.metadata.get("left_out", [])))
+
+def _manifest(tmp: Path, model: Path, companions: list[Path], name: str, source: dict[str, Any], textures: Any,
+              height: float, tolerance: float, params: Any, fits: Any, result: Any,
+              nav: dict[str, Any]) -> dict[str, Any]:
+    """The bundle's arena.toml document, hashing the files staged in ``tmp``."""
+    from .formats.bundle import sha256_file
+    from .nav.arena_levels import spawn_y_needed
+
+    walls, bounds, with_y = result.walls.walls, result.walls.walls.bounds, spawn_y_needed(result)
+    return {
+        "name": name,
+        "tool_version": __version__,
+        "bounds": [[_r(bounds[0, 0]), _r(bounds[0, 1])], [_r(bounds[1, 0]), _r(bounds[1, 1])]],
+        "floor_y": _r(result.floor_y),
+        "spawns": [[_r(x), _r(z), _r(h, 6), _r(y)] if with_y else [_r(x), _r(z), _r(h, 6)]
+                   for x, z, h, y in result.spawns],
+        "source": {"file": model.name, "sha256": sha256_file(tmp / model.name), **source,
+                   **({"companions": [_beside(f, model) for f in companions]} if companions else {})},
+        "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
+        "walls": {"file": "walls.txt", "height": float(height), "tolerance": float(tolerance),
+                  "count": len(walls)},
+        "walkable": params.as_toml(),
+        "vehicles": {"largest": fits.radius_of, "radius": _r(fits.radius),
+                     "too_big": [n for n, _ in result.too_big]},
+        "levels": [{"level": x.level, "area": _r(x.area, 1), "y": [_r(x.y_lo, 3), _r(x.y_hi, 3)],
+                    "regions": x.regions} for x in result.levels],
+        "navgrid": nav,
+        "derived": {f: sha256_file(tmp / f) for f in ("walls.txt", "model.glb", "preview.png")},
+    }
+
+
+def _stage_grid(tmp: Path, fits: Any, remark: Callable[[str], None],
+                progress: Callable[[str], None] | None) -> Any:
+    """navgrid.npz, quadtree.npz and navgrid.png as build-navgrid writes them, recorded in the manifest."""
+    from .formats.bundle import write_toml
+    from .grid_files import build_grid, open_target, render_picture, stage_grid_files
+
+    staged = open_target(tmp)
+    built = build_grid(staged, warn=remark, fleet=fits)
+    write_toml(tmp / MANIFEST, stage_grid_files(tmp, staged, built, render_picture(built, staged)))
+    if progress:
+        progress("navgrid")
+    return built
 
 
 def _plan_source(fmt: str, wall_height: float | None, wall_thickness: float | None) -> dict[str, float]:
