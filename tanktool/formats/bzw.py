@@ -198,24 +198,11 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None, defines: dict | 
     """
     path = Path(path)
     if text is None:
-        data = read_input(path, "a .bzw file", limit=MAX_MODEL_BYTES)
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError:
-            text = data.decode("latin-1")   # old maps are often Latin-1; keywords are ASCII
+        text = _read_text(path)
     world = BzwWorld(path, depth=depth)
     if defines is not None:
         world.defines = defines
-    warn = world.warnings.append
-    current: BzwObject | None = None       # a known object being read
-    in_world: int | None = None            # line of an open ``world`` block
-    skipping: tuple[str, int] | None = None  # an unknown object being skipped: (kind, line)
-    skip_stack: list[str] = []             # drawinfo / lod / matref blocks inside it
-    in_define: int | None = None
-    options: list[tuple[int, str]] | None = None   # tokens of an open ``options`` block, with lines
-    options_line = 0
-    mesh: BzwMesh | BzwGroup | None = None   # an open ``mesh`` or ``group`` block
-    define: tuple[str, list[str]] = ("", [])   # the open define's name and body lines
+    st = _ParseState()
     for lineno, raw in enumerate(text.splitlines(), 1):
         line = _strip(raw)
         if not line:
@@ -223,114 +210,169 @@ def parse_bzw(path: str | os.PathLike, text: str | None = None, defines: dict | 
         words = line.split()
         key = words[0].lower()
         args = words[1:]
-        if in_define is not None:
-            if key == "enddef":
-                world.defines[define[0]] = (in_define, define[1])
-                in_define = None
-            else:
-                define[1].append(raw)
+        if _inside_block(st, path, lineno, raw, words, key, args, world):
             continue
-        if mesh is not None:
-            done = (_group_line(path, lineno, key, args, mesh, world) if isinstance(mesh, BzwGroup)
-                    else _mesh_line(path, lineno, key, args, mesh, world))
-            if done:
-                mesh = None
-            continue
-        if options is not None:
-            if key == "end" and not args:
-                _apply_options(path, options_line, options, world)
-                options = None
-            else:
-                options.extend((lineno, w) for w in words)
-            continue
-        if skipping is not None:
-            # BZFlag's mesh drawinfo nests blocks that close with their own ``end``
-            if key == "drawinfo" or (key in _DRAWINFO_BLOCKS and skip_stack):
-                skip_stack.append(key)
-            elif key == "end":
-                if skip_stack:
-                    skip_stack.pop()
-                else:
-                    skipping = None
-            continue
-        if current is None and in_world is None:
-            if key == "end":
-                raise FormatError(f"{path}:{lineno}: 'end' without an object to close")
-            if key == "world":
-                in_world = lineno
-            elif key == "options":
-                options, options_line = [(lineno, w) for w in args], lineno
-            elif key in SOLIDS:
-                if len(world.objects) >= MAX_OBJECTS:
-                    raise FormatError(f"{path}:{lineno}: more than {MAX_OBJECTS:,} objects (a world this tool reads "
-                                      f"has fewer)")
-                current = BzwObject(key, lineno, size=DEFAULT_SIZE[key])
-            elif key == "mesh":
-                if len(world.meshes) >= MAX_OBJECTS:
-                    raise FormatError(f"{path}:{lineno}: more than {MAX_OBJECTS:,} meshes (a world this tool reads "
-                                      f"has fewer)")
-                mesh = BzwMesh(lineno)
-            elif key == "group":
-                mesh = BzwGroup(lineno, " ".join(args).lower())
-            elif key == "define":
-                in_define, define = lineno, (" ".join(args).lower(), [])
-            elif key in ("enddef",):
-                raise FormatError(f"{path}:{lineno}: 'enddef' without 'define'")
-            else:
-                skipping = (key, lineno)
-                skip_stack = []
-                if key in _SOLID_UNSUPPORTED:
-                    world.leave_out(key, lineno)
-                warn(f"{path}:{lineno}: unknown or unsupported object '{words[0]}' skipped")
+        if st.current is None and st.in_world is None:
+            _open_block(st, path, lineno, words, key, args, world)
             continue
         if key == "end":
-            if current is not None:
-                _finish(path, current, world)
-                current = None
+            if st.current is not None:
+                _finish(path, st.current, world)
+                st.current = None
             else:
-                in_world = None
+                st.in_world = None
             continue
-        if in_world is not None:
-            if key == "size":
-                (s,) = _numbers(path, lineno, "size", args, 1)
-                if s <= 0:
-                    raise FormatError(f"{path}:{lineno}: world 'size' must be positive, got {s:g}")
-                _set_size(world, s, lineno, f"world size {s:g}")
-            elif key == "nowalls":
-                world.walls = False
-            elif key not in _QUIET_PROPS:
-                warn(f"{path}:{lineno}: world property '{words[0]}' ignored")
+        if st.in_world is not None:
+            _world_line(path, lineno, words, key, args, world)
             continue
-        assert current is not None
-        if key in ("position", "pos"):
-            current.position = _numbers(path, lineno, key, args, 3)  # type: ignore[assignment]
-        elif key == "size":
-            current.size = _numbers(path, lineno, key, args, 3)  # type: ignore[assignment]
-        elif key in ("rotation", "rot"):
-            (current.rotation,) = _numbers(path, lineno, key, args, 1)
-        elif key == "flipz":
-            current.flipz = True
-        elif key in ("drivethrough", "passable"):
-            current.drivethrough = True
-        elif key == "border" and current.kind == "teleporter":
-            (current.border,) = _numbers(path, lineno, key, args, 1)
-        elif key == "color" and current.kind == "base":
-            (c,) = _numbers(path, lineno, key, args, 1)
-            current.color = int(c)
-        elif key in _QUIET_PROPS:
-            pass
+        assert st.current is not None
+        _object_line(path, lineno, words, key, args, st.current, world.warnings.append)
+    _check_closed(path, st)
+    return world
+
+
+def _read_text(path: Path) -> str:
+    """The file's text: UTF-8, else Latin-1."""
+    data = read_input(path, "a .bzw file", limit=MAX_MODEL_BYTES)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")   # old maps are often Latin-1; keywords are ASCII
+
+
+@dataclass
+class _ParseState:
+    """What parse_bzw has open while it reads the lines."""
+    current: BzwObject | None = None       # a known object being read
+    in_world: int | None = None            # line of an open ``world`` block
+    skipping: tuple[str, int] | None = None  # an unknown object being skipped: (kind, line)
+    skip_stack: list[str] = field(default_factory=list)   # drawinfo / lod / matref blocks inside it
+    in_define: int | None = None
+    options: list[tuple[int, str]] | None = None   # tokens of an open ``options`` block, with lines
+    options_line: int = 0
+    mesh: BzwMesh | BzwGroup | None = None   # an open ``mesh`` or ``group`` block
+    define: tuple[str, list[str]] = ("", [])   # the open define's name and body lines
+
+
+def _inside_block(st: _ParseState, path: Path, lineno: int, raw: str, words: list[str], key: str,
+                  args: list[str], world: BzwWorld) -> bool:
+    """Feed a line to an open define, mesh, group, options or skipped block; False when none is open."""
+    if st.in_define is not None:
+        if key == "enddef":
+            world.defines[st.define[0]] = (st.in_define, st.define[1])
+            st.in_define = None
         else:
-            warn(f"{path}:{lineno}: {current.kind} property '{words[0]}' ignored")
+            st.define[1].append(raw)
+        return True
+    if st.mesh is not None:
+        done = (_group_line(path, lineno, key, args, st.mesh, world) if isinstance(st.mesh, BzwGroup)
+                else _mesh_line(path, lineno, key, args, st.mesh, world))
+        if done:
+            st.mesh = None
+        return True
+    if st.options is not None:
+        if key == "end" and not args:
+            _apply_options(path, st.options_line, st.options, world)
+            st.options = None
+        else:
+            st.options.extend((lineno, w) for w in words)
+        return True
+    if st.skipping is not None:
+        # BZFlag's mesh drawinfo nests blocks that close with their own ``end``
+        if key == "drawinfo" or (key in _DRAWINFO_BLOCKS and st.skip_stack):
+            st.skip_stack.append(key)
+        elif key == "end":
+            if st.skip_stack:
+                st.skip_stack.pop()
+            else:
+                st.skipping = None
+        return True
+    return False
+
+
+def _open_block(st: _ParseState, path: Path, lineno: int, words: list[str], key: str, args: list[str],
+                world: BzwWorld) -> None:
+    """A line outside any block: it opens one (or is an error, or an unknown object skipped)."""
+    if key == "end":
+        raise FormatError(f"{path}:{lineno}: 'end' without an object to close")
+    if key == "world":
+        st.in_world = lineno
+    elif key == "options":
+        st.options, st.options_line = [(lineno, w) for w in args], lineno
+    elif key in SOLIDS:
+        if len(world.objects) >= MAX_OBJECTS:
+            raise FormatError(f"{path}:{lineno}: more than {MAX_OBJECTS:,} objects (a world this tool reads "
+                              f"has fewer)")
+        st.current = BzwObject(key, lineno, size=DEFAULT_SIZE[key])
+    elif key == "mesh":
+        if len(world.meshes) >= MAX_OBJECTS:
+            raise FormatError(f"{path}:{lineno}: more than {MAX_OBJECTS:,} meshes (a world this tool reads "
+                              f"has fewer)")
+        st.mesh = BzwMesh(lineno)
+    elif key == "group":
+        st.mesh = BzwGroup(lineno, " ".join(args).lower())
+    elif key == "define":
+        st.in_define, st.define = lineno, (" ".join(args).lower(), [])
+    elif key in ("enddef",):
+        raise FormatError(f"{path}:{lineno}: 'enddef' without 'define'")
+    else:
+        st.skipping = (key, lineno)
+        st.skip_stack = []
+        if key in _SOLID_UNSUPPORTED:
+            world.leave_out(key, lineno)
+        world.warnings.append(f"{path}:{lineno}: unknown or unsupported object '{words[0]}' skipped")
+
+
+def _world_line(path: Path, lineno: int, words: list[str], key: str, args: list[str], world: BzwWorld) -> None:
+    """A property inside ``world``: its size and walls; the rest ignored."""
+    if key == "size":
+        (s,) = _numbers(path, lineno, "size", args, 1)
+        if s <= 0:
+            raise FormatError(f"{path}:{lineno}: world 'size' must be positive, got {s:g}")
+        _set_size(world, s, lineno, f"world size {s:g}")
+    elif key == "nowalls":
+        world.walls = False
+    elif key not in _QUIET_PROPS:
+        world.warnings.append(f"{path}:{lineno}: world property '{words[0]}' ignored")
+
+
+def _object_line(path: Path, lineno: int, words: list[str], key: str, args: list[str], current: BzwObject,
+                 warn: Callable[[str], None]) -> None:
+    """A property of the solid object being read."""
+    if key in ("position", "pos"):
+        current.position = _numbers(path, lineno, key, args, 3)  # type: ignore[assignment]
+    elif key == "size":
+        current.size = _numbers(path, lineno, key, args, 3)  # type: ignore[assignment]
+    elif key in ("rotation", "rot"):
+        (current.rotation,) = _numbers(path, lineno, key, args, 1)
+    elif key == "flipz":
+        current.flipz = True
+    elif key in ("drivethrough", "passable"):
+        current.drivethrough = True
+    elif key == "border" and current.kind == "teleporter":
+        (current.border,) = _numbers(path, lineno, key, args, 1)
+    elif key == "color" and current.kind == "base":
+        (c,) = _numbers(path, lineno, key, args, 1)
+        current.color = int(c)
+    elif key in _QUIET_PROPS:
+        pass
+    else:
+        warn(f"{path}:{lineno}: {current.kind} property '{words[0]}' ignored")
+
+
+def _check_closed(path: Path, st: _ParseState) -> None:
+    """At the end of the file: an error naming the first block still open."""
+    current, skipping, mesh = st.current, st.skipping, st.mesh
     for open_line, what in ((current.line if current else None, current.kind if current else ""),
-                            (in_world, "world"), (skipping[1] if skipping else None, skipping[0] if skipping else ""),
-                            (in_define, "define"), (options_line if options is not None else None, "options"),
+                            (st.in_world, "world"),
+                            (skipping[1] if skipping else None, skipping[0] if skipping else ""),
+                            (st.in_define, "define"), (st.options_line if st.options is not None else None, "options"),
                             (mesh.line if mesh is not None else None,
                              "group" if isinstance(mesh, BzwGroup) else "mesh")):
         if open_line is not None:
             closer = "enddef" if what == "define" else "end"
             raise FormatError(f"{path}:{open_line}: '{what}' is never closed (expected '{closer}' "
                               f"before the end of the file)")
-    return world
 
 
 #: solid objects this reader does not build: counted in what the import leaves out
