@@ -73,9 +73,8 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
     within --climb; a node is valid where it keeps --clearance from the walls of its
     level.  A bare walls file gives the flat 2002 grid of its walls.
     """
-    from ..formats.bundle import atomic_write_bytes, atomic_write_text, dumps_toml
-    from ..grid_files import build_grid, open_target, render_picture, settings, stage_grid_files
-    from ..nav.navgrid import format_table, grid_shape, open_ends
+    from ..grid_files import open_target, render_picture
+    from ..nav.navgrid import format_table
 
     def warn(message: str) -> None:
         click.echo(f"warning: {message}", err=True)
@@ -90,6 +89,32 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
         if p is not None and not p.parent.is_dir():
             raise ArenaError(f"{p}: folder {p.parent} does not exist")
 
+    _warn_open_ends(target)
+    kw = dict(cell=cell, clearance=clearance, max_slope=max_slope, climb=climb, headroom=headroom,
+              quadtree_depth=quadtree_depth, warn=warn)
+    built = _build(target, cell, kw)
+    grid, tree = built.grid, built.tree
+
+    # everything rendered in memory first: a failure here writes nothing
+    picture = render_picture(built, target, fmt, annotate, reg)
+    table = format_table(grid, reg) if table_path is not None else None
+    tree_path = target.output("quadtree.npz")
+    grid_path = target.output("navgrid.npz")
+
+    _write_files(target, built, picture, table, table_path, plot_path, grid_path, tree_path)
+    _report(target, built)
+    wrote = [str(grid_path), f"{tree_path} ({len(tree.leaves)} leaves, depth {tree.max_depth})", str(plot_path)]
+    if table_path is not None:
+        wrote.append(str(table_path))
+    if target.manifest is not None:
+        wrote.append(f"{target.manifest} (hashes)")
+    echo("wrote " + ", ".join(wrote))
+
+
+def _warn_open_ends(target: Any) -> None:
+    """Warn when a flat walls file's walls leave ends open."""
+    from ..nav.navgrid import open_ends
+
     # walls in blocks per level open onto each other (a ramp's top onto the deck): their
     # ends need not close up, the surface says where the free space is
     loose = open_ends(target.walls) if not target.walls.layered else []
@@ -99,8 +124,13 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
             f"warning: {target.walls.path}: {len(loose)} wall end(s) do not close up (first at {x:g}, {z:g}); "
             "free space near them depends on the direction it is scanned", err=True,
         )
-    kw = dict(cell=cell, clearance=clearance, max_slope=max_slope, climb=climb, headroom=headroom,
-              quadtree_depth=quadtree_depth, warn=warn)
+
+
+def _build(target: Any, cell: float | None, kw: dict[str, Any]) -> Any:
+    """build_grid, with a progress bar on a large flat grid."""
+    from ..grid_files import build_grid, settings
+    from ..nav.navgrid import grid_shape
+
     nodes = 0
     if target.model is None and (cell is None or (math.isfinite(cell) and cell > 0)):
         shape0 = grid_shape(target.bounds, settings(target, cell, None)[0])
@@ -110,16 +140,16 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
             built = build_grid(target, progress=bar.update, **kw)
     else:
         built = build_grid(target, **kw)
-    grid, tree, params = built.grid, built.tree, built.params
-    cell, clearance, source, t_build = built.cell, built.clearance, built.clearance_source, built.seconds
-    shape = grid.shape
+    return built
 
-    # everything rendered in memory first: a failure here writes nothing
-    picture = render_picture(built, target, fmt, annotate, reg)
-    table = format_table(grid, reg) if table_path is not None else None
-    tree_path = target.output("quadtree.npz")
-    grid_path = target.output("navgrid.npz")
 
+def _write_files(target: Any, built: Any, picture: bytes, table: str | None, table_path: Path | None,
+                 plot_path: Path, grid_path: Path, tree_path: Path) -> None:
+    """Write the table, grid, quadtree and picture (in a bundle: with its manifest, in one swap)."""
+    from ..formats.bundle import atomic_write_bytes, atomic_write_text, dumps_toml
+    from ..grid_files import stage_grid_files
+
+    grid, tree = built.grid, built.tree
     if table is not None:
         atomic_write_text(table_path, table)
     if target.manifest is None:
@@ -138,6 +168,12 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
             doc = stage_grid_files(stage, target, built, picture if in_bundle else None)
             atomic_write_text(stage / target.manifest.name, dumps_toml(doc))
 
+
+def _report(target: Any, built: Any) -> None:
+    """The summary line, the per-level counts and heights, and the warnings on valid nodes and spawns."""
+    grid, params = built.grid, built.params
+    cell, clearance, source, t_build = built.cell, built.clearance, built.clearance_source, built.seconds
+    shape = grid.shape
     n_valid = int(grid.valid.sum())
     n_reach = int((grid.valid & grid.reachable).sum())
     levels = f" on {grid.levels} levels" if grid.levels > 1 else ""
@@ -157,9 +193,3 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
         click.echo(f"warning: {target.name}: no valid node: no tank of clearance {clearance:g} m fits anywhere", err=True)
     if target.spawns is not None and len(grid.spawn_nodes) < len(target.spawns) and not is_quiet():
         click.echo(f"warning: {len(target.spawns) - len(grid.spawn_nodes)} spawn point(s) have no valid node nearby", err=True)
-    wrote = [str(grid_path), f"{tree_path} ({len(tree.leaves)} leaves, depth {tree.max_depth})", str(plot_path)]
-    if table_path is not None:
-        wrote.append(str(table_path))
-    if target.manifest is not None:
-        wrote.append(f"{target.manifest} (hashes)")
-    echo("wrote " + ", ".join(wrote))
