@@ -245,17 +245,14 @@ def peak_mb() -> float | None:
 def recast_full(model_spec: str, params: dict, repeat: int, work: Path) -> dict | None:
     """Recast's whole build (through the detail mesh) of the level's triangles at the
     import's settings: stage times in ms, None when Recast is not available."""
-    from walkable import build_harness
+    from walkable import build_harness, write_mesh
 
     exe = build_harness(Path(tempfile.gettempdir()) / "tanktool-bench")
     if exe is None:
         return None
     V, F = level_triangles(model_spec)
     mesh, spans = work / "mesh.bin", work / "spans.bin"
-    with open(mesh, "wb") as f:
-        f.write(np.array([len(V), len(F)], np.int32).tobytes())
-        f.write(np.asarray(V, np.float32).tobytes())
-        f.write(np.asarray(F, np.int32).tobytes())
+    write_mesh(mesh, V, F)
     p = params
     args = [str(exe), str(mesh), str(spans), str(p["cell"]), str(p["cell_height"]), str(p["max_slope"]),
             str(p["headroom"]), str(p["climb"]), str(p["radius"] or 0.0), str(repeat), "full"]

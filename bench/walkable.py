@@ -77,13 +77,18 @@ def build_harness(cache: Path) -> Path | None:
     return exe if r.returncode == 0 else None
 
 
-def run_recast(exe: Path, V: np.ndarray, F: np.ndarray, repeat: int, work: Path) -> tuple[dict, np.ndarray]:
-    """Recast's timings (ms) and its eroded walkable spans (k, 3): column x, row z, floor y."""
-    mesh, spans = work / "mesh.bin", work / "spans.bin"
-    with open(mesh, "wb") as f:
+def write_mesh(path: Path, V: np.ndarray, F: np.ndarray) -> None:
+    """The triangles as recast_harness reads them: counts, float32 vertices, int32 faces."""
+    with open(path, "wb") as f:
         f.write(np.array([len(V), len(F)], np.int32).tobytes())
         f.write(np.asarray(V, np.float32).tobytes())
         f.write(np.asarray(F, np.int32).tobytes())
+
+
+def run_recast(exe: Path, V: np.ndarray, F: np.ndarray, repeat: int, work: Path) -> tuple[dict, np.ndarray]:
+    """Recast's timings (ms) and its eroded walkable spans (k, 3): column x, row z, floor y."""
+    mesh, spans = work / "mesh.bin", work / "spans.bin"
+    write_mesh(mesh, V, F)
     s = SETTINGS
     args = [str(exe), str(mesh), str(spans), str(s["cell"]), str(s["cell_height"]), str(s["max_slope"]),
             str(s["headroom"]), str(s["climb"]), str(s["clearance"]), str(repeat)]
