@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import threading
 import time
+from collections import Counter
 
 import pytest
 
+from tanktool.net import probe
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer
 
@@ -119,3 +121,16 @@ def match_kw(arena: str = "box", vehicle: str | None = None) -> dict:
     info = load_match_arena(arena)
     spec = load_tank_spec(choose_vehicle(info, vehicle, lambda line: None))
     return {"digest": match_digest(info, spec), "label": match_label(info, spec)}
+
+
+def guess_flood(peers, address, guesses: int = 30) -> Counter:
+    """``guesses`` joins with a wrong password from one address, made in a thread while
+    ``peers`` poll; the host's replies counted (``probe.join_once``'s words)."""
+    replies: Counter = Counter()
+    th = threading.Thread(target=lambda: replies.update(probe.join_once(address, "guess") for _ in range(guesses)),
+                          daemon=True)
+    th.start()
+    while th.is_alive():
+        pump(peers, 0.05)
+    th.join()
+    return replies

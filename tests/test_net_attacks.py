@@ -10,6 +10,7 @@ import time
 from collections import Counter
 
 import pytest
+from net_helpers import guess_flood
 from net_helpers import LOOPBACK, join, peers, play, pump, states_from  # noqa: F401 (peers: the fixture)
 from net_helpers import session as _session
 
@@ -230,13 +231,7 @@ def test_join_flood_is_limited_and_real_peers_drop_nothing(peers, password):
 def test_wrong_password_flood_is_cut_off(peers):
     _session(peers, 2, "pw")
     host = peers[0]
-    replies: Counter = Counter()
-    th = threading.Thread(target=lambda: replies.update(probe.join_once(host.tcp_address, "guess")
-                                                        for _ in range(30)), daemon=True)
-    th.start()
-    while th.is_alive():
-        pump(peers, 0.05)
-    th.join()
+    replies = guess_flood(peers, host.tcp_address)
     # ten wrong answers are checked; after that the address's answers are not even looked at
     assert replies[PASSWORD] == peer_mod.AUTH_FAIL_BURST, replies
     assert replies[RATE] >= 15, replies

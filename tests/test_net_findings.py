@@ -12,6 +12,7 @@ import time
 from collections import Counter
 
 import pytest
+from net_helpers import guess_flood
 from net_helpers import LOOPBACK, join, match_kw, peers, play, pump, states_from  # noqa: F401 (peers: the fixture)
 from net_helpers import session as _session
 
@@ -164,12 +165,7 @@ def test_parked_hellos_and_silent_connections_do_not_lock_joiners_out(peers):
 def test_wrong_passwords_from_a_players_address_do_not_lock_it_out(peers):
     _session(peers, 2, "pw")
     host = peers[0]
-    replies: Counter = Counter()
-    th = threading.Thread(target=lambda: replies.update(probe.join_once(host.tcp_address, "guess")
-                                                        for _ in range(30)), daemon=True)
-    th.start()
-    while th.is_alive():
-        pump(peers, 0.05)
+    replies = guess_flood(peers, host.tcp_address)
     assert replies[f"REFUSE {P.RefuseCode.RATE.value}"] >= 15, replies
     # right away, from the same address, the real player proves the password and gets in
     real = join(peers, host.tcp_address, "real", "pw", timeout=0.3)

@@ -9,27 +9,11 @@ import math
 import random
 
 import pytest
+from judge_helpers import STATE_DT, judge_match, judge_world
 
 from tanktool.net import protocol as P
 from tanktool.net.judge import Judge
-from tanktool.net.session import NET_RULES
-from tanktool.net.simnet import SimNet
-from tanktool.sim.driver import ScriptedDriver
-from tanktool.sim.match import load_match_arena, load_tank_spec
-from tanktool.sim.world import World
-
-STATE_DT = 1.0 / 30.0
-
-
-def _world(arena: str, vehicle: str = "light", seed: int = 0, tanks: int = 4) -> World:
-    info = load_match_arena(arena)
-    spec = load_tank_spec(vehicle)
-    return World(info.walls, [spec] * tanks, info.spawns, seed=seed, bounds=info.bounds, ground=info.ground,
-                 rules=NET_RULES)
-
-
-def _state(t, n: int, now: float) -> P.State:
-    return P.State(n, now, t.x, t.z, math.remainder(t.heading, 2 * math.pi), t.vx, t.vz, t.omega, t.hp, t.alive)
+from tanktool.sim.match import load_match_arena
 
 
 @pytest.mark.parametrize("arena,seed", [("box", 1), ("fort", 2), ("hills", 3)])
@@ -37,43 +21,14 @@ def test_honest_tanks_over_a_bad_network_are_never_corrected(arena, seed):
     """Four scripted tanks fight for 30 s; their states (30 Hz, UDP: 50-200 ms, 5 %
     lost, some reordered), shots and the host's hits (TCP: delayed, not lost) reach
     another peer's judge."""
-    w = _world(arena, seed=seed)
-    judge = Judge(_world(arena, seed=seed))
-    drivers = [ScriptedDriver(random.Random(seed * 10 + k)) for k in range(len(w.tanks))]
-    udp = SimNet(seed=seed, delay=0.05, jitter=0.15, loss=0.05, reorder=0.05)
-    tcp = SimNet(seed=seed + 100, delay=0.05, jitter=0.15)
-    next_state, judged, shots, deaths = 0.0, 0, 0, 0
-    while w.t < 30.0:
-        poses = {t.index: (t.x, t.z, t.heading, t.vx, t.vz) for t in w.tanks}
-        events = w.step(None, [d(w, t) if t.alive else None for d, t in zip(drivers, w.tanks)])
-        for ev in events:
-            n = ev.tank + 1
-            if ev.kind == "shot":
-                tcp.send(n, 0, P.Shot(n, w.t, *poses[ev.tank]))
-            elif ev.kind == "hit":
-                victim = w.tanks[ev.other]
-                tcp.send(0, 0, ("hit", ev.other + 1, victim.hp, not victim.alive, w.t))
-        if w.t >= next_state:
-            next_state += STATE_DT
-            for t in w.tanks:
-                udp.send(t.index + 1, 0, _state(t, t.index + 1, w.t))
-        for net in (udp, tcp):
-            net.advance(w.dt)
-        for _, _, m in tcp.deliver():
-            if isinstance(m, P.Shot):
-                assert judge.shot(m, tcp.now) is None, (m, judge.record(m.tank))
-                shots += 1
-            else:
-                _, victim, hp, killed, t_hit = m
-                judge.hit(victim, hp, killed, t_hit)
-                deaths += killed
-        for _, _, s in udp.deliver():
-            judged += judge.state(s, udp.now) is not None
+    w = judge_world(arena, seed=seed)
+    judge = Judge(judge_world(arena, seed=seed))
+    run = judge_match(w, judge, 30.0, seed)
     assert judge.corrections == {} and judge.refused_shots == {}, judge.report()
     # (150 ms of jitter reorders many states: a peer keeps only the newest, as here)
-    assert judged > 1500 and shots > 10 and udp.lost > 100
-    assert deaths >= (1 if arena == "box" else 0)       # respawns judged too
-    assert all(not judge.to_kick(n, udp.now) for n in range(1, 5))
+    assert run.judged > 1500 and run.shots > 10 and run.udp.lost > 100
+    assert run.deaths >= (1 if arena == "box" else 0)       # respawns judged too
+    assert all(not judge.to_kick(n, run.udp.now) for n in range(1, 5))
 
 
 # ---------------------------------------------------------------- a cheater
@@ -81,7 +36,7 @@ class _Feed:
     """States of tank 2 fed to a judge on box, 30 a second, received at once."""
 
     def __init__(self) -> None:
-        self.judge = Judge(_world("box"))
+        self.judge = Judge(judge_world("box"))
         self.spec = self.judge.world.tanks[1].spec
         self.t = 1.0
         self.shown: list[P.State] = []

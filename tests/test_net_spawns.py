@@ -6,33 +6,19 @@ tanks its own world was built with -- and still corrects one anywhere else."""
 from __future__ import annotations
 
 import math
-import random
 
 import numpy as np
 import pytest
+from judge_helpers import judge_match, judge_world
 
 from tanktool.net import protocol as P
 from tanktool.net.judge import Judge
-from tanktool.net.session import NET_RULES
-from tanktool.net.simnet import SimNet
-from tanktool.sim.driver import ScriptedDriver
 from tanktool.sim.match import load_match_arena, load_tank_spec
-from tanktool.sim.world import World
-
-STATE_DT = 1.0 / 30.0
 
 
-def _world(arena: str, tanks: int, seed: int = 0) -> World:
+def _world(arena: str, tanks: int, seed: int = 0):
     """A world on ``arena`` cut to its first 2 spawn points."""
-    info = load_match_arena(arena)
-    spec = load_tank_spec("light")
-    return World(info.walls, [spec] * tanks, info.spawns[:2], seed=seed, bounds=info.bounds, ground=info.ground,
-                 rules=NET_RULES)
-
-
-def _state(t, now: float) -> P.State:
-    return P.State(t.index + 1, now, t.x, t.z, math.remainder(t.heading, 2 * math.pi), t.vx, t.vz, t.omega, t.hp,
-                   t.alive)
+    return judge_world(arena, tanks, seed=seed, spawns=2)
 
 
 def _respawn(judge: Judge, x: float, z: float, t0: float = 1.0) -> P.State | None:
@@ -80,38 +66,11 @@ def test_six_honest_tanks_on_two_spawn_points_are_never_corrected():
     for t in w.tanks[6:]:                     # empty slots, as net/session.py keeps them
         t.alive, t.respawn_at = False, math.inf
     judge = Judge(_world("box", 6, seed=seed))
-    drivers = [ScriptedDriver(random.Random(seed * 10 + k)) for k in range(len(w.tanks))]
-    udp = SimNet(seed=seed, delay=0.05, jitter=0.15, loss=0.05, reorder=0.05)
-    tcp = SimNet(seed=seed + 100, delay=0.05, jitter=0.15)
-    next_state, judged, extra_respawns = 0.0, 0, 0
-    while w.t < 40.0:
-        poses = {t.index: (t.x, t.z, t.heading, t.vx, t.vz) for t in w.tanks}
-        events = w.step(None, [d(w, t) if t.alive else None for d, t in zip(drivers, w.tanks)])
-        for ev in events:
-            n = ev.tank + 1
-            if ev.kind == "shot":
-                tcp.send(n, 0, P.Shot(n, w.t, *poses[ev.tank]))
-            elif ev.kind == "hit":
-                victim = w.tanks[ev.other]
-                tcp.send(0, 0, ("hit", ev.other + 1, victim.hp, not victim.alive, w.t))
-            elif ev.kind == "respawn":
-                extra_respawns += min(math.hypot(ev.x - x, ev.z - z) for x, z, _ in w.spawns[:2]) > 2.0
-        if w.t >= next_state:
-            next_state += STATE_DT
-            for t in w.tanks[:6]:
-                udp.send(t.index + 1, 0, _state(t, w.t))
-        for net in (udp, tcp):
-            net.advance(w.dt)
-        for _, _, m in tcp.deliver():
-            if isinstance(m, P.Shot):
-                assert judge.shot(m, tcp.now) is None, (m, judge.record(m.tank))
-            else:
-                _, victim, hp, killed, t_hit = m
-                judge.hit(victim, hp, killed, t_hit)
-        for _, _, s in udp.deliver():
-            judged += judge.state(s, udp.now) is not None
+    run = judge_match(w, judge, 40.0, seed, senders=6)
+    extra_respawns = sum(min(math.hypot(rx - x, rz - z) for x, z, _ in w.spawns[:2]) > 2.0
+                         for rx, rz in run.respawns)
     assert judge.corrections == {} and judge.refused_shots == {}, judge.report()
-    assert judged > 2000 and extra_respawns >= 1
+    assert run.judged > 2000 and extra_respawns >= 1
 
 
 class _Peer:
