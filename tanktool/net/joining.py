@@ -21,6 +21,10 @@ from .names import name_problem
 class JoiningMixin:
     """Admitting players and keeping the table."""
 
+    #: player numbers this session gives (1..slots): fewer than the protocol's when the
+    #: arena holds fewer tanks at once (set by net/session.py before anyone joins)
+    slots: int = P.MAX_PLAYERS
+
     def _accept(self) -> None:
         assert self.tcp is not None
         for _ in range(ACCEPTS_PER_POLL):
@@ -149,7 +153,8 @@ class JoiningMixin:
             return
         slot = self._new_slot()
         if slot is None:
-            self._refuse(link, P.RefuseCode.FULL, f"session full: {P.MAX_PLAYERS} players already")
+            room = "" if self.slots >= P.MAX_PLAYERS else f" (the arena holds {self.slots} tanks at once)"
+            self._refuse(link, P.RefuseCode.FULL, f"session full: {self.slots} players already{room}")
             return
         try:
             ip = link.sock.getpeername()[0]
@@ -192,7 +197,7 @@ class JoiningMixin:
         """(number, epoch) for a newcomer: a number never used in this session while
         there is one, else the one freed longest ago; an epoch above every one seen.
         None when full."""
-        free = [n for n in range(1, P.MAX_PLAYERS + 1) if n not in self.table]
+        free = [n for n in range(1, self.slots + 1) if n not in self.table]
         if not free:
             return None
         fresh = [n for n in free if n not in self.used_numbers]

@@ -101,8 +101,9 @@ class NetMatch:
     restart_stats: bool = field(init=False, default=False)
 
     def __post_init__(self) -> None:
-        names = [f"p{n}" for n in range(1, P.MAX_PLAYERS + 1)]
-        self.world = World(self.arena.walls, [self.spec] * P.MAX_PLAYERS, self.arena.spawns, seed=self.seed,
+        self._seat()
+        names = [f"p{n}" for n in range(1, self.peer.slots + 1)]
+        self.world = World(self.arena.walls, [self.spec] * self.peer.slots, self.arena.spawns, seed=self.seed,
                            names=names, bounds=self.arena.bounds, ground=getattr(self.arena, "ground", None),
                            rules=NET_RULES)
         for t in self.world.tanks:
@@ -134,6 +135,17 @@ class NetMatch:
             self.names[e.number] = e.name
 
     # ------------------------------------------------------------------ pieces
+    def _seat(self) -> None:
+        """One slot per tank the arena holds at once, up to the protocol's players: the
+        host's room check refuses joiners beyond it, so a 4-tank arena hosts 2-4 players."""
+        from ..sim.extra_spawns import slots
+
+        n = self.peer.slots = slots(self.arena, self.spec, P.MAX_PLAYERS)
+        want = 1 + max(self.bots, len(self.bot_specs))
+        if n < 2 or self.peer.number > n or want > n:
+            raise NetError(f"arena {self.arena.name} holds {n} tank{'s' * (n != 1)} of {self.spec.name} at once: "
+                           + ("a network match needs 2" if n < 2 else f"not {max(want, self.peer.number)}"))
+
     @staticmethod
     def _absent(t: Any) -> None:
         t.alive = False

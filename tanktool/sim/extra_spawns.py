@@ -114,3 +114,12 @@ def holds(info: Any, specs: list, limit: int = 64) -> list[tuple[str, int]]:
             w.spawn_y.append(float(row[3]) if len(row) > 3 and math.isfinite(row[3]) else None)
         out.append((spec.name, min(capacity(w, spec.radius, spec.box[2] - spec.box[0], limit), limit)))
     return out
+
+
+def slots(info: Any, spec: Any, limit: int) -> int:
+    """How many tanks of ``spec`` a match on ``info`` (``match.ArenaInfo``) can seat, up
+    to ``limit`` (a network session's player numbers): ``limit`` when the arena has that
+    many spawn points, else what it holds at once (:func:`holds`)."""
+    if len(info.spawns) >= limit:
+        return limit
+    return holds(info, [spec], limit)[0][1]
