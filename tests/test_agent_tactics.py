@@ -382,3 +382,51 @@ def test_only_a_level_that_scoots_goes_back_to_cover_while_reloading(monkeypatch
         cmd = drv.bot.machine.states["attack"].update(drv.bot, view_of(drv, w), p)
         assert not cmd.fire
     assert asked == ["normal"]
+
+
+# ------------------------------------------------------------------ hunting a camper
+def _hunting(w, camp):
+    """Our normal agent (tank 0) remembering an enemy (tank 1, dead for good) camping
+    at ``camp``, hunting it."""
+    me, enemy = w.tanks
+    enemy.alive, enemy.respawn_at = False, math.inf
+    drv = driver(Agent("normal"), 0)
+    drv(w, me)
+    agent = drv.bot
+    agent.memory.met = True
+    agent.memory.camps[1] = (camp[0], camp[1], w.t, math.pi)
+    drv.next_think = -math.inf
+    drv(w, me)
+    return agent, drv
+
+
+def test_a_hunt_ends_when_the_camp_is_in_its_cone_and_sight_and_nobody_is_there():
+    # the camp 40 m ahead in the open box: an enemy there would be seen, it has gone
+    w = box_world([(20.0, 70.0), (100.0, 10.0)])
+    agent, drv = _hunting(w, (60.0, 80.0))
+    # it went hunting, looked, and gave it up in the same think
+    assert ("camp_known", "hunt") in [(when, to) for _, _, when, to in agent.machine.trace]
+    assert 1 not in agent.memory.camps and agent.state != "hunt", (hunted, agent.state, agent.machine.trace)
+
+
+def test_a_hunt_that_comes_no_nearer_looks_from_where_it_is(monkeypatch):
+    # the camp behind the thin wall x=60; the tank held where it is (as on a hillside it
+    # could not climb): after HUNT_STALL s it turns to look from there, and gives it up
+    HUNT_STALL = 4.0
+
+    w = box_world([(40.0, 35.0), (100.0, 10.0)], headings=[math.pi])
+    agent, drv = _hunting(w, (80.0, 35.0))
+    assert agent.state == "hunt"
+    me = w.tanks[0]
+    hunted = 0.0
+    for _ in range(int((HUNT_STALL + 4.0) / w.dt)):
+        cmd = drv(w, me)
+        w.step(None, [cmd, IDLE])
+        om = me.omega
+        me.place(40.0, 35.0, me.heading)           # it cannot get anywhere, but turns
+        me.omega = om
+        hunted += w.dt * (agent.state == "hunt")
+        if agent.state != "hunt":
+            break
+    assert 1 not in agent.memory.camps and agent.state != "hunt", (hunted, agent.state, agent.machine.trace)
+    assert hunted >= HUNT_STALL

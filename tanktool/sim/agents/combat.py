@@ -53,6 +53,8 @@ SCOOT = 0.4
 #: sight is driven at most this fast [m/s], gun on it
 CAMP_MEMORY = 90.0
 CAMP_SPEED = 7.0
+#: hunting: no nearer to the place to look from for this long, it looks from where it is [s]
+HUNT_STALL = 4.0
 #: evading lasts at most this long [s]; then no new evasion for EVADE_COOLDOWN s
 EVADE_TIME = 5.0
 EVADE_COOLDOWN = 8.0
@@ -311,10 +313,22 @@ class Hunt(State["Agent"]):
     def __init__(self) -> None:
         self.camp: tuple[float, float] | None = None
         self.replan = -math.inf
+        self.best, self.best_at = math.inf, 0.0      # nearest to the path's end so far, since
         self._room: np.ndarray | None = None
 
     def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
         self.camp, self.replan = None, -math.inf
+        self.best, self.best_at = math.inf, view.t
+
+    @staticmethod
+    def _looked(agent: "Agent", view: "View", cx: float, cz: float) -> bool:
+        """Whether the camp lies in our cone (with a margin), in vision range and in
+        our line of sight: then an enemy there would be seen."""
+        me = view.me
+        d = math.hypot(cx - me.x, cz - me.z)
+        off = abs(wrap(math.atan2(cz - me.z, cx - me.x) - me.heading))
+        return d <= agent.senses.vision_range and off < agent.senses.half_angle - 0.2 and \
+            not view.map.line_blocked(me.x, me.z, cx, cz, me.eye)
 
     def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
         """To the nearest place (by path) that sees the camp from ``stand_off`` +- 15 m
@@ -325,13 +339,21 @@ class Hunt(State["Agent"]):
         if idx is None:
             return None
         cx, cz, seen_t, face = mem.camps[idx]
+        if self._looked(agent, view, cx, cz):
+            del mem.camps[idx]                # in our cone and line of sight, and not there
+            return None
         if self.camp != (cx, cz) or t >= self.replan or not agent.path:
             if not self._plan(agent, view, (cx, cz), face):
                 del mem.camps[idx]             # nowhere to see it from: give it up
                 return None
         trim(agent.path, me.x, me.z)
         end = agent.path[-1]
-        if math.hypot(end[0] - me.x, end[1] - me.z) < 3.0:
+        d_end = math.hypot(end[0] - me.x, end[1] - me.z)
+        if d_end < self.best - 1.0:
+            self.best, self.best_at = d_end, t
+        if d_end < 3.0 or t - self.best_at > HUNT_STALL:
+            # there, or no nearer for HUNT_STALL s (circling a place it cannot stand
+            # on: seen on a hillside of the hills for 70 s): look from here
             err = wrap(math.atan2(cz - me.z, cx - me.x) - me.heading)
             if abs(err) < 0.3:
                 del mem.camps[idx]            # looking at where it was, and it is not there
@@ -365,6 +387,8 @@ class Hunt(State["Agent"]):
         top = me.vehicle.top_speed
         score = pd - np.where(roomy, 2.0 * top, 0.0) - np.where(unseen, 4.0 * top, 0.0)
         b = int(np.argmin(np.where(ok, score, np.inf)))
+        if self.camp != camp:
+            self.best, self.best_at = math.inf, view.t
         self.camp, self.replan = camp, view.t + 5.0
         agent.path = view.map.path((me.x, me.z, me.y), (float(pts[b][0]), float(pts[b][1]), float(v.heights[b])),
                                    agent.nav.grid)
