@@ -9,6 +9,7 @@ from __future__ import annotations
 import io
 import math
 import os
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -54,43 +55,104 @@ def node_states(grid: Any, free: np.ndarray | None = None) -> np.ndarray:
     return s
 
 
-def _draw_panel(ax, grid, walls, free, quadtree, spawns, annotate, view, j0, j1, i0, i1, width_in, across, view_span,
-                relief, plt, title, whole) -> int:
-    """Draw one level's nodes, walls, leaves, spawns and run numbers on ``ax``."""
-    from matplotlib.collections import LineCollection
+@dataclass
+class _Frame:
+    """What every panel of one picture shares: the view, the cells it touches and the
+    figure's size (they decide whether run numbers fit)."""
+
+    view: np.ndarray            # [[x0, z0], [x1, z1]] of the axes
+    j0: int                     # the cells the view touches: columns j0..j1, rows i0..i1
+    j1: int
+    i0: int
+    i1: int
+    view_span: float            # the view's larger side [m]
+    width_in: float             # the figure's width, legend included [in]
+    height_in: float            # one panel's height [in]
+    relief: tuple[float, float] | None    # the heights of a grid with relief, else None
+
+    @property
+    def cell_pt(self) -> float:
+        """How many points wide a cell is drawn."""
+        return (self.width_in - 2.6) * 0.92 * 72.0 / max(1, self.j1 - self.j0)
+
+
+def _frame(grid: Any, region: np.ndarray | None, annotate: str) -> _Frame:
+    """The view of ``grid`` (the whole of it, padded, or ``region`` widened to whole
+    cells) and a figure big enough for ``annotate``'s labels when they can fit."""
+    b = grid.bounds
+    view = b.copy() if region is None else np.asarray(region, dtype=np.float64).reshape(2, 2)
+    # the cells the view touches; they decide how big the figure must be for labels
+    j0 = max(0, int(math.floor((view[0, 0] - grid.origin[0]) / grid.cell)))
+    j1 = min(grid.nx, int(math.ceil((view[1, 0] - grid.origin[0]) / grid.cell)))
+    i0 = max(0, int(math.floor((view[0, 1] - grid.origin[1]) / grid.cell)))
+    i1 = min(grid.nz, int(math.ceil((view[1, 1] - grid.origin[1]) / grid.cell)))
+    if region is not None:  # widen a region to whole cells, so no label is cut
+        view = grid.origin + grid.cell * np.array([[j0, i0], [j1, i1]], dtype=np.float64)
+    view_span = float(np.max(view[1] - view[0]))
+    if region is None:
+        pad = 0.02 * view_span
+        view = view + np.array([[-pad], [pad]])
+    across = max(1, j1 - j0)
+    tall = max(1, i1 - i0)
+    aspect = (view[1, 1] - view[0, 1]) / max(view[1, 0] - view[0, 0], 1e-9)
+    want_pt = MIN_LABEL_PT.get(annotate, 0.0) * 1.45
+    width_in = 10.0
+    if annotate != "none" and across <= 80 and tall <= 80:
+        width_in = min(max(width_in, across * want_pt / 72.0), 22.0)
+    height_in = min(max(width_in * aspect, 3.0), 22.0)
+    width_in = min(width_in, 22.0) + 2.6  # room for the legend
+    heights = grid.heights()
+    hv = heights[np.isfinite(heights)]
+    relief = (float(hv.min()), float(hv.max())) if len(hv) and hv.max() - hv.min() > 0.25 else None
+    return _Frame(view, j0, j1, i0, i1, view_span, width_in, height_in, relief)
+
+
+def _draw_nodes(ax, grid: Any, states: np.ndarray, fr: _Frame, labelling: bool) -> None:
+    """Node states (shaded by height on a grid with relief), and node centres and cell
+    edges when cells are big enough to show them."""
     from matplotlib.colors import ListedColormap
 
     b = grid.bounds
-    states = node_states(grid, free)
     cmap = ListedColormap(list(STATE_COLOURS.values()))
     ax.imshow(
         states, origin="lower", cmap=cmap, vmin=-0.5, vmax=3.5, interpolation="nearest",
         extent=(b[0, 0], b[1, 0], b[0, 1], b[1, 1]), zorder=0,
     )
+    relief = fr.relief
     if relief is not None:  # reachable nodes shaded by their height
         shade = np.where(states == 2, grid.heights()[0], np.nan)
         ax.imshow(shade, origin="lower", cmap=HEIGHT_CMAP, vmin=relief[0], vmax=max(relief[1], relief[0] + 1e-6),
                   alpha=0.85, interpolation="nearest", extent=(b[0, 0], b[1, 0], b[0, 1], b[1, 1]), zorder=0)
-    cell_pt = (width_in - 2.6) * 0.92 * 72.0 / across
-    labelling = annotate != "none" and cell_pt >= MIN_LABEL_PT.get(annotate, 99)
-    if cell_pt >= 6:  # node centres and cell edges, when they do not turn into a smear
-        xs, zs = np.meshgrid(grid.node_x[j0:j1], grid.node_z[i0:i1])
-        # no dots on solid ground (clutter) nor under labels (the label marks the node)
-        dot = states[i0:i1, j0:j1] > 0
-        if labelling:
-            dot &= ~grid.valid[0, i0:i1, j0:j1]
-        ax.scatter(xs[dot], zs[dot], s=min(max(1.0, (cell_pt * 0.12) ** 2), 9.0), c="#00000055", lw=0, zorder=1)
-        gx = grid.origin[0] + np.arange(j0, j1 + 1) * grid.cell
-        gz = grid.origin[1] + np.arange(i0, i1 + 1) * grid.cell
-        ax.vlines(gx, gz[0], gz[-1], colors="#ffffff", lw=0.4, alpha=0.7, zorder=1)
-        ax.hlines(gz, gx[0], gx[-1], colors="#ffffff", lw=0.4, alpha=0.7, zorder=1)
+    cell_pt = fr.cell_pt
+    if cell_pt < 6:  # node centres and cell edges would turn into a smear
+        return
+    i0, i1, j0, j1 = fr.i0, fr.i1, fr.j0, fr.j1
+    xs, zs = np.meshgrid(grid.node_x[j0:j1], grid.node_z[i0:i1])
+    # no dots on solid ground (clutter) nor under labels (the label marks the node)
+    dot = states[i0:i1, j0:j1] > 0
+    if labelling:
+        dot &= ~grid.valid[0, i0:i1, j0:j1]
+    ax.scatter(xs[dot], zs[dot], s=min(max(1.0, (cell_pt * 0.12) ** 2), 9.0), c="#00000055", lw=0, zorder=1)
+    gx = grid.origin[0] + np.arange(j0, j1 + 1) * grid.cell
+    gz = grid.origin[1] + np.arange(i0, i1 + 1) * grid.cell
+    ax.vlines(gx, gz[0], gz[-1], colors="#ffffff", lw=0.4, alpha=0.7, zorder=1)
+    ax.hlines(gz, gx[0], gx[-1], colors="#ffffff", lw=0.4, alpha=0.7, zorder=1)
 
-    if quadtree is not None:
-        lb = quadtree.box[quadtree.leaves]
-        lines = []
-        for (x0, z0), (x1, z1) in lb.tolist():
-            lines += [[(x0, z0), (x1, z0)], [(x1, z0), (x1, z1)], [(x1, z1), (x0, z1)], [(x0, z1), (x0, z0)]]
-        ax.add_collection(LineCollection(lines, colors=QUADTREE_COLOUR, lw=0.8, alpha=0.55, zorder=2))
+
+def _draw_quadtree(ax, quadtree: Any) -> None:
+    """The quadtree's leaves as boxes."""
+    from matplotlib.collections import LineCollection
+
+    lb = quadtree.box[quadtree.leaves]
+    lines = []
+    for (x0, z0), (x1, z1) in lb.tolist():
+        lines += [[(x0, z0), (x1, z0)], [(x1, z0), (x1, z1)], [(x1, z1), (x0, z1)], [(x0, z1), (x0, z0)]]
+    ax.add_collection(LineCollection(lines, colors=QUADTREE_COLOUR, lw=0.8, alpha=0.55, zorder=2))
+
+
+def _draw_walls(ax, walls: Any, view_span: float) -> None:
+    """Walls, auxiliary rectangles dashed, and the walls' normals."""
+    from matplotlib.collections import LineCollection
 
     seg = walls.segments
     ax.add_collection(LineCollection(seg, colors=WALL_COLOUR, lw=1.8, capstyle="round", zorder=3))
@@ -102,48 +164,101 @@ def _draw_panel(ax, grid, walls, free, quadtree, spawns, annotate, view, j0, j1,
         tick = walls.normals * (0.012 * view_span)
         ax.add_collection(LineCollection(np.stack([mid, mid + tick], axis=1), colors=WALL_COLOUR, lw=1.0, zorder=3))
 
-    if spawns is not None and len(spawns):
-        sp = np.asarray(spawns, dtype=np.float64).reshape(len(spawns), -1)
-        ax.scatter(sp[:, 0], sp[:, 1], marker="*", s=200, c=SPAWN_COLOUR, edgecolors="white", linewidths=0.8, zorder=6)
-        if sp.shape[1] >= 3:
-            L = 0.04 * view_span
-            ax.quiver(sp[:, 0], sp[:, 1], np.cos(sp[:, 2]) * L, np.sin(sp[:, 2]) * L, angles="xy",
-                      scale_units="xy", scale=1, color=SPAWN_COLOUR, width=0.004, zorder=5)
 
+def _draw_spawns(ax, spawns: Any, view_span: float) -> None:
+    """Spawn points as stars, with an arrow along their heading when they have one."""
+    sp = np.asarray(spawns, dtype=np.float64).reshape(len(spawns), -1)
+    ax.scatter(sp[:, 0], sp[:, 1], marker="*", s=200, c=SPAWN_COLOUR, edgecolors="white", linewidths=0.8, zorder=6)
+    if sp.shape[1] >= 3:
+        L = 0.04 * view_span
+        ax.quiver(sp[:, 0], sp[:, 1], np.cos(sp[:, 2]) * L, np.sin(sp[:, 2]) * L, angles="xy",
+                  scale_units="xy", scale=1, color=SPAWN_COLOUR, width=0.004, zorder=5)
+
+
+def _draw_labels(ax, grid: Any, fr: _Frame, annotate: str) -> int:
+    """Run numbers on the valid nodes inside the view; how many were written."""
+    # "12/34" is five characters of about 0.6 em: fill most of the cell's width
+    font = min(11.0, fr.cell_pt / 4.0)
+    view = fr.view
+    ii, jj = np.nonzero(grid.valid[0, fr.i0:fr.i1, fr.j0:fr.j1])
+    ii, jj = ii + fr.i0, jj + fr.j0
     labelled = 0
-    if labelling:
-        # "12/34" is five characters of about 0.6 em: fill most of the cell's width
-        font = min(11.0, cell_pt / 4.0)
-        ii, jj = np.nonzero(grid.valid[0, i0:i1, j0:j1])
-        ii, jj = ii + i0, jj + j0
-        for i, j in zip(ii.tolist(), jj.tolist()):
-            x, z = grid.centre(i, j)
-            if not (view[0, 0] <= x <= view[1, 0] and view[0, 1] <= z <= view[1, 1]):
-                continue  # a label must not spill over the axes
-            r = f"{grid.row_index[0, i, j]}/{grid.row_total[0, i, j]}"
-            c = f"{grid.col_index[0, i, j]}/{grid.col_total[0, i, j]}"
-            text = {"rows": r, "cols": c, "both": f"{r}\n{c}"}[annotate]
-            ax.text(x, z, text, ha="center", va="center", fontsize=font, color="#10301a", linespacing=0.95,
-                    zorder=4, clip_on=True)
-            labelled += 1
+    for i, j in zip(ii.tolist(), jj.tolist()):
+        x, z = grid.centre(i, j)
+        if not (view[0, 0] <= x <= view[1, 0] and view[0, 1] <= z <= view[1, 1]):
+            continue  # a label must not spill over the axes
+        r = f"{grid.row_index[0, i, j]}/{grid.row_total[0, i, j]}"
+        c = f"{grid.col_index[0, i, j]}/{grid.col_total[0, i, j]}"
+        text = {"rows": r, "cols": c, "both": f"{r}\n{c}"}[annotate]
+        ax.text(x, z, text, ha="center", va="center", fontsize=font, color="#10301a", linespacing=0.95,
+                zorder=4, clip_on=True)
+        labelled += 1
+    return labelled
 
+
+def _panel_title(grid: Any, title: str, whole: Any) -> str:
+    """A panel's title: the grid's size and settings and its count of valid nodes
+    (``whole``: the grid of which ``grid`` is a level, on the first panel only)."""
+    n_valid = int(grid.valid.sum())
+    n_reach = int((grid.valid & grid.reachable).sum())
+    total = whole if whole is not None else grid
+    levels = f", {whole.levels} levels" if whole is not None and whole.levels > 1 else ""
+    return (f"{title}: {grid.nz} x {grid.nx} nodes{levels}, cell {grid.cell:g} m, clearance {grid.clearance:g} m\n"
+            f"{n_valid:,} valid ({n_reach:,} reachable, {n_valid - n_reach:,} unreachable)"
+            + (f" of {total.valid.size:,}" if whole is not None or total is grid else ""))
+
+
+def _draw_panel(ax, grid: Any, walls: Any, fr: _Frame, annotate: str, title: str, whole: Any, *,
+                free: np.ndarray | None, quadtree: Any, spawns: Any) -> int:
+    """Draw one level's nodes, walls, leaves, spawns and run numbers on ``ax``; how many
+    run numbers were written."""
+    states = node_states(grid, free)
+    labelling = annotate != "none" and fr.cell_pt >= MIN_LABEL_PT.get(annotate, 99)
+    _draw_nodes(ax, grid, states, fr, labelling)
+    if quadtree is not None:
+        _draw_quadtree(ax, quadtree)
+    _draw_walls(ax, walls, fr.view_span)
+    if spawns is not None and len(spawns):
+        _draw_spawns(ax, spawns, fr.view_span)
+    labelled = _draw_labels(ax, grid, fr, annotate) if labelling else 0
+    view = fr.view
     ax.set_xlim(view[0, 0], view[1, 0])
     ax.set_ylim(view[0, 1], view[1, 1])
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("z [m]")
-    n_valid = int(grid.valid.sum())
-    n_reach = int((grid.valid & grid.reachable).sum())
-    head = title
-    total = whole if whole is not None else grid
-    levels = f", {whole.levels} levels" if whole is not None and whole.levels > 1 else ""
-    ax.set_title(
-        f"{head}: {grid.nz} x {grid.nx} nodes{levels}, cell {grid.cell:g} m, clearance {grid.clearance:g} m\n"
-        f"{n_valid:,} valid ({n_reach:,} reachable, {n_valid - n_reach:,} unreachable)"
-        + (f" of {total.valid.size:,}" if whole is not None or total is grid else ""),
-        fontsize=10,
-    )
+    ax.set_title(_panel_title(grid, title, whole), fontsize=10)
     return labelled
+
+
+def _legend(fig, walls: Any, quadtree: Any, spawns: Any, annotate: str, labelled: int,
+            relief: tuple[float, float] | None) -> None:
+    """The legend (only what the picture shows) and, on a grid with relief, the height bar."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
+    handles = [Patch(fc=c, ec="#888888", label=k) for k, c in STATE_COLOURS.items()]
+    if relief is not None:
+        handles[2] = Patch(fc="#6fb36b", ec="#888888", label="valid (shade: height)")
+    handles.append(Line2D([], [], color=WALL_COLOUR, lw=1.8, label="wall (tick: free side)"))
+    if walls.aux is not None:
+        handles.append(Line2D([], [], color=WALL_COLOUR, lw=0.8, ls="--", label="auxiliary rectangle"))
+    if quadtree is not None:
+        handles.append(Line2D([], [], color=QUADTREE_COLOUR, lw=0.8, alpha=0.7,
+                              label=f"quadtree leaves ({len(quadtree.leaves)}, depth {quadtree.max_depth})"))
+    if spawns is not None and len(spawns):
+        handles.append(Line2D([], [], marker="*", color=SPAWN_COLOUR, lw=0, ms=12, label="spawn point"))
+    if labelled:
+        handles.append(Patch(fc="none", ec="none", label={
+            "rows": "labels: renglón/total", "cols": "labels: columna/total",
+            "both": "labels: renglón/total\n            columna/total"}[annotate]))
+    fig.legend(handles=handles, loc="upper right", fontsize=8, frameon=False, bbox_to_anchor=(0.995, 0.93))
+    if relief is not None:
+        import matplotlib.cm as cm
+        from matplotlib.colors import Normalize
+
+        cax = fig.add_axes((0.90, 0.08, 0.015, 0.25))
+        fig.colorbar(cm.ScalarMappable(Normalize(*relief), HEIGHT_CMAP), cax=cax, label="surface y [m]")
 
 
 def render_navgrid(
@@ -171,70 +286,20 @@ def render_navgrid(
     if os.environ.get("DISPLAY") is None:
         matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.collections import LineCollection
-    from matplotlib.colors import ListedColormap
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch
 
-    b = grid.bounds
-    view = b.copy() if region is None else np.asarray(region, dtype=np.float64).reshape(2, 2)
-    # the cells the view touches; they decide how big the figure must be for labels
-    j0 = max(0, int(math.floor((view[0, 0] - grid.origin[0]) / grid.cell)))
-    j1 = min(grid.nx, int(math.ceil((view[1, 0] - grid.origin[0]) / grid.cell)))
-    i0 = max(0, int(math.floor((view[0, 1] - grid.origin[1]) / grid.cell)))
-    i1 = min(grid.nz, int(math.ceil((view[1, 1] - grid.origin[1]) / grid.cell)))
-    if region is not None:  # widen a region to whole cells, so no label is cut
-        view = grid.origin + grid.cell * np.array([[j0, i0], [j1, i1]], dtype=np.float64)
-    view_span = float(np.max(view[1] - view[0]))
-    if region is None:
-        pad = 0.02 * view_span
-        view = view + np.array([[-pad], [pad]])
-    across = max(1, j1 - j0)
-    tall = max(1, i1 - i0)
-    aspect = (view[1, 1] - view[0, 1]) / max(view[1, 0] - view[0, 0], 1e-9)
-    want_pt = MIN_LABEL_PT.get(annotate, 0.0) * 1.45
-    width_in = 10.0
-    if annotate != "none" and across <= 80 and tall <= 80:
-        width_in = min(max(width_in, across * want_pt / 72.0), 22.0)
-    height_in = min(max(width_in * aspect, 3.0), 22.0)
-    width_in = min(width_in, 22.0) + 2.6  # room for the legend
+    fr = _frame(grid, region, annotate)
     L = grid.levels
-    heights = grid.heights()
-    hv = heights[np.isfinite(heights)]
-    relief = (float(hv.min()), float(hv.max())) if len(hv) and hv.max() - hv.min() > 0.25 else None
-    panel_h = height_in + 0.8
-    fig = plt.figure(figsize=(width_in, panel_h * L))
+    fig = plt.figure(figsize=(fr.width_in, (fr.height_in + 0.8) * L))
     labelled = 0
     for lv in range(L):
         top = 1.0 - lv / L
-        ax = fig.add_axes((0.06, top - (0.94 / L), (width_in - 2.6) / width_in * 0.92, 0.86 / L))
-        g = level_view(grid, lv)
+        ax = fig.add_axes((0.06, top - (0.94 / L), (fr.width_in - 2.6) / fr.width_in * 0.92, 0.86 / L))
         w = walls.on_level(lv) if getattr(walls, "layered", False) else walls
-        labelled += _draw_panel(ax, g, w, free if L == 1 else None, quadtree, spawns if lv == 0 else None, annotate, view, j0, j1,
-                    i0, i1, width_in, across, view_span, relief, plt,
-                    f"{title or 'navigation grid'}" + (f", level {lv}" if L > 1 else ""), grid if lv == 0 else None)
-    handles = [Patch(fc=c, ec="#888888", label=k) for k, c in STATE_COLOURS.items()]
-    if relief is not None:
-        handles[2] = Patch(fc="#6fb36b", ec="#888888", label="valid (shade: height)")
-    handles.append(Line2D([], [], color=WALL_COLOUR, lw=1.8, label="wall (tick: free side)"))
-    if walls.aux is not None:
-        handles.append(Line2D([], [], color=WALL_COLOUR, lw=0.8, ls="--", label="auxiliary rectangle"))
-    if quadtree is not None:
-        handles.append(Line2D([], [], color=QUADTREE_COLOUR, lw=0.8, alpha=0.7,
-                              label=f"quadtree leaves ({len(quadtree.leaves)}, depth {quadtree.max_depth})"))
-    if spawns is not None and len(spawns):
-        handles.append(Line2D([], [], marker="*", color=SPAWN_COLOUR, lw=0, ms=12, label="spawn point"))
-    if labelled:
-        handles.append(Patch(fc="none", ec="none", label={
-            "rows": "labels: renglón/total", "cols": "labels: columna/total",
-            "both": "labels: renglón/total\n            columna/total"}[annotate]))
-    fig.legend(handles=handles, loc="upper right", fontsize=8, frameon=False, bbox_to_anchor=(0.995, 0.93))
-    if relief is not None:
-        import matplotlib.cm as cm
-        from matplotlib.colors import Normalize
-
-        cax = fig.add_axes((0.90, 0.08, 0.015, 0.25))
-        fig.colorbar(cm.ScalarMappable(Normalize(*relief), HEIGHT_CMAP), cax=cax, label="surface y [m]")
+        head = f"{title or 'navigation grid'}" + (f", level {lv}" if L > 1 else "")
+        labelled += _draw_panel(ax, level_view(grid, lv), w, fr, annotate, head, grid if lv == 0 else None,
+                                free=free if L == 1 else None, quadtree=quadtree,
+                                spawns=spawns if lv == 0 else None)
+    _legend(fig, walls, quadtree, spawns, annotate, labelled, fr.relief)
     buf = io.BytesIO()
     # SVG keeps its text as text, so run numbers can be searched and selected
     with plt.rc_context({"svg.fonttype": "none"}):
