@@ -15,7 +15,7 @@ from net_helpers import LOOPBACK, join, peers, play, pump, states_from  # noqa: 
 from net_helpers import session as _session
 
 from tanktool.errors import NetError
-from tanktool.net import auth, probe
+from tanktool.net import auth, limits, probe
 from tanktool.net import peer as peer_mod
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer
@@ -81,7 +81,7 @@ def test_a_flood_of_silent_connections_while_a_player_joins(peers):
 
 
 def test_silent_connections_time_out_after_the_handshake_deadline(peers, monkeypatch):
-    monkeypatch.setattr(peer_mod, "PENDING_TIMEOUT", 1.0)
+    monkeypatch.setattr(limits, "PENDING_TIMEOUT", 1.0)
     _session(peers, 2)
     host = peers[0]
     socks = _silent(host.tcp_address, 5, peers)
@@ -98,7 +98,7 @@ def test_silent_connections_time_out_after_the_handshake_deadline(peers, monkeyp
 def test_busiest_address_is_evicted_first(peers, monkeypatch):
     """Over the overall cap, the new connection pushes out one of the busiest address's,
     not one of a quieter address (a real player elsewhere)."""
-    monkeypatch.setattr(peer_mod, "MAX_PENDING", 6)
+    monkeypatch.setattr(limits, "MAX_PENDING", 6)
     host = Peer.host(("0.0.0.0", 0), "host")
     peers.append(host)
     port = host.tcp_address[1]

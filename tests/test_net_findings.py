@@ -20,7 +20,9 @@ from tanktool.errors import NetError
 from tanktool.net import probe
 from tanktool.net import protocol as P
 from tanktool.net.names import name_key, name_problem, visible
-from tanktool.net.peer import Link, Peer
+from tanktool.net.core import Core
+from tanktool.net.links import Send
+from tanktool.net.peer import Peer
 
 
 # ---------------------------------------------------------------- finding 1
@@ -57,46 +59,28 @@ def test_numbers_and_epochs_are_not_reused_while_others_are_free(peers):
 
 
 # ---------------------------------------------------------------- finding 2
-class _DeadSocket:
-    """A socket whose other end has gone: sends fail."""
-
-    def __init__(self) -> None:
-        self.closed = False
-
-    def send(self, data: bytes) -> int:
-        raise BrokenPipeError(32, "Broken pipe")
-
-    def fileno(self) -> int:
-        return -1 if self.closed else 1000
-
-    def getpeername(self) -> tuple[str, int]:
-        return (LOOPBACK, 40000)
-
-    def close(self) -> None:
-        self.closed = True
-
-
-def test_admitting_while_sends_fail_does_not_crash_the_host(peers):
+def test_admitting_while_sends_fail_does_not_crash_the_host():
     """The host admits a joiner while the link to an earlier member fails and the
     joiner itself has already gone: the cleanup used to remove the joiner before
-    ``_admit`` read its entry (KeyError)."""
-    from tanktool.net.guard import Bucket
-
-    host = Peer.host((LOOPBACK, 0), "host")
-    peers.append(host)
-    now = host.clock()
-    host.table[2] = P.Entry(2, 2, LOOPBACK, 40001, 40001, "early")
-    host._saw(host.table[2])
-    host.links[2] = Link(_DeadSocket(), P.StreamReader(Counter()), Bucket(100, 100, now), now, number=2)
-    joiner = Link(_DeadSocket(), P.StreamReader(Counter()), Bucket(100, 100, now), now, addr=(LOOPBACK, 40000))
-    host.pending.append(joiner)
-    m = P.Message(P.MessageType.JOIN, 0, 1, now, P.Join("newbie", 40002, 40002, bytes(P.MAC_SIZE), host.digest))
-    host._on_pending(joiner, m)
-    host._reap()
-    events = host.poll(0)
-    kinds = [(e.kind, e.number) for e in events]
+    ``_admit`` read its entry (KeyError).  The core sends nothing itself: the transport
+    reports the failed sends after the admission is done."""
+    core = Core("host")
+    core.start_host((LOOPBACK, 5000, 5000), now=0.0)
+    core.table[2] = P.Entry(2, 2, LOOPBACK, 40001, 40001, "early")
+    core._saw(core.table[2])
+    early = core._new_link((LOOPBACK, 40001))
+    core._bind_link(early, 2)
+    joiner = core.accepted((LOOPBACK, 40000), now=0.1)
+    assert joiner is not None and [type(a) for a in core.take_actions()] == [Send]      # the challenge
+    join = P.encode(P.Join("newbie", 40002, 40002, bytes(P.MAC_SIZE), core.digest), 0, 1, 0.1)
+    core.received(joiner, join, now=0.2)
+    sends = [a for a in core.take_actions() if isinstance(a, Send)]
+    assert {a.link for a in sends} == {joiner, early.id}       # NUMBER to it, NEW_PLAYER to 2
+    for a in sends:                                            # both sends fail
+        core.disconnected(a.link, "closed", now=0.3)
+    kinds = [(e.kind, e.number) for e in core.take_events()]
     assert ("joined", 3) in kinds and ("left", 3) in kinds and ("left", 2) in kinds
-    assert sorted(host.table) == [1] and not host.links and not host.pending
+    assert sorted(core.table) == [1] and not core.links and not core.pending and not core.conns
 
 
 # ---------------------------------------------------------------- finding 3

@@ -1,24 +1,25 @@
 """Datagrams: sending states, reading them (the per-address budget, the tag, the
-sender's address, the sequence window, the per-tank rate).  Part of
-:class:`~tanktool.net.peer.Peer`."""
+sender's address, the sequence window, the per-tank rate).  No I/O: part of
+:class:`~tanktool.net.core.Core`."""
 
 from __future__ import annotations
 
 from . import protocol as P
 from .auth import TAG_SIZE, seal, unseal
+from . import limits as L
 from .guard import Bucket
-from .limits import UDP_RATE, UDP_BURST, UDP_READS
-from .links import NetEvent
+from .links import NetEvent, SendTo
 
 
 class DatagramsMixin:
     """States over UDP."""
 
-    def send_state(self, state: P.State) -> None:
+    def send_state(self, state: P.State, now: float) -> None:
         """A state of a tank I run to every other player, by UDP (with a password, each
         copy sealed with the key of that player's link; none goes to a player whose
         link is not up yet)."""
-        if self.udp is None:
+        self.now = now
+        if self.closed:
             return
         self.counters["state_rounds"] += 1
         data = self._pack(state)
@@ -32,48 +33,43 @@ class DatagramsMixin:
                     self.counters["states_unkeyed"] += 1
                     continue
                 out = seal(link.udp_key, data)
-            try:
-                self.udp.sendto(out, (e.ip, e.udp_port))
-            except OSError:
-                self.dropped["send_failed"] += 1
-                continue
             self.counters["sent"] += 1
             self.counters["states_sent"] += 1
             self.counters["bytes_sent"] += len(out)
+            self.actions.append(SendTo((e.ip, e.udp_port), out))
 
-    def _read_udp(self) -> None:
-        assert self.udp is not None
-        now = self.clock()
-        for _ in range(UDP_READS):    # bounded: a flood cannot starve the game loop
-            try:
-                data, addr = self.udp.recvfrom(2048)
-            except (BlockingIOError, InterruptedError):
+    def unsent(self, data: bytes) -> None:
+        """The transport could not send a datagram the core counted as sent."""
+        self.dropped["send_failed"] += 1
+        self.counters["sent"] -= 1
+        self.counters["states_sent"] -= 1
+        self.counters["bytes_sent"] -= len(data)
+
+    def datagram(self, addr: tuple, data: bytes, now: float) -> None:
+        """A datagram arrived from ``addr`` (ip, port)."""
+        self.now = now
+        self.counters["bytes_received"] += len(data)
+        self.dropped.source = addr
+        if not self._udp_budget(addr, now):
+            # a member over what its tanks may send: dropped before any tag or decode,
+            # so its flood costs a dictionary look-up, not the others' states (finding 8)
+            self.dropped["flood"] += 1
+            return
+        if self.password:
+            data = self._unseal(data, addr)
+            if data is None:
                 return
-            except OSError:
-                self.dropped["udp_error"] += 1
-                return
-            self.counters["bytes_received"] += len(data)
-            self.dropped.source = addr
-            if not self._udp_budget(addr, now):
-                # a member over what its tanks may send: dropped before any tag or decode,
-                # so its flood costs a dictionary look-up, not the others' states (finding 8)
-                self.dropped["flood"] += 1
-                continue
-            if self.password:
-                data = self._unseal(data, addr)
-                if data is None:
-                    continue
-            m = P.decode(data, self.dropped)
-            if m is None:
-                continue
-            if self._from_member(m.sender, addr) is None:
-                continue
-            if not isinstance(m.body, P.State):
-                self.dropped["unexpected"] += 1
-                continue
-            if self._on_state(m, now):
-                self.counters["received"] += 1
-                self.last_heard[m.sender] = now
+        m = P.decode(data, self.dropped)
+        if m is None:
+            return
+        if self._from_member(m.sender, addr) is None:
+            return
+        if not isinstance(m.body, P.State):
+            self.dropped["unexpected"] += 1
+            return
+        if self._on_state(m, now):
+            self.counters["received"] += 1
+            self.last_heard[m.sender] = now
 
     def _udp_budget(self, addr: tuple, now: float) -> bool:
         """Whether a datagram from ``addr`` may be read: a member's address gets the
@@ -84,7 +80,7 @@ class DatagramsMixin:
             tanks = sum(1 for e in self.table.values() if (e.ip, e.udp_port) == addr)
             if tanks == 0:
                 return True
-            b = self.addr_buckets[addr] = Bucket(UDP_RATE * tanks, UDP_BURST * tanks, now)
+            b = self.addr_buckets[addr] = Bucket(L.UDP_RATE * tanks, L.UDP_BURST * tanks, now)
         return b.take(now)
 
     def _from_member(self, sender: int, addr: tuple) -> P.Entry | None:

@@ -1,19 +1,15 @@
 """The listener's side: accepting connections, challenges, JOIN and HELLO (password,
-digest, names, numbers and epochs), the table, computer opponents and kicks.  Part of
-:class:`~tanktool.net.peer.Peer`."""
+digest, names, numbers and epochs), the table, computer opponents and kicks.  No I/O:
+part of :class:`~tanktool.net.core.Core`."""
 
 from __future__ import annotations
 
 import hmac
-import os
-import selectors
-import socket
 
 from ..errors import NetError
 from . import protocol as P
 from .auth import datagram_key, hello_mac, join_mac
-from .guard import Bucket
-from .limits import MAX_HELLO_WAITING, ACCEPTS_PER_POLL, TCP_RATE, TCP_BURST
+from . import limits as L
 from .links import Link, NetEvent
 from .names import name_problem
 
@@ -25,35 +21,24 @@ class JoiningMixin:
     #: arena holds fewer tanks at once (set by net/session.py before anyone joins)
     slots: int = P.MAX_PLAYERS
 
-    def _accept(self) -> None:
-        assert self.tcp is not None
-        for _ in range(ACCEPTS_PER_POLL):
-            try:
-                sock, addr = self.tcp.accept()
-            except (BlockingIOError, InterruptedError):
-                return
-            except OSError:
-                self.dropped["accept_failed"] += 1
-                return
-            self.dropped.source = addr[0]      # TCP: by address (each connection has its own port)
-            if not self._make_room(addr[0]):
-                self.dropped["too_many_pending"] += 1
-                sock.close()
-                continue
-            sock.setblocking(False)
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            now = self.clock()
-            link = Link(sock, P.StreamReader(self.dropped), Bucket(TCP_RATE, TCP_BURST, now), now, addr=addr,
-                        nonce=os.urandom(P.NONCE_SIZE))
-            self.pending.append(link)
-            self.sel.register(sock, selectors.EVENT_READ, link)
-            challenge = P.Challenge(link.nonce, self.password is not None, self.term, self.host_number,
-                                    len(self._others()) + (1 if self.number else 0))
-            self._queue(link, self._pack_control(challenge))
+    def accepted(self, addr: tuple, now: float) -> int | None:
+        """A connection from ``addr`` (ip, port) was accepted: its link number (a
+        challenge is on its way), or None when there is no room (close it)."""
+        self.now = now
+        self.dropped.source = addr[0]      # TCP: by address (each connection has its own port)
+        if not self._make_room(addr[0]):
+            self.dropped["too_many_pending"] += 1
+            return None
+        link = self._new_link(tuple(addr), nonce=self.nonce_source(P.NONCE_SIZE))
+        self.pending.append(link)
+        challenge = P.Challenge(link.nonce, self.password is not None, self.term, self.host_number,
+                                len(self._others()) + (1 if self.number else 0))
+        self._queue(link, self._pack_control(challenge))
+        return link.id
 
     def _on_pending(self, link: Link, m: P.Message) -> None:
         body = m.body
-        now = self.clock()
+        now = self.now
         ip = link.addr[0]
         if isinstance(body, (P.Join, P.Hello)) and self.password:
             # every answer is checked: a player who proves the password gets in however
@@ -114,16 +99,12 @@ class JoiningMixin:
                 self._refuse(link, P.RefuseCode.BAD_REQUEST, f"no player {n} with epoch {epoch} here")
             else:
                 waiting = [k for k in self.pending if k.hello is not None and not k.closing]
-                if len(waiting) > MAX_HELLO_WAITING:
+                if len(waiting) > L.MAX_HELLO_WAITING:
                     # a real joiner's HELLO waits a round trip at most: the oldest goes
                     self._refuse(min(waiting, key=lambda k: (k.proven, k.opened)), P.RefuseCode.BAD_REQUEST,
                                  "no such player yet")
             return False
-        try:
-            ip = link.sock.getpeername()[0]
-        except OSError:
-            self._drop_link(link, "closed")
-            return False
+        ip = link.addr[0]
         mine = self.links.get(n)
         if mine is not None and mine.initiated and n > self.number and ip == e.ip:
             # both opened a link at once: the one opened by the higher number stays
@@ -136,8 +117,8 @@ class JoiningMixin:
         self.pending.remove(link)
         if self.password:
             link.udp_key = datagram_key(self.password, m.body.mac)
-        self.window.anchor(n, m.seq, self.clock())
-        self._bind_link(link, n, registered=True)
+        self.window.anchor(n, m.seq, self.now)
+        self._bind_link(link, n)
         return True
 
     def _admit(self, link: Link, m: P.Message) -> None:
@@ -156,19 +137,15 @@ class JoiningMixin:
             room = "" if self.slots >= P.MAX_PLAYERS else f" (the arena holds {self.slots} tanks at once)"
             self._refuse(link, P.RefuseCode.FULL, f"session full: {self.slots} players already{room}")
             return
-        try:
-            ip = link.sock.getpeername()[0]
-        except OSError:
-            self._drop_link(link, "closed")
-            return
+        ip = link.addr[0]
         n, epoch = slot
         self.table[n] = P.Entry(n, epoch, ip, join.tcp_port, join.udp_port, join.name)
         self._saw(self.table[n])
         self.pending.remove(link)
         if self.password:
             link.udp_key = datagram_key(self.password, join.mac)
-        self.window.anchor(n, m.seq, self.clock())
-        self._bind_link(link, n, registered=True)
+        self.window.anchor(n, m.seq, self.now)
+        self._bind_link(link, n)
         table = self._table()
         t = self.session_time()
         self._queue(link, self._pack(P.Assign(n, t, table, self.term), P.MessageType.NUMBER))
@@ -183,7 +160,7 @@ class JoiningMixin:
         self._queue(link, self._pack_control(P.Refuse(code, text)))
         link.closing = True
         link.hello = None
-        self._flush(link)
+        self._close_link(link, "refused")
 
     def _saw(self, e: P.Entry) -> None:
         """Note an entry's epoch and number as used (never given again)."""
@@ -208,8 +185,9 @@ class JoiningMixin:
             n = order[0] if order else free[0]
         return n, self.max_epoch + 1
 
-    def add_bot(self, name: str) -> int | None:
+    def add_bot(self, name: str, now: float) -> int | None:
         """The host adds a computer opponent (it runs it): its number, or None when full."""
+        self.now = now
         if not self.is_host:
             raise NetError("only the host adds computer opponents")
         slot = self._new_slot()
@@ -229,31 +207,19 @@ class JoiningMixin:
             if not link.outgoing:
                 self._queue(link, news)
         self.events.append(NetEvent("joined", n, self.table[n]))
-        self._reap()
         return n
 
-    def kick(self, n: int, reason: str) -> None:
+    def kick(self, n: int, reason: str, now: float) -> None:
         """The host disconnects player ``n``: a refusal saying why, then it leaves
         every table (TABLE), and its (number, epoch) is never let back in."""
+        self.now = now
         if not self.is_host or n == self.number or n not in self.table:
             return
-        link = self.links.pop(n, None)
+        link = self.links.get(n)
         if link is not None:
             self._queue(link, self._pack(P.Refuse(P.RefuseCode.BAD_REQUEST, reason)))
-            self._flush(link)
-            try:
-                self.sel.unregister(link.sock)
-            except (KeyError, ValueError):
-                pass
-            # half-close and hold the socket a moment: closing it with the peer's unread
-            # messages in our buffer would reset the connection and lose the refusal
-            try:
-                link.sock.shutdown(socket.SHUT_WR)
-            except OSError:
-                pass
-            self._linger.append((link.sock, self.clock() + 1.0))
+            self._close_link(link, "kicked", linger=1.0)
         self._remove(n, "disconnected: " + reason)
-        self._reap()
 
     def _table(self) -> P.Table:
         return P.Table(self.host_number, tuple(self.table[n] for n in sorted(self.table)))
@@ -276,7 +242,7 @@ class JoiningMixin:
                     self._remove(e.number, "replaced")
                 self.table[e.number] = e
                 self._saw(e)
-                self.last_heard[e.number] = self.clock()
+                self.last_heard[e.number] = self.now
                 self.events.append(NetEvent("joined", e.number, e))
         for link in list(self.pending):
             if link.hello is not None:

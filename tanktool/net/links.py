@@ -1,20 +1,21 @@
-"""Links and events of a peer: the TCP connection record, what a poll reports, the
-address helpers, and the plumbing of bound links (queueing, flushing, failing, closing,
-reading, and handling what a bound link says).  Part of :class:`~tanktool.net.peer.Peer`."""
+"""Links, events and actions of the protocol core (:mod:`.core`), and the plumbing of
+links: queueing, closing, reading what a link says and dispatching it.  No socket: a
+link is a number the transport (:mod:`.peer`, or a simulated network) maps to its
+connection; sending and closing are *actions* the transport performs.  Part of
+:class:`~tanktool.net.core.Core`."""
 
 from __future__ import annotations
 
 import math
-import selectors
-import socket
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 from ..errors import NetError
+from . import limits as L     # read at call time: tests patch the limits
 from . import protocol as P
 from .auth import datagram_key, hello_mac
 from .guard import Bucket
-from .limits import MAX_OUTBUF
+
 
 def parse_address(text: str, default_host: str = "127.0.0.1", need_host: bool = False) -> tuple[str, int]:
     """``[ADDR:]PORT`` -> (dotted IPv4, port); NetError (one line) if malformed."""
@@ -33,42 +34,50 @@ def parse_address(text: str, default_host: str = "127.0.0.1", need_host: bool = 
         raise NetError(f"{text!r}: the port must be a number from 0 to 65535") from None
     if not 0 <= port <= 65535 or (need_host and port == 0):
         raise NetError(f"{text!r}: the port must be a number from {1 if need_host else 0} to 65535")
-    try:
-        socket.inet_aton(host)
-        if host.count(".") != 3:
-            raise OSError
-    except OSError:
-        raise NetError(f"{text!r}: {host!r} is not an IPv4 address (e.g. 127.0.0.1)") from None
+    parts = host.split(".")
+    if len(parts) != 4 or not all(p.isdigit() and int(p) <= 255 for p in parts):
+        raise NetError(f"{text!r}: {host!r} is not an IPv4 address (e.g. 127.0.0.1)")
     return host, port
 
 
-def free_port(ip: str = "127.0.0.1") -> int:
-    """A port number free on ``ip`` for both TCP and UDP, as a host needs (for scripts
-    and tests that start a host in another process; another program may still take it)."""
-    for _ in range(50):
-        t, u = socket.socket(), socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        try:
-            t.bind((ip, 0))
-            port = t.getsockname()[1]
-            u.bind((ip, port))
-            return port
-        except OSError:
-            continue
-        finally:
-            t.close()
-            u.close()
-    raise NetError(f"no port free for both TCP and UDP on {ip}")
+# ---------------------------------------------------------------- actions (core -> transport)
+class Send(NamedTuple):
+    """Write ``data`` (whole messages) on link ``link``."""
+    link: int
+    data: bytes
 
 
-class _Busy(NetError):
-    """The host said "too many joins": ``Peer.join`` waits a little and asks again."""
+class SendTo(NamedTuple):
+    """Send one datagram to ``addr`` (ip, udp port)."""
+    addr: tuple
+    data: bytes
+
+
+class Close(NamedTuple):
+    """Close link ``link`` once what was sent on it is flushed.  ``linger`` > 0: then
+    half-close and keep the connection that long (closing with the other end's unread
+    messages in our buffer would reset it and lose the last message: a kick's reason)."""
+    link: int
+    reason: str = ""
+    linger: float = 0.0
+
+
+class Connect(NamedTuple):
+    """Open a connection to ``addr`` (ip, tcp port) for link ``link``; if it fails,
+    tell the core ``disconnected(link)``."""
+    link: int
+    addr: tuple
+
+
+Action = Send | SendTo | Close | Connect
 
 
 @dataclass
 class Link:
-    """A TCP connection: pending until it says who it is, then bound to one number."""
+    """A connection as the core sees it: pending until it says who it is, then bound to
+    one number."""
 
-    sock: socket.socket
+    id: int
     reader: P.StreamReader
     bucket: Bucket
     opened: float
@@ -77,19 +86,21 @@ class Link:
     number: int = 0                   # bound player number (0 while pending)
     udp_key: bytes | None = None      # with a password: the key of this pair's datagrams
     hello: P.Message | None = None    # a HELLO waiting for the table to know its number
-    out: bytearray = field(default_factory=bytearray)
-    closing: bool = False             # close once ``out`` is flushed (after a refusal)
+    closing: bool = False             # refused: nothing it says counts any more
     outgoing: bool = False            # a mesh link we opened, waiting for its challenge
     initiated: bool = False           # a mesh link we opened (for simultaneous opens)
     refused: bool = False             # the other end refused this link: its closing is no exit
-    failed: bool = False              # a send failed: dropped at the end of the current handler
     proven: bool = False              # it answered the password challenge right (a HELLO waiting)
     probe: bool = False               # we dialled a lost player's address to read its term (terms.py)
+    joining: bool = False             # our own join request's link (handshake.py)
+    join_mac: bytes = b""             # the MAC our JOIN carried (the datagram key derives from it)
+    join_sent: float | None = None    # when our JOIN went out (None: waiting for the challenge)
 
 
 @dataclass(frozen=True)
 class NetEvent:
-    """What a poll saw: ``kind`` is joined, left, host, state, shot or hit."""
+    """What the core saw: ``kind`` is joined, left, host, state, shot, hit, adopt,
+    kicked or stepdown."""
 
     kind: str
     number: int
@@ -107,57 +118,29 @@ def percentile(values: list[float], q: float) -> float:
 
 
 class LinksMixin:
-    """Bound links: queue, flush, fail, close; read and dispatch what they say."""
+    """Links: queue, close, drop; read and dispatch what they say."""
+
+    def _new_link(self, addr: tuple, **kw: Any) -> Link:
+        self._next_link += 1
+        link = Link(self._next_link, P.StreamReader(self.dropped), Bucket(L.TCP_RATE, L.TCP_BURST, self.now),
+                    self.now, addr=addr, **kw)
+        self.conns[link.id] = link
+        return link
 
     def _queue(self, link: Link, data: bytes) -> None:
-        if link.failed:
+        if link.id not in self.conns:
             return
-        link.out += data
         self.counters["sent"] += 1
         self.counters["bytes_sent"] += len(data)
-        self._flush(link)
-
-    def _flush(self, link: Link) -> None:
-        if link.failed:
-            return
-        if link.out:
-            try:
-                n = link.sock.send(link.out)
-                del link.out[:n]
-            except (BlockingIOError, InterruptedError):
-                pass
-            except OSError:
-                self._fail(link, "closed")
-                return
-        if len(link.out) > MAX_OUTBUF:
-            self._fail(link, "too slow")
-            return
-        want = selectors.EVENT_READ | (selectors.EVENT_WRITE if link.out else 0)
-        try:
-            if self.sel.get_key(link.sock).events != want:
-                self.sel.modify(link.sock, want, link)
-        except (KeyError, ValueError):
-            pass
-        if link.closing and not link.out:
-            self._close_link(link)
-
-    def _fail(self, link: Link, reason: str) -> None:
-        """A send on ``link`` failed: it is dropped by :meth:`_reap` once the message
-        being handled is done (dropping it here could take its player out of the
-        table in the middle of admitting another: the KeyError of finding 2)."""
-        if not link.failed:
-            link.failed = True
-            link.out.clear()
-            self._failed.append((link, reason))
-
-    def _reap(self) -> None:
-        while self._failed:
-            link, reason = self._failed.pop(0)
-            self._drop_link(link, reason)
+        self.actions.append(Send(link.id, data))
 
     def _drop_link(self, link: Link, reason: str) -> None:
+        """The connection of ``link`` closed or failed (``reason``)."""
         if link.probe:
             self._end_probe(link)
+            return
+        if link.joining:
+            self._join_failed(link, reason)
             return
         if link.outgoing or link.refused:
             # a mesh link that never opened says nothing about its peer: silence will
@@ -170,57 +153,56 @@ class LinksMixin:
                 self.dropped["garbage_stream"] += 1
             self._close_link(link)
 
-    def _close_link(self, link: Link) -> None:
-        try:
-            self.sel.unregister(link.sock)
-        except (KeyError, ValueError):
-            pass
-        link.sock.close()
+    def _close_link(self, link: Link, reason: str = "", linger: float = 0.0) -> None:
+        if self.conns.pop(link.id, None) is None:
+            return
+        self.actions.append(Close(link.id, reason, linger))
         if link in self.pending:
             self.pending.remove(link)
+        if link in self.probes:
+            self.probes.remove(link)
         if link.number and self.links.get(link.number) is link:
             del self.links[link.number]
 
-    def _bind_link(self, link: Link, number: int, registered: bool = False) -> None:
+    def _bind_link(self, link: Link, number: int) -> None:
         link.number = number
         self.links[number] = link
-        self.last_heard[number] = self.clock()
-        if registered:
-            self._flush(link)
-        else:
-            self.sel.register(link.sock, selectors.EVENT_READ, link)
-            if link.out:
-                self._flush(link)
+        self.last_heard[number] = self.now
 
-    def _read_tcp(self, link: Link) -> None:
-        try:
-            data = link.sock.recv(65536)
-        except (BlockingIOError, InterruptedError):
+    def received(self, link_id: int, data: bytes, now: float) -> None:
+        """Bytes arrived on a link (``b""``: the other end closed it)."""
+        self.now = now
+        link = self.conns.get(link_id)
+        if link is None:
             return
-        except OSError:
-            data = b""
         self.dropped.source = link.addr[0]
         if not data:
             self._drop_link(link, "closed")
             return
         self.counters["bytes_received"] += len(data)
-        msgs = link.reader.feed(data)
-        now = self.clock()
-        for m in msgs:
-            if link.sock.fileno() < 0:
+        for m in link.reader.feed(data):
+            if link.id not in self.conns:
                 return
             if not link.bucket.take(now):
                 self.dropped["rate"] += 1
                 continue
             self._on_tcp(link, m)
-            self._reap()
-        if link.reader.broken:
+        if link.reader.broken and link.id in self.conns:
             self._drop_link(link, "garbage")
 
+    def disconnected(self, link_id: int, reason: str, now: float) -> None:
+        """A link's connection closed or failed (a send, a connect, too slow)."""
+        self.now = now
+        link = self.conns.get(link_id)
+        if link is not None:
+            self._drop_link(link, reason)
+
     def _on_tcp(self, link: Link, m: P.Message) -> None:
-        now = self.clock()
         if link.probe:
             self._on_probe(link, m)
+            return
+        if link.joining:
+            self._on_join_answer(link, m)
             return
         if link.closing:
             return
@@ -236,41 +218,40 @@ class LinksMixin:
             mac = hello_mac(self.password, m.body.nonce, self.number, epoch) if self.password else bytes(P.MAC_SIZE)
             if self.password:
                 link.udp_key = datagram_key(self.password, mac)
-            self.window.anchor(link.number, m.seq, now)
+            self.window.anchor(link.number, m.seq, self.now)
             self._queue(link, self._pack(P.Hello(epoch, mac)))
             return
         if m.sender != link.number:
             self.dropped["impostor"] += 1      # a peer speaks only for its own number
             return
-        self.window.anchor(link.number, m.seq, now)     # the link is authenticated: its numbers are real
+        self.window.anchor(link.number, m.seq, self.now)     # the link is authenticated: its numbers are real
+        self._on_bound(link, m)
+
+    def _on_bound(self, link: Link, m: P.Message) -> None:
+        """What a bound, authenticated link said."""
         if isinstance(m.body, P.Refuse) and link.initiated:
             link.refused = True                # a duplicate link lost the tie-break
             return
         if isinstance(m.body, P.Refuse) and m.sender == self.host_number and not self.is_host:
             # the host disconnected us (a kick): leave, rather than elect ourselves
             self.events.append(NetEvent("kicked", m.sender, reason=m.body.text))
-            self.close(send_exit=False)
+            self.leave(self.now, send_exit=False)
             return
         self.counters["received"] += 1
-        self.last_heard[link.number] = now
+        self.last_heard[link.number] = self.now
         body = m.body
-        if m.type == P.MessageType.NEW_PLAYER:
+        if m.type in (P.MessageType.NEW_PLAYER, P.MessageType.TABLE):
             if m.sender != self.host_number:
                 self.dropped["not_host"] += 1
                 return
             self.term = max(self.term, body.term)
-            self._merge_table(body.table, body.number)
-        elif m.type == P.MessageType.TABLE:
-            if m.sender != self.host_number:
-                self.dropped["not_host"] += 1
-                return
-            self.term = max(self.term, body.term)
-            # the host's table is the reference: who is not in it has left (for
-            # example a player whose EXIT reached only the host)
-            keep = {e.number for e in body.table.entries}
-            for n in list(self.table):
-                if n not in keep and n != self.number:
-                    self._remove(n, "dropped by the host")
+            if m.type == P.MessageType.TABLE:
+                # the host's table is the reference: who is not in it has left (for
+                # example a player whose EXIT reached only the host)
+                keep = {e.number for e in body.table.entries}
+                for n in list(self.table):
+                    if n not in keep and n != self.number:
+                        self._remove(n, "dropped by the host")
             self._merge_table(body.table, body.number)
         elif isinstance(body, P.Shot):
             if not self._may_speak(m.sender, body.tank):
@@ -285,6 +266,7 @@ class LinksMixin:
         elif isinstance(body, P.Exit):
             self._remove(link.number, "exit")
         elif isinstance(body, P.State):
-            self._on_state(m, now)            # allowed on TCP too (e.g. through firewalls)
+            self._on_state(m, self.now)            # allowed on TCP too (e.g. through firewalls)
         else:
             self.dropped["unexpected"] += 1
+

@@ -1,31 +1,15 @@
-"""A peer of a network session (paper §3.3): the player table, joins, the full mesh,
-and host migration.
+"""A peer of a network session on real sockets: the thin transport around the protocol
+core (:mod:`.core`).
 
-The first peer hosts.  A joiner opens TCP to the host and answers its challenge with a
-join request; the host checks room (8 players), assigns the lowest free number and sends
-the joiner its number and the whole table (number, name, address), and every other
-peer the new table.  The joiner then opens a TCP link to every other peer (full mesh),
-so any of them can take over.  TCP carries what must arrive (join, table, shots, hits,
-exits); UDP carries tank states, latest sequence wins.
+:class:`Peer` owns the TCP listener, the UDP socket, the connections and a selector; it
+feeds the core what arrives (with the time of its clock) and performs the core's actions
+(send, send a datagram, close, connect).  Everything the protocol decides — the player
+table, joins, numbers and epochs, terms and host migration, silences, kicks, which
+states are taken — is the core's; the peer's attributes that are not its own (``table``,
+``links``, ``dropped``, ``term`` ...) are read through to the core.
 
-Host migration: a peer whose TCP link closes, or who is silent for ``silence`` seconds
-(3 s), leaves every table on its own.  When the host leaves, the remaining peer with
-the lowest number becomes host; all tables hold the same numbers, so all agree without
-a vote.  The host's only duty is answering joins, so nothing else has to move.
-
-Safety: a number is bound to a TCP link (the host's, or one the joiner opened to the
-address in the host's table, or a HELLO whose number, epoch and IP match the table) and to
-the UDP address in the table; anything a link or address sends for another number is
-dropped and counted.  With a password, every link answers an HMAC-SHA256 challenge and
-every datagram carries a tag made with the key of its link (:mod:`.auth`).  Messages are
-size-checked by the protocol; states must carry sequence numbers within a window; links,
-tanks and joins are rate-limited; unidentified connections are capped per address, and a
-new one pushes out the oldest silent one (:mod:`.guard`).
-
-The class is put together from its parts: :mod:`.handshake` (listening, joining),
-:mod:`.joining` (admitting players, the table), :mod:`.datagrams` (states over UDP),
-:mod:`.links` (bound links), :mod:`.terms` (host terms, stepping down); the limits are in
-:mod:`.limits`.  Here: the peer's state, the poll loop, timeouts, leaving, reports.
+A connection is flushed as the kernel takes it; one whose unsent data passes
+``MAX_OUTBUF`` is too slow and is dropped.
 """
 
 from __future__ import annotations
@@ -33,92 +17,85 @@ from __future__ import annotations
 import selectors
 import socket
 import time
-from collections import Counter, deque
-from dataclasses import replace
+from dataclasses import dataclass, field
 from typing import Any, Callable
 
 from ..errors import NetError
+from . import limits as L
 from . import protocol as P
 from .auth import hello_mac, join_mac  # noqa: F401 (re-exported)
-from .datagrams import DatagramsMixin
-from .guard import Bucket, Buckets, DropLog, JoinLimiter, SeqWindow
-from .handshake import JoinerMixin
-from .joining import JoiningMixin
-from .limits import (  # noqa: F401 - also here for those who tune or patch them (tests do)
+from .core import Core
+from .guard import Bucket  # noqa: F401 (re-exported)
+from .limits import (  # noqa: F401 - re-exported for those who read them
     SILENCE, PENDING_TIMEOUT, HELLO_WAIT, MAX_HELLO_WAITING, MAX_PENDING, MAX_PENDING_PER_IP,
     ACCEPTS_PER_POLL, LISTEN_BACKLOG, TCP_RATE, TCP_BURST, UDP_RATE, UDP_BURST, UDP_READS,
     JOIN_RATE, JOIN_BURST, JOINS_RATE, JOINS_BURST, AUTH_FAIL_RATE, AUTH_FAIL_BURST, JOIN_SETTLE,
     JOIN_BUSY_WAIT, MAX_OUTBUF, LATENCY_SAMPLES,
 )
-from .links import Link, LinksMixin, NetEvent, free_port, parse_address, percentile  # noqa: F401 (re-exported)
-from .names import name_problem, visible
-from .terms import TermsMixin
+from .links import Close, Connect, Link, NetEvent, Send, SendTo, parse_address, percentile  # noqa: F401
 
 __all__ = ["Peer", "NetEvent", "Link", "Bucket", "parse_address", "free_port", "join_mac", "hello_mac",
            "percentile"]
 
 
-class Peer(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
+def free_port(ip: str = "127.0.0.1") -> int:
+    """A port number free on ``ip`` for both TCP and UDP, as a host needs (for scripts
+    and tests that start a host in another process; another program may still take it)."""
+    for _ in range(50):
+        t, u = socket.socket(), socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            t.bind((ip, 0))
+            port = t.getsockname()[1]
+            u.bind((ip, port))
+            return port
+        except OSError:
+            continue
+        finally:
+            t.close()
+            u.close()
+    raise NetError(f"no port free for both TCP and UDP on {ip}")
+
+
+@dataclass
+class _Conn:
+    """A TCP connection of the transport, and the core's link number for it."""
+
+    sock: socket.socket
+    link: int
+    out: bytearray = field(default_factory=bytearray)
+    close_at: float | None = None     # closing: flushed, then closed by this time (monotonic)
+    linger: float = 0.0               # after the flush: half-close and keep this long
+
+
+class Peer:
     """One player's end of a session.  Build with :meth:`host` or :meth:`join`, then
     call :meth:`poll` often (it never blocks longer than its timeout)."""
 
     def __init__(self, name: str, password: str | None = None, clock: Callable[[], float] = time.time,
                  silence: float = SILENCE, digest: bytes = bytes(P.DIGEST_SIZE), label: str = "") -> None:
-        P.name_bytes(name)      # validates the name early, with a clear message
-        if not name.isprintable():      # the protocol refuses such names: say so here
-            raise NetError(f"the name {visible(name)} has characters that are not printable")
-        problem = name_problem(name, [])
-        if problem is not None:
-            raise NetError(problem)
-        if len(digest) != P.DIGEST_SIZE:
-            raise ValueError(f"the match digest must be {P.DIGEST_SIZE} bytes")
-        self.name = name
-        #: the arena + vehicle this peer plays (net/digest.py): a host refuses joiners on others
-        self.digest = bytes(digest)
-        self.label = label                  # what the digest is of, for the refusal text
-        #: the highest epoch ever seen: a new player's epoch is above it, never reused
-        self.max_epoch = 0
-        #: numbers ever given in this session, and the order the free ones were freed
-        self.used_numbers: set[int] = set()
-        self.freed: list[int] = []
-        #: links whose send failed: dropped after the current message is handled, so a
-        #: failure never pulls a player out of the table while a handler is using it
-        self._failed: list[tuple[Link, str]] = []
-        #: sockets of kicked players, half-closed, closed after their deadline
-        self._linger: list[tuple[socket.socket, float]] = []
-        self._init_terms()
-        #: per member address: its datagram budget (rebuilt when the table changes)
-        self.addr_buckets: dict[tuple, Bucket] = {}
-        self.password = password or None
         self.clock = clock
-        self.silence = silence
-        self.number = 0
-        self.table: dict[int, P.Entry] = {}
-        self.host_number = 0
-        self.links: dict[int, Link] = {}            # bound links by number
-        self.pending: list[Link] = []
-        self.departed: set[tuple[int, int]] = set()  # (number, epoch) that left
-        self.last_heard: dict[int, float] = {}
-        self.last_state_seq: dict[tuple[int, int], int] = {}
-        self.window = SeqWindow()                   # sequence numbers a sender's states may carry
-        self.state_buckets = Buckets(UDP_RATE, UDP_BURST)     # per (sender, tank)
-        now = clock()
-        self.joins = JoinLimiter((JOIN_RATE, JOIN_BURST), (JOINS_RATE, JOINS_BURST), now)
-        self.auth_failures = Buckets(AUTH_FAIL_RATE, AUTH_FAIL_BURST)
-        self.counters: Counter = Counter()          # sent, received, bytes_sent, bytes_received
-        self.states_from: Counter = Counter()       # states taken, by sender
-        self.dropped: DropLog = DropLog()           # reason -> count (and where from, for -v)
-        self.latencies: deque[float] = deque(maxlen=LATENCY_SAMPLES)
-        self.host_changes: list[tuple[float, int]] = []
-        self.events: list[NetEvent] = []
-        self.seq = 0
-        self.session_offset = 0.0       # session time = clock() - session_offset
+        self.core = Core(name, password, silence=silence, digest=digest, label=label, now=clock())
         self.sel = selectors.DefaultSelector()
         self.tcp: socket.socket | None = None
         self.udp: socket.socket | None = None
-        self.closed = False
-        self._backlog: list[P.Message] = []
-        self._pruned = now
+        self.conns: dict[int, _Conn] = {}          # by link number
+        self._closing: list[_Conn] = []            # closed by the core, still flushing or lingering
+        self._shut = False                         # sockets closed
+
+    #: the transport's own attributes; every other one is the core's
+    _OWN = frozenset({"clock", "core", "sel", "tcp", "udp", "conns", "_closing", "_shut"})
+
+    def __getattr__(self, name: str) -> Any:
+        # the protocol's state (table, links, pending, dropped, term, ...) is the core's
+        if name == "core":
+            raise AttributeError(name)
+        return getattr(self.core, name)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in self._OWN:
+            object.__setattr__(self, name, value)
+        else:
+            setattr(self.core, name, value)
 
     # ------------------------------------------------------------------ set-up
     @property
@@ -137,11 +114,7 @@ class Peer(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
         peer = cls(name, password, **kw)
         peer._listen(*bind)
         ip, tcp_port = peer.tcp_address
-        peer.number = peer.host_number = 1
-        peer.table = {1: P.Entry(1, 1, ip, tcp_port, peer.udp_address[1], name)}
-        peer.max_epoch = 1
-        peer.used_numbers = {1}
-        peer.session_offset = peer.clock()
+        peer.core.start_host((ip, tcp_port, peer.udp_address[1]), peer.clock())
         return peer
 
     @classmethod
@@ -165,56 +138,146 @@ class Peer(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
             peer.close(send_exit=False)
             raise
 
-    def _pack(self, body: P.Body, kind: P.MessageType | None = None) -> bytes:
-        self.seq += 1
-        return P.encode(body, self.number, self.seq, self.clock(), kind=kind)
+    def _listen(self, ip: str, port: int) -> None:
+        """A TCP listener and a UDP socket on ip (TCP on ``port``, UDP on the same
+        number when free)."""
+        tcp = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        tcp.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        try:
+            tcp.bind((ip, port))
+            tcp.listen(LISTEN_BACKLOG)
+            try:
+                udp.bind((ip, tcp.getsockname()[1]))
+            except OSError:
+                if port:       # the user asked for this port: UDP must have it too
+                    raise
+                udp.bind((ip, 0))
+        except OSError as e:
+            tcp.close()
+            udp.close()
+            what = "in use" if e.errno in (98, 48, 10048) else f"not available ({e.strerror})"
+            raise NetError(f"cannot listen on {ip}:{port}: address {what}") from None
+        tcp.setblocking(False)
+        udp.setblocking(False)
+        udp.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1 << 20)
+        self.tcp, self.udp = tcp, udp
+        self.sel.register(tcp, selectors.EVENT_READ, "accept")
+        self.sel.register(udp, selectors.EVENT_READ, "udp")
 
-    def _pack_control(self, body: P.Body) -> bytes:
-        """A challenge or refusal to a connection not yet bound: it carries the game
-        counter without advancing it, so however many strangers knock, the members'
-        window on this peer's states does not move (finding 3 of issue 27)."""
-        return P.encode(body, self.number, self.seq, self.clock())
+    def _join_loop(self, address: tuple[str, int], timeout: float, port: int, busy_until: float) -> None:
+        """Ask ``address`` to join, following redirects and waiting out "busy"."""
+        redirects = 0
+        while True:
+            outcome = self._join_once(address, timeout, port)
+            if outcome.kind == "busy":
+                if time.monotonic() + JOIN_BUSY_WAIT > busy_until:
+                    raise NetError(outcome.text)
+                time.sleep(JOIN_BUSY_WAIT)
+                continue
+            if outcome.kind == "error":
+                raise NetError(outcome.text)
+            if outcome.kind == "joined":
+                return
+            assert outcome.address is not None
+            redirects += 1       # a member that is not the host names it: follow
+            if redirects >= 3:
+                raise NetError(f"cannot join: redirected too many times (last {outcome.address[0]}:"
+                               f"{outcome.address[1]})")
+            address = outcome.address
 
-    # ------------------------------------------------------------------ queries
-    @property
-    def is_host(self) -> bool:
-        return self.number != 0 and self.number == self.host_number
+    def _join_once(self, address: tuple[str, int], timeout: float, port: int) -> Any:
+        """One join request: dial, listen on the interface that reached the host, and
+        serve everything until the core has the outcome (or the time is up)."""
+        where = f"{address[0]}:{address[1]}"
+        try:
+            sock = socket.create_connection(address, timeout=timeout)
+        except OSError as e:
+            raise NetError(f"cannot reach {where}: {e.strerror or e}") from None
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        if self.tcp is None:
+            try:
+                self._listen(sock.getsockname()[0], port)
+            except BaseException:
+                sock.close()
+                raise
+        sock.setblocking(False)
+        link = self.core.joining(address, self.tcp_address[1], self.udp_address[1], self.clock())
+        self._adopt(sock, link)
+        deadline = time.monotonic() + timeout
+        while self.core.join_outcome is None:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                self.core.disconnected(link, "timeout", self.clock())
+                self._perform()
+                raise NetError(f"{where} did not answer in time")
+            self._service(min(left, 0.05))
+        return self.core.join_outcome
 
+    def _settle(self, seconds: float) -> None:
+        """Poll until every mesh link this joiner opened has had its challenge answered
+        (or failed), for at most ``seconds``; what happened waits for the next poll."""
+        end = time.monotonic() + seconds
+        while any(link.outgoing for link in self.core.links.values()):
+            left = end - time.monotonic()
+            if left <= 0:
+                break
+            self._service(min(left, 0.01))
+
+    def rejoin(self, address: tuple[str, int] | None = None, timeout: float = 5.0) -> None:
+        """Leave what is left of our session (our computer opponents with it) and join
+        the one at ``address`` (default: where a probe found a newer session) as a new
+        member, on the same ports.  Blocks like ``Peer.join``; NetError if it fails."""
+        address = address or self.core.step_down_to
+        if address is None:
+            raise NetError("no session to rejoin")
+        self.core.forget_session(self.clock())
+        self._perform()
+        self._join_loop(address, timeout, 0, time.monotonic() + timeout)
+        self._settle(1.0)
+
+    # ------------------------------------------------------------------ the game's calls
     def session_time(self) -> float:
-        return self.clock() - self.session_offset
+        return self.clock() - self.core.session_offset
 
-    def players(self) -> list[P.Entry]:
-        """Every table entry (players and computer opponents), by number."""
-        return [self.table[n] for n in sorted(self.table)]
+    def send_state(self, state: P.State) -> None:
+        """A state of a tank I run to every other player, by UDP."""
+        if self.udp is None:
+            return
+        self.core.send_state(state, self.clock())
+        self._perform()
 
-    def speaks_for(self) -> list[int]:
-        """The tanks this peer runs: its own and the computer opponents it owns."""
-        return [n for n in sorted(self.table) if n == self.number or self.table[n].owner == self.number]
-
-    def _may_speak(self, sender: int, tank: int) -> bool:
-        e = self.table.get(tank)
-        return tank == sender or (e is not None and e.owner == sender)
-
-    # ------------------------------------------------------------------ sending
     def send_event(self, body: P.Body) -> None:
         """A shot, hit or exit to every linked peer, by TCP."""
-        data = self._pack(body)
-        for link in list(self.links.values()):
-            self._queue(link, data)
-        if not isinstance(body, P.Exit):
-            self._reap()
+        self.core.send_event(body, self.clock())
+        self._perform()
+
+    def add_bot(self, name: str) -> int | None:
+        """The host adds a computer opponent (it runs it): its number, or None when full."""
+        n = self.core.add_bot(name, self.clock())
+        self._perform()
+        return n
+
+    def kick(self, n: int, reason: str) -> None:
+        """The host disconnects player ``n`` with a reason."""
+        self.core.kick(n, reason, self.clock())
+        self._perform()
 
     # ------------------------------------------------------------------ the loop
     def poll(self, timeout: float = 0.0) -> list[NetEvent]:
         """Handle everything that arrived (waiting at most ``timeout`` seconds for the
-        first thing), check silences and pending links; return what happened."""
+        first thing), run the core's timers; return what happened."""
         if self.closed:
             return []
         self._service(timeout)
-        out, self.events = self.events, []
-        return out
+        return self.core.take_events()
+
+    @property
+    def closed(self) -> bool:
+        return self.core.closed
 
     def _service(self, timeout: float) -> None:
+        self._perform()            # what a direct call on the core (tests) left to do
         accept = False
         for key, mask in self.sel.select(max(timeout, 0.0)):
             if key.data == "accept":
@@ -222,124 +285,202 @@ class Peer(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
             elif key.data == "udp":
                 self._read_udp()
             else:
-                link: Link = key.data
-                if link.sock.fileno() < 0:
+                conn: _Conn = key.data
+                if conn.sock.fileno() < 0:
                     continue
                 if mask & selectors.EVENT_WRITE:
-                    self._flush(link)
-                if mask & selectors.EVENT_READ and link.sock.fileno() >= 0 and not link.failed:
-                    self._read_tcp(link)
-                self._reap()
+                    self._flush(conn)
+                if mask & selectors.EVENT_READ and conn.sock.fileno() >= 0 and conn.close_at is None:
+                    self._read_tcp(conn)
+            self._perform()
         # new connections last: one accepted at the previous poll has had its answer read
         # before any newer one can push it out of the pending list
         if accept:
             self._accept()
-            self._reap()
-        self._check_timeouts()
-        self._probe_tick(self.clock())
-        self._reap()
+        self.core.tick(self.clock())
+        self._perform()
+        self._linger_tick()
+        if self.core.closed:          # the core left (kicked): so do the sockets
+            self.close(send_exit=False)
 
-    def _make_room(self, ip: str) -> bool:
-        """Room in the pending list for a connection from ``ip``: over the per-address
-        cap, that address's oldest pending connection goes; over the overall cap, the
-        busiest address's.  Refusals being flushed go first, then silent connections,
-        then HELLOs waiting for the table.  A real player answers its challenge within a
-        round trip; silent connections never do, so they cannot keep it out."""
-        mine = [link for link in self.pending if link.addr[0] == ip]
-        if len(mine) >= MAX_PENDING_PER_IP:
-            victims = mine
-        elif len(self.pending) >= MAX_PENDING:
-            busiest = Counter(link.addr[0] for link in self.pending).most_common(1)[0][0]
-            victims = [link for link in self.pending if link.addr[0] == busiest]
-        else:
-            return True
-        if not victims:
-            return False
-        victim = min(victims, key=lambda link: (not link.closing, link.proven, link.hello is not None, link.opened))
-        self.dropped.source = victim.addr[0]
-        self.dropped["evicted"] += 1
-        self._close_link(victim)
-        return True
+    def _accept(self) -> None:
+        assert self.tcp is not None
+        for _ in range(ACCEPTS_PER_POLL):
+            try:
+                sock, addr = self.tcp.accept()
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                self.core.dropped["accept_failed"] += 1
+                return
+            link = self.core.accepted(addr, self.clock())
+            if link is None:
+                sock.close()
+            else:
+                sock.setblocking(False)
+                sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+                self._adopt(sock, link)
+            self._perform()
+
+    def _adopt(self, sock: socket.socket, link: int) -> None:
+        conn = self.conns[link] = _Conn(sock, link)
+        self.sel.register(sock, selectors.EVENT_READ, conn)
+
+    def _read_tcp(self, conn: _Conn) -> None:
+        try:
+            data = conn.sock.recv(65536)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            data = b""
+        self.core.received(conn.link, data, self.clock())
+
+    def _read_udp(self) -> None:
+        assert self.udp is not None
+        datagram = self.core.datagram
+        for _ in range(UDP_READS):    # bounded: a flood cannot starve the game loop
+            try:
+                data, addr = self.udp.recvfrom(2048)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                self.core.dropped["udp_error"] += 1
+                return
+            datagram(addr, data, self.clock())
+
+    # ------------------------------------------------------------------ performing actions
+    def _perform(self) -> None:
+        """Do what the core asked, in order; what fails is told back to the core (after
+        the handler that asked is done: a failure never pulls a player out of the table
+        while the core is using it, the KeyError of finding 2)."""
+        while True:
+            actions = self.core.take_actions()
+            if not actions:
+                return
+            for a in actions:
+                if isinstance(a, SendTo):
+                    self._sendto(a)
+                elif isinstance(a, Send):
+                    conn = self.conns.get(a.link)
+                    if conn is not None and conn.close_at is None:
+                        conn.out += a.data
+                        self._flush(conn)
+                elif isinstance(a, Close):
+                    self._close(a)
+                elif isinstance(a, Connect):
+                    self._connect(a)
+
+    def _sendto(self, a: SendTo) -> None:
+        assert self.udp is not None
+        try:
+            self.udp.sendto(a.data, a.addr)
+        except OSError:
+            self.core.unsent(a.data)
+
+    def _connect(self, a: Connect) -> None:
+        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock.setblocking(False)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        err = sock.connect_ex(a.addr)
+        if err not in (0, 115, 36, 11, 35, 10035):      # EINPROGRESS / EWOULDBLOCK (Linux, BSD, Windows)
+            sock.close()
+            self.core.disconnected(a.link, "connect failed", self.clock())
+            return
+        self._adopt(sock, a.link)
+
+    def _flush(self, conn: _Conn) -> None:
+        if conn.out:
+            try:
+                n = conn.sock.send(conn.out)
+                del conn.out[:n]
+            except (BlockingIOError, InterruptedError):
+                pass
+            except OSError:
+                self._gone(conn, "closed")
+                return
+        if len(conn.out) > MAX_OUTBUF:
+            self._gone(conn, "too slow")
+            return
+        want = selectors.EVENT_READ | (selectors.EVENT_WRITE if conn.out else 0)
+        try:
+            if self.sel.get_key(conn.sock).events != want:
+                self.sel.modify(conn.sock, want, conn)
+        except (KeyError, ValueError):
+            pass
+        if conn.close_at is not None and not conn.out:
+            self._finish(conn)
+
+    def _gone(self, conn: _Conn, reason: str) -> None:
+        """A connection failed: closed here, and the core told."""
+        conn.out.clear()
+        self._release(conn)
+        if self.conns.pop(conn.link, None) is not None:
+            self.core.disconnected(conn.link, reason, self.clock())
+
+    def _close(self, a: Close) -> None:
+        """The core closed a link: flush what it sent, then close (or half-close and
+        linger)."""
+        conn = self.conns.pop(a.link, None)
+        if conn is None:
+            return
+        conn.close_at = time.monotonic() + max(a.linger, 1.0)
+        conn.linger = a.linger
+        self._closing.append(conn)
+        self._flush(conn)
+
+    def _finish(self, conn: _Conn) -> None:
+        """A closing connection is flushed: close it, or half-close it and let it linger."""
+        if conn.linger > 0:
+            try:
+                self.sel.unregister(conn.sock)
+            except (KeyError, ValueError):
+                pass
+            try:
+                conn.sock.shutdown(socket.SHUT_WR)
+            except OSError:
+                pass
+            conn.close_at = time.monotonic() + conn.linger
+            conn.linger = 0.0
+            return
+        self._release(conn)
+
+    def _release(self, conn: _Conn) -> None:
+        try:
+            self.sel.unregister(conn.sock)
+        except (KeyError, ValueError):
+            pass
+        conn.sock.close()
+        if conn in self._closing:
+            self._closing.remove(conn)
+
+    def _linger_tick(self) -> None:
+        now = time.monotonic()
+        for conn in list(self._closing):
+            if conn.close_at is not None and conn.close_at <= now:
+                self._release(conn)
 
     # ------------------------------------------------------------------ leaving
-    def _check_timeouts(self) -> None:
-        now = self.clock()
-        while self._linger and (self._linger[0][1] <= now or self.closed):
-            self._linger.pop(0)[0].close()
-        for link in list(self.pending):
-            if now - link.opened > (HELLO_WAIT if link.hello is not None else PENDING_TIMEOUT):
-                self.dropped.source = link.addr[0]
-                self.dropped["pending_timeout"] += 1
-                self._close_link(link)
-        if now - self._pruned > 1.0:          # forget the buckets of addresses gone quiet
-            self._pruned = now
-            for buckets in (self.joins.addresses, self.auth_failures, self.state_buckets):
-                buckets.prune(now)
-        for n in list(self.table):
-            if n in self.table and n != self.number and not self.table[n].is_bot \
-                    and now - self.last_heard.get(n, now) > self.silence:
-                self._remove(n, "silent")
-
-    def _remove(self, n: int, reason: str) -> None:
-        """Player ``n`` left (exit, closed link, silence): out of the table; if it was
-        the host, the lowest remaining number hosts."""
-        e = self.table.pop(n, None)
-        self.addr_buckets.clear()
-        link = self.links.get(n)
-        if link is not None:
-            self._close_link(link)
-        self.last_heard.pop(n, None)
-        for key in [k for k in self.last_state_seq if n in k]:
-            del self.last_state_seq[key]
-        for key in [k for k in self.state_buckets.buckets if n in k]:
-            self.state_buckets.forget(key)
-        self.window.forget(n)
-        if e is None:
-            return
-        self.departed.add((n, e.epoch))
-        self.freed.append(n)
-        self.events.append(NetEvent("left", n, e, reason))
-        players = [k for k, x in self.table.items() if not x.is_bot]
-        if n == self.host_number and players:
-            self.host_number = min(players)
-            self.term += 1                    # every peer sees the same departures: same term
-            self.host_changes.append((self.session_time(), self.host_number))
-            self.events.append(NetEvent("host", self.host_number))
-        # its computer opponents go on, run by the host (the new one if it was the host)
-        for k, x in list(self.table.items()):
-            if x.owner == n:
-                self.table[k] = replace(x, owner=self.host_number)
-                if self.host_number == self.number:
-                    self.events.append(NetEvent("adopt", k, self.table[k]))
-        if self.is_host and self.links and not self.closed:
-            table = self._pack(P.Assign(self.number, self.session_time(), self._table(), self.term),
-                               P.MessageType.TABLE)
-            for link in list(self.links.values()):
-                if not link.outgoing:
-                    self._queue(link, table)
-        self._lost_player(e, reason)
-
     def close(self, send_exit: bool = True) -> None:
         """Leave: tell everyone (TCP), close every socket."""
-        if self.closed:
+        if self._shut:
             return
-        if send_exit and self.links:
-            self.send_event(P.Exit())
-            for link in list(self.links.values()):
-                if link.out:
-                    try:
-                        link.sock.setblocking(True)
-                        link.sock.settimeout(0.5)
-                        link.sock.sendall(link.out)
-                    except OSError:
-                        pass
-        for link in list(self.links.values()) + list(self.pending):
-            self._close_link(link)
-        for sock, _ in self._linger:
-            sock.close()
-        self._linger.clear()
-        for link in list(self.probes):
-            self._end_probe(link)
+        self._shut = True
+        self.core.leave(self.clock(), send_exit)
+        for a in self.core.take_actions():
+            conn = self.conns.get(getattr(a, "link", -1))
+            if isinstance(a, Send) and conn is not None:
+                conn.out += a.data
+        for conn in list(self.conns.values()):
+            if conn.out:       # the goodbyes: up to 0.5 s a link
+                try:
+                    conn.sock.setblocking(True)
+                    conn.sock.settimeout(0.5)
+                    conn.sock.sendall(conn.out)
+                except OSError:
+                    pass
+        for conn in list(self.conns.values()) + list(self._closing):
+            self._release(conn)
+        self.conns.clear()
         for s in (self.tcp, self.udp):
             if s is not None:
                 try:
@@ -348,26 +489,3 @@ class Peer(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
                     pass
                 s.close()
         self.sel.close()
-        self.closed = True
-
-    def reset_stats(self) -> None:
-        """Restart the traffic counters and latency samples (a benchmark's window);
-        drop reasons are kept."""
-        self.counters.clear()
-        self.states_from.clear()
-        self.latencies.clear()
-
-    def network_report(self) -> dict[str, Any]:
-        """Counters for reports: messages sent / received / dropped, bytes, reasons."""
-        return {
-            "sent": self.counters["sent"], "received": self.counters["received"],
-            "dropped": sum(self.dropped.values()),
-            "bytes_sent": self.counters["bytes_sent"], "bytes_received": self.counters["bytes_received"],
-            "state_rounds": self.counters["state_rounds"],
-            "states_sent": self.counters["states_sent"], "states_received": self.counters["states_received"],
-            "states_unkeyed": self.counters["states_unkeyed"],
-            "states_received_by_sender": {str(k): v for k, v in sorted(self.states_from.items())},
-            "dropped_reasons": dict(sorted(self.dropped.items())),
-        }
-
-

@@ -14,21 +14,16 @@ computer opponents are dropped (the new host adopted them: no duplicates), joine
 are redirected to that session, and :meth:`TermsMixin.rejoin` joins it as a member
 (a new number).  Until its first round of probes has been answered, it refuses joins
 with "try again" so that a joiner dialling a stale host's address is not taken into a
-split session.
+split session.  No I/O: part of :class:`~tanktool.net.core.Core` (a probe is a
+``Connect`` action; the answer comes back as any link's bytes).
 """
 
 from __future__ import annotations
 
-import errno
-import socket
-import time
 from typing import Any
 
-from ..errors import NetError
 from . import protocol as P
-from .guard import Bucket
-from .limits import TCP_BURST, TCP_RATE
-from .links import Link, NetEvent
+from .links import Connect, Link, NetEvent
 
 #: how long after losing everyone a peer probes their addresses, and how often [s]
 PROBE_TIME = 6.0
@@ -40,7 +35,7 @@ CLEAN = ("exit", "dropped by the host", "replaced")
 
 
 class TermsMixin:
-    """Terms, probes and stepping down, for :class:`~tanktool.net.peer.Peer`."""
+    """Terms, probes and stepping down, for :class:`~tanktool.net.core.Core`."""
 
     term: int
     lost: dict[tuple[str, int], float]
@@ -66,7 +61,7 @@ class TermsMixin:
         """Called when player ``e`` left: if that left us alone and not by goodbyes, probe."""
         if reason in CLEAN or reason.startswith("disconnected") or e.is_bot:
             return
-        now = self.clock()                                         # type: ignore[attr-defined]
+        now = self.now                                             # type: ignore[attr-defined]
         self.lost[(e.ip, e.tcp_port)] = now
         if not self._others() and not self.closed:                 # type: ignore[attr-defined]
             self.probe_until = now + PROBE_TIME
@@ -75,7 +70,7 @@ class TermsMixin:
 
     def probing(self) -> bool:
         """Whether joins wait: the first round of probes is not over yet."""
-        return self.first_round and (bool(self.probes) or self.next_probe <= self.clock())  # type: ignore[attr-defined]
+        return self.first_round and (bool(self.probes) or self.next_probe <= self.now)  # type: ignore[attr-defined]
 
     def _probe_tick(self, now: float) -> None:
         for link in list(self.probes):
@@ -96,27 +91,13 @@ class TermsMixin:
             self.first_round = False
 
     def _dial_probe(self, addr: tuple[str, int], now: float) -> None:
-        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-        sock.setblocking(False)
-        err = sock.connect_ex(addr)
-        if err not in (0, errno.EINPROGRESS, errno.EWOULDBLOCK):
-            sock.close()
-            return
-        reader = P.StreamReader(self.dropped)                       # type: ignore[attr-defined]
-        link = Link(sock, reader, Bucket(TCP_RATE, TCP_BURST, now), now, addr=addr)
-        link.probe = True
+        link = self._new_link(addr, probe=True)                    # type: ignore[attr-defined]
         self.probes.append(link)
-        self.sel.register(sock, 1, link)                            # type: ignore[attr-defined]
+        self.actions.append(Connect(link.id, addr))                # type: ignore[attr-defined]
 
     def _end_probe(self, link: Any) -> None:
-        if link in self.probes:
-            self.probes.remove(link)
-        try:
-            self.sel.unregister(link.sock)                          # type: ignore[attr-defined]
-        except (KeyError, ValueError):
-            pass
-        link.sock.close()
-        if not self.probes and self.next_probe > self.clock():      # type: ignore[attr-defined]
+        self._close_link(link, "probe over")                       # type: ignore[attr-defined]
+        if not self.probes and self.next_probe > self.now:         # type: ignore[attr-defined]
             self.first_round = False
 
     def _on_probe(self, link: Any, m: P.Message) -> None:
@@ -134,18 +115,12 @@ class TermsMixin:
                                         f"term {body.term} with {body.players} players at "
                                         f"{link.addr[0]}:{link.addr[1]}"))
 
-    def rejoin(self, address: tuple[str, int] | None = None, timeout: float = 5.0) -> None:
-        """Leave what is left of our session (our computer opponents with it) and join
-        the one at ``address`` (default: where a probe found a newer session) as a new
-        member, on the same ports.  Blocks like ``Peer.join``; NetError if it fails."""
-        address = address or self.step_down_to
-        if address is None:
-            raise NetError("no session to rejoin")
-        for link in list(self.links.values()) + list(self.pending) + list(self.probes):  # type: ignore[attr-defined]
-            if link in self.probes:
-                self._end_probe(link)
-            else:
-                self._close_link(link)                                 # type: ignore[attr-defined]
+    def forget_session(self, now: float) -> None:
+        """Leave what is left of our session (our computer opponents with it) before
+        joining another as a new member (:meth:`~tanktool.net.peer.Peer.rejoin`)."""
+        self.now = now                                                # type: ignore[attr-defined]
+        for link in list(self.conns.values()):                        # type: ignore[attr-defined]
+            self._close_link(link, "rejoining")                       # type: ignore[attr-defined]
         self.table.clear()                                            # type: ignore[attr-defined]
         self.links.clear()                                            # type: ignore[attr-defined]
         self.last_heard.clear()                                       # type: ignore[attr-defined]
@@ -157,5 +132,3 @@ class TermsMixin:
         self.first_round = False
         self.step_down_to = None
         self.used_numbers, self.freed, self.max_epoch = set(), [], 0   # type: ignore[attr-defined]
-        self._join_loop(address, timeout, 0, time.monotonic() + timeout)   # type: ignore[attr-defined]
-        self._settle(1.0)                                              # type: ignore[attr-defined]
