@@ -92,7 +92,8 @@ def _source_ok(folder: Path, doc: dict[str, Any]) -> bool:
 
 def rebuild_grid(folder: Path, doc: dict[str, Any]) -> None:
     """The navigation files again, with the manifest's settings, swapped in atomically."""
-    from .formats.bundle import atomic_write_text, bundle_update, dumps_toml
+    from .formats.bundle import atomic_write_text, dumps_toml
+    from .formats.bundle_swap import bundle_update
     from .grid_files import build_grid, open_target, render_picture, stage_grid_files
 
     nav = doc.get("navgrid") if isinstance(doc.get("navgrid"), dict) else {}

@@ -104,7 +104,8 @@ def import_arena(
     place at the end, so a failure leaves nothing behind.
     """
     from .fleet import bundled_fleet
-    from .formats.bundle import staged_dir, write_toml
+    from .formats.bundle import write_toml
+    from .formats.bundle_swap import staged_dir
     from .formats.models import default_up, detect_format, load_scene
 
     t0 = time.perf_counter()
@@ -152,7 +153,7 @@ def import_arena(
 def _check_options(model: Path, out: str | os.PathLike | None, name: str | None, force: bool, height: float,
                    tolerance: float) -> tuple[str, Path]:
     """The arena's name and folder, checked with the cut's numbers before any work."""
-    from .formats.bundle import check_replaceable
+    from .formats.bundle_swap import check_replaceable
 
     if name is None:  # from the file stem, made a safe folder name ("my arena" -> "my_arena")
         name = re.sub(r"[^A-Za-z0-9._-]+", "_", model.stem).strip("._-") or "arena"

@@ -1,7 +1,8 @@
 import pytest
 
 from tanktool.errors import FormatError, OutputError
-from tanktool.formats.bundle import atomic_write_text, read_toml, sha256_file, staged_dir, write_toml
+from tanktool.formats.bundle import atomic_write_text, read_toml, sha256_file, write_toml
+from tanktool.formats.bundle_swap import staged_dir
 
 
 def test_toml_round_trip(tmp_path):

@@ -26,8 +26,9 @@ from tanktool.arena import load_arena
 from tanktool.cli.main import cli
 from tanktool.errors import ArenaError, OutputError, VehicleError
 from tanktool.formats import bundle as B
-from tanktool.formats.bundle import (bundle_update, check_replaceable, clean_stale, read_toml, sha256_file,
-                                     staged_dir)
+from tanktool.formats import bundle_swap
+from tanktool.formats.bundle import clean_stale, read_toml, sha256_file
+from tanktool.formats.bundle_swap import bundle_update, check_replaceable, staged_dir
 from tanktool.formats.vehicle_bundle import load_vehicle
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -186,7 +187,7 @@ def test_a_bundle_moved_aside_by_a_killed_swap_is_put_back(tmp_path):
 
 
 def test_replacing_without_rename_exchange(tmp_path, monkeypatch):
-    monkeypatch.setattr(B, "_exchange", lambda a, b: False)
+    monkeypatch.setattr(bundle_swap, "_exchange", lambda a, b: False)
     model = box_obj(tmp_path / "box.obj")
     out = tmp_path / "b"
     for height in ("1", "1.2"):
@@ -260,7 +261,7 @@ def bundle_is_whole(out: Path) -> list[str]:
     wrong = [f"{name}: sha256 differs" for name, digest in doc["derived"].items()
              if not (out / name).is_file() or sha256_file(out / name) != digest]
     wrong += [f"{n}: not in the manifest" for n in os.listdir(out)
-              if n not in B.bundle_files(out, doc, "arena.toml")]
+              if n not in bundle_swap.bundle_files(out, doc, "arena.toml")]
     return wrong
 
 

@@ -159,7 +159,7 @@ def _write_files(target: Any, built: Any, picture: bytes, table: str | None, tab
     else:
         # the grid files and the manifest that hashes them change together, in one
         # atomic swap of the bundle folder (formats/bundle.py bundle_update)
-        from ..formats.bundle import bundle_update
+        from ..formats.bundle_swap import bundle_update
 
         in_bundle = plot_path.resolve().parent == target.out_dir.resolve() and plot_path.name == "navgrid.png"
         if not in_bundle:

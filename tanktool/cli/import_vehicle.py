@@ -175,8 +175,8 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
     """
     import trimesh
 
-    from ..formats.bundle import (atomic_write_bytes, atomic_write_text, check_replaceable, dumps_toml,
-                                  sha256_file, staged_dir)
+    from ..formats.bundle import atomic_write_bytes, atomic_write_text, dumps_toml, sha256_file
+    from ..formats.bundle_swap import check_replaceable, staged_dir
     from ..formats.materials import export_glb
     from ..formats.models import default_up, detect_format, load_scene
     from ..formats.vehicle_bundle import write_hull
