@@ -7,14 +7,14 @@ vehicle frame) with their textures and material colours (game/meshes.py).  A fra
    from the light into a shadow map.  The light is the paper's point light high over
    the middle of the arena; everything lies below it, so one perspective view looking
    down, its frustum fitted to the arena's bounding box, holds every shadow.  The
-   arena's depth is drawn once and copied in each frame; only the tanks are drawn.
+   arena's map is drawn once, the tanks' every frame (game/shadows.py).
 2. **scene**: tanks, then the arena (front to back: the software rasteriser skips what
    is hidden), Phong-lit per pixel by the point light (position, range, attenuation
    1/(a0 + a1 d + a2 d²) as D3DLIGHT8) plus ambient, textured, shadowed, fogged
    towards the horizon (game/shaders.py).  Closed models are drawn with back faces
    culled.
 3. **sky** at the far plane, only where nothing was drawn: gradient, the light's glow,
-   clouds.
+   clouds (game/sky.py, as the effects' pass).
 4. **effects**: particles (game/particles.py: muzzle flashes, fire, smoke, sparks,
    debris, dust) and tracers, blended, never wider on screen than a share of the
    window and faded near the camera.
@@ -41,19 +41,16 @@ from ..errors import TanktoolError
 from . import shaders
 # the matrices and GL helpers live in game/matrices.py (no OpenGL needed there)
 from .matrices import _gl, cloud_pixels, frustum, look_at, perspective, set_uniform, tank_matrix, vertex_format  # noqa: F401
+from .shadows import ShadowMaps, shadow_lookup  # noqa: F401
+from .sky import PARTICLE_MAX_SCREEN, SKY, ZENITH, EffectsPass, Sky  # noqa: F401
 from .meshes import STRIDE, Batch, Model, box_tank_model, load_model
 from .quality import PRESETS, Quality
 from .session import GameSession, pose3d, tank_colour
 
 CAMERAS = ("chase", "first-person", "overview")
-#: the sky at the horizon (and the fog's colour), and overhead
-SKY = (0.66, 0.75, 0.85)
-ZENITH = (0.30, 0.48, 0.78)
 #: how much of a tank's colour is its team tint (the rest is the model's own colours)
 TINT = 0.8
 FOV_Y = math.radians(60.0)
-#: the widest a particle may be on screen, as a share of the window's height
-PARTICLE_MAX_SCREEN = 0.2
 #: a tank smaller than this on screen [px] is drawn without its small parts (wheels...)
 LOD_PIXELS = 70.0
 #: the longest triangle edge of the arena as drawn [m] (a tenth of the arena if larger):
@@ -102,10 +99,7 @@ class Renderer3D:
                                       fragment_shader=shaders.source(shaders.DEPTH_FRAGMENT))
         self.flat_prog = ctx.program(vertex_shader=shaders.source(shaders.FLAT_VERTEX),
                                      fragment_shader=shaders.source(shaders.FLAT_FRAGMENT))
-        self.particle_prog = ctx.program(vertex_shader=shaders.source(shaders.PARTICLE_VERTEX),
-                                         fragment_shader=shaders.source(shaders.PARTICLE_FRAGMENT))
-        self.beam_prog = ctx.program(vertex_shader=shaders.source(shaders.BEAM_VERTEX),
-                                     fragment_shader=shaders.source(shaders.BEAM_FRAGMENT))
+        self.fx_pass = EffectsPass(ctx)
         quad = np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype="f4")
         self._quad = ctx.buffer(quad.tobytes())
         self.hud_vao = ctx.vertex_array(self.hud_prog, [(self._quad, "2f", "in_pos")])
@@ -209,8 +203,6 @@ class Renderer3D:
             self._setup_quality(quality)
 
     def _setup_quality(self, q: Quality) -> None:
-        import moderngl
-
         from .particles import SessionEffects
 
         self.quality = q
@@ -225,122 +217,24 @@ class Renderer3D:
         self.arena_prog = self.prog if per_pixel else scene(False)
         # no triangle so big that the light's attenuation or the fog change across it
         self.arena_shape = self._split_arena()
-        self.sky_prog = ctx.program(vertex_shader=shaders.source(shaders.SKY_VERTEX),
-                                    fragment_shader=shaders.source(shaders.SKY_FRAGMENT, CLOUDS=q.sky == "clouds"))
         self.arena = self._gpu(self.arena_shape, self.arena_prog)
         self.tanks = {name: self._gpu(m, self.prog) for name, m in self.tank_models.items()}
         # far away (and in the shadow map) a tank is drawn without its small parts
         self.tanks_far = {name: self._gpu(m.far, self.prog) if m.far is not None else self.tanks[name]
                           for name, m in self.tank_models.items()}
-        self.cloud_tex = None
-        if q.sky == "clouds":
-            pix = cloud_pixels()
-            self.cloud_tex = ctx.texture(pix.shape[::-1], 1, pix.tobytes())
-            self.cloud_tex.repeat_x = self.cloud_tex.repeat_y = True
-            self.cloud_tex.build_mipmaps()
-            self.cloud_tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-        self.shadow_fbo = None
-        if q.shadow_size:
-            n = q.shadow_size
-            self.light_vp = self._light_matrix()
-            # the arena's shadows once (it never moves), the tanks' every frame at half the size
-            self.static_tex, static_fbo = self._shadow_target(n)
-            self._draw_shadows(static_fbo, n, [(self.arena, [np.identity(4)])])
-            self.tank_shadow_size = max(n // 2, 256)
-            self.shadow_tex, self.shadow_fbo = self._shadow_target(self.tank_shadow_size)
-        self.sky_grid = self._sky_grid()
+        self.sky = Sky(ctx, q.sky == "clouds")
+        # the arena's shadows once (it never moves), the tanks' every frame
+        self.shadows = (ShadowMaps(ctx, self.depth_prog, self.light_pos, self.scene_box, q.shadow_size, self.arena)
+                        if q.shadow_size else None)
         self.effects = SessionEffects(q.particles, seed=int(getattr(self.session.world, "seed", 0)))
-        self._particle_buf = ctx.buffer(reserve=64 * 9 * 4, dynamic=True)
-        self._corners = ctx.buffer(np.array([-1, -1, 1, -1, -1, 1, 1, 1], dtype="f4").tobytes())
-        self._beam_buf = ctx.buffer(reserve=64 * 9 * 4, dynamic=True)
-        self._make_effect_vaos()
-
-    def _make_effect_vaos(self) -> None:
-        self.particle_vao = self.ctx.vertex_array(self.particle_prog, [
-            (self._corners, "2f", "in_corner"),
-            (self._particle_buf, "4f 4f 1f/i", "in_particle", "in_rgba", "in_glow")])
-        self.beam_vao = self.ctx.vertex_array(self.beam_prog, [
-            (self._beam_buf, "3f 2f 4f", "in_pos", "in_across", "in_rgba")])
 
     # ------------------------------------------------------------------ shadows
-    def _light_matrix(self) -> np.ndarray:
-        """The light's view-projection: from the light straight down, the frustum fitted
-        to the arena's bounding box (every corner inside)."""
-        lx, ly, lz = self.light_pos
-        view = look_at(self.light_pos, (lx, ly - 1.0, lz), up=(0.0, 0.0, -1.0))
-        (x0, y0, z0), (x1, y1, z1) = self.scene_box.tolist()
-        corners = np.array([[x, y, z, 1.0] for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)])
-        cam = (view @ corners.T).T[:, :3]
-        depth = -cam[:, 2]                                  # distance below the light
-        near = max(float(depth.min()) * 0.9, 0.1)
-        far = float(depth.max()) * 1.05 + 1.0
-        sx, sy = cam[:, 0] / depth * near, cam[:, 1] / depth * near
-        pad = 1.02
-        proj = frustum(float(sx.min()) * pad, float(sx.max()) * pad, float(sy.min()) * pad, float(sy.max()) * pad,
-                       near, far)
-        return proj @ view
-
-    @staticmethod
-    def shadow_lookup(light_vp: np.ndarray, bias: float = 0.0005) -> np.ndarray:
-        """The light's matrix as the scene shader samples with it: clip space to [0, 1]
-        texture coordinates and depth, the depth nudged towards the light."""
-        b = np.array([[0.5, 0, 0, 0.5], [0, 0.5, 0, 0.5], [0, 0, 0.5, 0.5 - bias], [0, 0, 0, 1.0]])
-        return b @ light_vp
-
-    def _shadow_target(self, n: int) -> tuple[Any, Any]:
-        """A depth texture of n x n sampled with comparison (hardware PCF) and its framebuffer."""
-        import moderngl
-
-        tex = self.ctx.depth_texture((n, n))
-        tex.compare_func = "<="
-        tex.filter = (moderngl.LINEAR, moderngl.LINEAR)
-        tex.repeat_x = tex.repeat_y = False
-        return tex, self.ctx.framebuffer(depth_attachment=tex)
-
-    def _draw_shadows(self, fbo: Any, n: int, groups: list[tuple[list[GpuBatch], list[np.ndarray]]]) -> None:
-        """Depth from the light of each group's batches placed at each of its model matrices."""
-        import moderngl
-
-        ctx = self.ctx
-        fbo.use()
-        ctx.viewport = (0, 0, n, n)
-        ctx.enable(moderngl.DEPTH_TEST)
-        fbo.clear(depth=1.0)
-        ctx.polygon_offset = (1.5, 2.0)
-        for batches, models in groups:
-            for model in models:
-                self.depth_prog["mvp"].write(_gl(self.light_vp @ model))
-                for b in batches:
-                    # closed models cast from their back faces: the lit side never shadows itself
-                    if b.closed:
-                        ctx.enable(moderngl.CULL_FACE)
-                        ctx.cull_face = "front"
-                    else:
-                        ctx.disable(moderngl.CULL_FACE)
-                    b.depth_vao.render()
-        ctx.cull_face = "back"
-        ctx.disable(moderngl.CULL_FACE)
-        ctx.polygon_offset = (0.0, 0.0)
-
     def _shadow_pass(self, alpha: float) -> None:
         """The tanks' shadow map for this frame."""
         by_kind: dict[str, list[np.ndarray]] = {}
         for t in self.session.world.tanks:
             by_kind.setdefault(t.spec.name, []).append(self._tank_model_matrix(t, alpha))
-        self._draw_shadows(self.shadow_fbo, self.tank_shadow_size,
-                           [(self.tanks_far[name], models) for name, models in by_kind.items()])
-
-    def _sky_grid(self, nx: int = 24, ny: int = 16) -> Any:
-        """Rows of quads over the window, bottom row first (drawn from the horizon up)."""
-        self.sky_cols, self.sky_rows = nx, ny
-        xs, ys = np.linspace(-1, 1, nx + 1), np.linspace(-1, 1, ny + 1)
-        quads = []
-        for i in range(ny):
-            for j in range(nx):
-                a, b, c, d = (xs[j], ys[i]), (xs[j + 1], ys[i]), (xs[j + 1], ys[i + 1]), (xs[j], ys[i + 1])
-                quads += [a, b, c, a, c, d]
-        buf = self.ctx.buffer(np.array(quads, dtype="f4").tobytes())
-        return self.ctx.vertex_array(self.sky_prog, [(buf, "2f", "in_pos")])
+        self.shadows.draw_tanks([(self.tanks_far[name], models) for name, models in by_kind.items()])
 
     # ------------------------------------------------------------------ camera
     def toggle_camera(self) -> str:
@@ -412,7 +306,7 @@ class Renderer3D:
         pv = proj @ view
         hud_rects = self._prepare_hud(fps, alpha, message, controls) if hud else []
         self.effects.sync(s, self.floor_y)
-        if self.shadow_fbo is not None:
+        if self.shadows is not None:
             self._shadow_pass(alpha)
         self.fbo.use()
         ctx.viewport = (0, 0, *self.size)
@@ -453,12 +347,8 @@ class Renderer3D:
         # haze: a fifth of the colour gone at twice the arena's size (1 / (1 + k d^2) = 0.8)
         set_uniform(prog, "fog_k", 0.25 / (2.0 * max(self.span, 40.0)) ** 2)
         set_uniform(prog, "tex", 0)
-        if self.shadow_fbo is not None:
-            set_uniform(prog, "light_vp", _gl(self.shadow_lookup(self.light_vp)))
-            set_uniform(prog, "shadow_static", 1)
-            set_uniform(prog, "shadow_tanks", 2)
-            self.static_tex.use(1)
-            self.shadow_tex.use(2)
+        if self.shadows is not None:
+            self.shadows.bind(prog)
 
     def _draw(self, prog: Any, batches: list[GpuBatch], pv: np.ndarray, model: np.ndarray, tint, amount: float,
               emissive=(0.0, 0.0, 0.0)) -> None:
@@ -490,80 +380,14 @@ class Renderer3D:
         return self.tanks[t.spec.name] if tall >= LOD_PIXELS else self.tanks_far[t.spec.name]
 
     def _draw_sky(self, pv: np.ndarray, eye: np.ndarray) -> None:
-        import moderngl
-
-        prog = self.sky_prog
-        prog["inv_view_proj"].write(_gl(np.linalg.inv(pv)))
-        prog["horizon"].value = SKY
-        prog["zenith"].value = ZENITH
         d = np.array(self.light_pos) - np.array([self.centre[0], self.floor_y, self.centre[1]])
-        prog["sun_dir"].value = tuple(float(v) for v in (d / np.linalg.norm(d) * np.array([0.4, 1.0, 0.4])))
-        prog["eye"].value = tuple(float(v) for v in eye)
-        set_uniform(prog, "time", float(self.session.t))
-        if self.cloud_tex is not None:
-            prog["clouds"].value = 0
-            self.cloud_tex.use(0)
-        # the sky is only above the horizon: below it the clear colour (the horizon's,
-        # the fog's) shows where nothing was drawn, and the grid's lower rows are not drawn
-        fwd = -self.view[2, :3]
-        flat = np.array([fwd[0], 0.0, fwd[2]])
-        lowest = 0
-        if np.linalg.norm(flat) > 1e-6:
-            far = eye + flat / np.linalg.norm(flat) * 1e4 + np.array([0.0, -0.02 * 1e4, 0.0])
-            clip = pv @ np.append(far, 1.0)
-            if clip[3] > 0:
-                ndc_y = clip[1] / clip[3]
-                if ndc_y > 1.0:
-                    return                          # looking down: no sky in view
-                lowest = int(np.clip(math.floor((ndc_y + 1.0) / 2.0 * self.sky_rows), 0, self.sky_rows - 1))
-        self.ctx.depth_func = "<="
-        self.ctx.depth_mask = False
-        per_row = 6 * self.sky_cols
-        self.sky_grid.render(moderngl.TRIANGLES, vertices=(self.sky_rows - lowest) * per_row, first=lowest * per_row)
-        self.ctx.depth_mask = True
-        self.ctx.depth_func = "<"
+        self.sky.draw(pv, self.view, eye, d / np.linalg.norm(d) * np.array([0.4, 1.0, 0.4]), self.session.t)
 
     def _draw_effects(self, pv: np.ndarray, eye: np.ndarray, alpha: float) -> None:
-        import moderngl
-
         from .particles import SessionEffects
 
-        parts = self.effects.particles.instances(eye)
-        beams = SessionEffects.tracers(self.session, alpha, eye)
-        if not len(parts) and not len(beams):
-            return
-        ctx = self.ctx
-        ctx.enable(moderngl.BLEND)
-        ctx.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA      # premultiplied alpha
-        ctx.depth_mask = False
-        if len(beams):
-            self._upload(beams, "_beam_buf")
-            self.beam_prog["view_proj"].write(_gl(pv))
-            self.beam_vao.render(moderngl.TRIANGLES, vertices=len(beams))
-        if len(parts):
-            self._upload(parts, "_particle_buf")
-            p = self.particle_prog
-            p["view_proj"].write(_gl(pv))
-            p["cam_right"].value = tuple(float(v) for v in self.view[0, :3])
-            p["cam_up"].value = tuple(float(v) for v in self.view[1, :3])
-            p["eye"].value = tuple(float(v) for v in eye)
-            p["max_screen"].value = PARTICLE_MAX_SCREEN
-            p["tan_half_fov"].value = math.tan(FOV_Y / 2)
-            self.particle_vao.render(moderngl.TRIANGLE_STRIP, vertices=4, instances=len(parts))
-        ctx.depth_mask = True
-        ctx.disable(moderngl.BLEND)
-
-    def _upload(self, rows: np.ndarray, name: str) -> None:
-        """Write rows into a dynamic buffer, growing it (and its vertex arrays) when needed."""
-        data = np.ascontiguousarray(rows, dtype="f4").tobytes()
-        buf = getattr(self, name)
-        if len(data) > buf.size:
-            grown = max(len(data), 2 * buf.size)
-            buf.release()
-            setattr(self, name, self.ctx.buffer(reserve=grown, dynamic=True))
-            self._make_effect_vaos()
-            buf = getattr(self, name)
-        buf.write(data)
+        self.fx_pass.draw(self.effects.particles.instances(eye), SessionEffects.tracers(self.session, alpha, eye),
+                          pv, self.view, eye, FOV_Y)
 
     def _prepare_hud(self, fps: float, alpha: float, message: str | None,
                      controls: list[tuple[str, str]] | None = None) -> list[Any]:
