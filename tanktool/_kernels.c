@@ -1,6 +1,7 @@
 /* tanktool._kernels: the walkable-surface loops numpy cannot make fast, in C.
  *
- * Two files (the rasteriser in _kernels_raster.c, shared definitions in _kernels.h).
+ * Three files (the rasteriser in _kernels_raster.c, the grid's loops in _kernels_grid.c,
+ * shared definitions in _kernels.h).
  * Optional: setup.py builds it when a C compiler is there; tanktool/nav/kernels.py
  * falls back to numpy otherwise, with identical results (tests/test_kernels.py
  * compares the two).  No numpy headers: arrays come in through the buffer protocol
@@ -22,6 +23,7 @@
  *       link: int64 (n, 4); label: int64 (n,) written: the smallest span of each component
  *   merge_spans(key, thr, col, smin, smax, walk, flat, top_walk) -> count
  *       key: sorted int64 packed pieces; outputs int64 / bool arrays as long as key
+ *   grid_reach(valid, link, L, nz, nx, seeds, out)   (_kernels_grid.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -355,6 +357,7 @@ static PyMethodDef methods[] = {
     {"filters", filters, METH_VARARGS, "Recast's three span filters, as span_filters.filter_masks"},
     {"components", components, METH_VARARGS, "component labels (smallest span index), in place"},
     {"merge_spans", merge_spans, METH_VARARGS, "the merged spans of sorted packed keys"},
+    {"grid_reach", tanktool_grid_reach, METH_VARARGS, "the grid's nodes linked to seeds (_kernels_grid.c)"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -362,7 +365,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 1
+#define TANKTOOL_KERNELS_ABI 2
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

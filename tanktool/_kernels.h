@@ -25,4 +25,7 @@ static inline i64 max64(i64 a, i64 b) { return a > b ? a : b; }
 /* the rasteriser (_kernels_raster.c) */
 PyObject *tanktool_raster(PyObject *self, PyObject *args);
 
+/* the grid (_kernels_grid.c) */
+PyObject *tanktool_grid_reach(PyObject *self, PyObject *args);
+
 #endif

@@ -121,3 +121,26 @@ def test_a_random_triangle_soup_cropped_by_the_grid_rasterises_the_same(seed):
         assert len(a.col) > 1000 and a.counts == b.counts
         for key in ("col", "smin", "smax", "walkable", "flat", "top_walkable"):
             assert np.array_equal(getattr(a, key), getattr(b, key)), key
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(6))
+def test_random_layered_grids_reach_the_same_nodes(seed):
+    """navgrid.layered_reachable: the grid's union-find (grid_reach) and numpy + scipy's
+    components keep the same nodes, links to invalid nodes, off the grid and to other
+    levels included."""
+    from tanktool.nav.navgrid import layered_reachable
+
+    rng = np.random.default_rng(seed)
+    L, nz, nx = int(rng.integers(1, 4)), int(rng.integers(1, 30)), int(rng.integers(1, 40))
+    valid = rng.random((L, nz, nx)) < 0.7
+    link = rng.integers(-1, L, size=(L, nz, nx, 4)).astype(np.int8)
+    link[rng.random(link.shape) < 0.3] = -1
+    nodes = np.argwhere(valid)
+    seeds = [tuple(int(v) for v in nodes[k]) for k in rng.choice(len(nodes), size=min(3, len(nodes)), replace=False)]
+    with use_kernels(True):
+        a = layered_reachable(valid, link, seeds)
+    with use_kernels(False):
+        b = layered_reachable(valid, link, seeds)
+    assert a.dtype == b.dtype == bool and a.any()
+    np.testing.assert_array_equal(a, b)
