@@ -13,6 +13,20 @@ Nothing here touches a socket or the wall clock::
 message (so messages overtake each other: reordering comes from jitter, or from
 ``reorder`` which adds a further ``jitter`` to that fraction of messages), ``loss`` the
 fraction dropped.  A partition cuts the pairs between two groups for a time span.
+
+:class:`~tanktool.net.simcluster.SimCluster` runs protocol cores (:mod:`.core`) on such a network, as
+:class:`~tanktool.net.peer.Peer` runs one on sockets: datagrams go through a
+:class:`SimNet` (lost, delayed, reordered, cut), connections are reliable and ordered
+(delayed by the same delay and jitter; what is sent across a cut arrives when it heals,
+as TCP retransmits), a process can be paused (SIGSTOP: nothing it receives is read,
+its clock stops) or killed (its connections close).  Everything is driven by one clock
+and one seed::
+
+    net = SimCluster(seed=1, delay=0.1, jitter=0.1, loss=0.05)
+    host = net.host("alice")
+    bob = net.join("bob", host)
+    net.run(5.0)                          # each peer ticks, sends its states at 30 Hz
+    assert sorted(bob.core.table) == [1, 2]
 """
 
 from __future__ import annotations
@@ -88,3 +102,10 @@ class SimNet:
 
     def pending(self) -> int:
         return len(self._flight)
+
+    def heals(self, src: Hashable, dst: Hashable, t: float) -> float | None:
+        """When the cut between ``src`` and ``dst`` at time ``t`` ends (None: not cut)."""
+        ends = [end for start, end, a, b in self._cuts
+                if start <= t < end and ((src in a and dst in b) or (src in b and dst in a))]
+        return max(ends) if ends else None
+

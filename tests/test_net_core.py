@@ -1,0 +1,229 @@
+"""The protocol core (net/core.py) on a simulated network (net/simcluster.py): joins,
+leaves and rejoins, a paused host, floods of joins, wrong passwords and parked HELLOs,
+all deterministic (one seed, one simulated clock, no socket)."""
+
+from __future__ import annotations
+
+import pytest
+
+from tanktool.net import auth
+from tanktool.net import protocol as P
+from tanktool.net.core import Core
+from tanktool.net.links import Connect, Send
+from tanktool.net.simcluster import SimCluster, SimNode
+
+BAD = dict(delay=0.05, jitter=0.05, loss=0.02, reorder=0.02)
+
+
+def live(net: SimCluster) -> list[SimNode]:
+    return [n for n in net.nodes.values() if not n.dead and not n.core.closed and n.core.number]
+
+
+def assert_one_session(net: SimCluster) -> None:
+    """Every live node has the same host, term and table, and a link to every other player."""
+    nodes = live(net)
+    ref = nodes[0].core
+    want = {k: (e.epoch, e.name, e.owner) for k, e in ref.table.items()}
+    for node in nodes:
+        c = node.core
+        assert (c.host_number, c.term) == (ref.host_number, ref.term), (node.name, c.host_number, c.term)
+        assert {k: (e.epoch, e.name, e.owner) for k, e in c.table.items()} == want, (node.name, c.table)
+        players = {k for k, e in c.table.items() if not e.is_bot}
+        assert sorted(c.links) == sorted(players - {c.number}), (node.name, sorted(c.links))
+    assert sorted(n.core.number for n in nodes) == sorted(k for k, e in ref.table.items() if not e.is_bot)
+
+
+def kinds(node: SimNode, kind: str) -> list:
+    return [e for _, e in node.events if e.kind == kind]
+
+
+# ---------------------------------------------------------------- the core by hand
+def test_the_core_by_hand_admits_a_joiner():
+    """The example of docs/network.md: no socket, no clock; bytes and times in, actions out."""
+    host = Core("alice", nonce_source=lambda k: bytes(k))
+    host.start_host(("10.0.0.1", 5000, 5000), now=0.0)
+    joiner = Core("bob")
+    link = host.accepted(("10.0.0.2", 40000), now=0.1)
+    (challenge,) = host.take_actions()
+    assert isinstance(challenge, Send) and challenge.link == link
+    mine = joiner.joining(("10.0.0.1", 5000), 5000, 5000, now=0.1)
+    joiner.received(mine, challenge.data, now=0.15)
+    (join,) = joiner.take_actions()
+    host.received(link, join.data, now=0.2)
+    (number,) = host.take_actions()
+    joiner.received(mine, number.data, now=0.25)
+    assert joiner.join_outcome.kind == "joined" and joiner.number == 2 and sorted(joiner.table) == [1, 2]
+    assert [(e.kind, e.number) for e in host.take_events()] == [("joined", 2)]
+    host.tick(now=3.5)                       # bob said nothing for longer than the silence
+    assert [(e.kind, e.number, e.reason) for e in host.take_events()] == [("left", 2, "silent")]
+
+
+def test_a_member_opens_the_mesh_with_connect_actions():
+    net = SimCluster(seed=1)
+    host = net.host("alice")
+    net.join("bob", host)
+    carol = net.node("carol")
+    net.start_join(carol, host)
+    for _ in range(20):
+        net.run(0.01)
+        if carol.core.number:
+            break
+    assert carol.core.number == 3 and 2 in carol.core.links and carol.core.links[2].initiated
+
+
+# ---------------------------------------------------------------- finding 1
+@pytest.mark.parametrize("seed", [1, 2])
+def test_leave_join_rejoin_keeps_every_table_the_same(seed):
+    net = SimCluster(seed=seed, **BAD)
+    host = net.host("alice")
+    a = net.join("bob", host)
+    b = net.join("carol", host)
+    b_number, b_epoch = b.core.number, b.core.table[b.core.number].epoch
+    net.run(1.0)
+    net.leave(b)
+    net.run(0.5)
+    c = net.join("dave", host, settle=2.0)
+    assert (c.core.number, c.core.table[c.core.number].epoch) != (b_number, b_epoch)
+    assert_one_session(net)
+    before = a.core.states_from[c.core.number]
+    net.run(1.0)
+    assert a.core.states_from[c.core.number] > before + 20          # the newcomer is seen, not just listed
+    again = net.join("carol", host, settle=2.0)                     # the leaver comes back: a new player
+    assert again.core.number not in (0, c.core.number) and again.core.table[again.core.number].epoch > b_epoch
+    net.run(1.0)
+    assert_one_session(net)
+    assert not any(kinds(n, "host") for n in net.nodes.values())
+
+
+def test_a_crashed_member_leaves_every_table_and_its_number_is_not_reused_at_once():
+    net = SimCluster(seed=3, **BAD)
+    host = net.host("alice")
+    a = net.join("bob", host)
+    b = net.join("carol", host)
+    net.run(0.5)
+    net.kill(b)
+    net.run(1.0)
+    assert all(b.core.number not in n.core.table for n in live(net))
+    d = net.join("dave", host, settle=2.0)
+    assert d.core.number == 4
+    assert_one_session(net)
+    assert [e.reason for e in kinds(a, "left")] == ["closed"]
+
+
+# ---------------------------------------------------------------- finding 4
+def test_a_paused_host_steps_down_on_resume_and_its_bots_are_not_duplicated():
+    net = SimCluster(seed=4, **BAD)
+    host = net.host("alice")
+    bots = [host.core.add_bot("bot1", net.now), host.core.add_bot("bot2", net.now)]
+    a = net.join("bob", host)
+    b = net.join("carol", host)
+    net.run(1.0)
+    assert bots == [2, 3] and (a.core.number, b.core.number) == (4, 5)
+    net.pause(host)                                          # SIGSTOP
+    net.run(10.0)
+    assert a.core.is_host and a.core.term == 2 and b.core.host_number == 4
+    assert [(e.number, e.owner) for e in a.core.players() if e.is_bot] == [(2, 4), (3, 4)]
+    net.resume(host)                                         # SIGCONT
+    net.run(4.0)
+    (step,) = kinds(host, "stepdown")
+    assert "term 2" in step.reason
+    assert host.core.number not in (0, 1) and host.core.host_number == 4
+    assert_one_session(net)
+    for node in live(net):
+        assert [(e.number, e.owner) for e in node.core.players() if e.is_bot] == [(2, 4), (3, 4)]
+    # a newcomer dialling the old host's address joins the one session
+    late = net.join("erin", host.address, settle=2.0)
+    assert late.core.host_number == 4 and late.join_error == ""
+    assert_one_session(net)
+
+
+# ---------------------------------------------------------------- findings 2, 3, 5
+def test_a_flood_of_real_joins_with_leavers_does_not_crash_or_split():
+    net = SimCluster(seed=5, **BAD)
+    host = net.host("alice")
+    a = net.join("bob", host)
+    crowd = [net.node(f"p{k}") for k in range(9)]             # more than the session holds
+    for node in crowd:
+        net.start_join(node, host)
+    net.run(0.15)
+    net.leave(a)                                              # leaves while the others are admitted
+    net.run(3.0)
+    assert_one_session(net)
+    assert len(host.core.table) == P.MAX_PLAYERS
+    refused = [n for n in crowd if not n.core.number]
+    assert refused and all("session full" in n.join_error for n in refused)
+
+
+def _guessers(net: SimCluster, host: SimNode, count: int, ip=None) -> list:
+    """``count`` connections (from ``count`` addresses, or all from ``ip``) that answer
+    the challenge with a wrong password, 40 at a time (fewer than the host keeps
+    pending: more would push each other out before answering)."""
+    dials = []
+    for start in range(0, count, 40):
+        batch = [net.dial(ip or f"10.9.{k // 250}.{k % 250 + 1}", host) for k in range(start, min(count, start + 40))]
+        net.run(0.2)
+        for d in batch:
+            (challenge,) = d.messages()
+            mac = auth.join_mac("guess", challenge.body.nonce, "mallory")
+            d.send(P.encode(P.Join("mallory", 6000, 6000, mac, bytes(P.DIGEST_SIZE)), 0, 1, net.now))
+        dials += batch
+    return dials
+
+
+def test_wrong_passwords_from_many_addresses_do_not_split_the_session():
+    net = SimCluster(seed=6, **BAD)
+    host = net.host("alice", "pw")
+    members = [net.join(name, host, "pw") for name in ("bob", "carol")]
+    net.run(0.5)
+    dials = _guessers(net, host, 300)
+    net.run(4.0)                                             # longer than the silence
+    assert host.core.dropped["refused_password"] + host.core.dropped["refused_rate"] == 300
+    assert all(d.closed for d in dials)
+    for m in members:
+        assert m.core.dropped["window"] == 0 and not kinds(m, "host")
+    assert_one_session(net)
+
+
+def test_a_burst_of_connections_does_not_push_the_host_out_of_the_members_window():
+    """600 strangers knock at once: each gets a challenge, which used to advance the
+    counter the host's states carry, past the members' window (slack 256)."""
+    net = SimCluster(seed=9, delay=0.05)
+    host = net.host("alice")
+    member = net.join("bob", host)
+    net.run(0.5)
+    dials = [net.dial(f"10.9.{k // 250}.{k % 250 + 1}", host) for k in range(600)]
+    net.run(4.0)
+    assert sum(1 for d in dials if d.messages()) == 600                  # all were challenged
+    assert member.core.dropped["window"] == 0 and not kinds(member, "host")
+    assert_one_session(net)
+
+
+def test_wrong_passwords_from_a_players_address_do_not_lock_it_out():
+    net = SimCluster(seed=7, **BAD)
+    host = net.host("alice", "pw")
+    real = net.node("bob", "pw")
+    _guessers(net, host, 60, ip=real.ip)                     # over the per-address budget
+    net.run(0.5)
+    assert host.core.dropped["refused_rate"] > 0
+    net.start_join(real, host)
+    net.run(2.0)
+    assert real.core.number == 2 and real.join_error == ""
+    assert_one_session(net)
+
+
+def test_parked_hellos_and_silent_connections_do_not_keep_real_joiners_out():
+    net = SimCluster(seed=8, **BAD)
+    host = net.host("alice")
+    member = net.join("bob", host)
+    parked = [net.dial("10.66.0.1", target) for target in (host, member) for _ in range(30)]
+    silent = [net.dial("10.66.0.2", host) for _ in range(60)]
+    net.run(0.2)
+    for k, d in enumerate(parked):
+        d.send(P.encode(P.Hello(50 + k, bytes(P.MAC_SIZE)), 6, 1, net.now))     # a player not in the table
+    joiners = [net.node(f"real{k}") for k in range(5)]
+    for node in joiners:
+        net.start_join(node, host)
+    net.run(3.0)
+    assert all(n.core.number for n in joiners), [n.join_error for n in joiners]
+    assert_one_session(net)
+    assert len(silent) == 60 and host.core.dropped["pending_timeout"] + host.core.dropped["evicted"] >= 60
