@@ -412,7 +412,7 @@ def test_a_hunt_ends_when_the_camp_is_in_its_cone_and_sight_and_nobody_is_there(
 def test_a_hunt_that_comes_no_nearer_looks_from_where_it_is(monkeypatch):
     # the camp behind the thin wall x=60; the tank held where it is (as on a hillside it
     # could not climb): after HUNT_STALL s it turns to look from there, and gives it up
-    HUNT_STALL = 4.0
+    from tanktool.sim.agents.combat import HUNT_STALL
 
     w = box_world([(40.0, 35.0), (100.0, 10.0)], headings=[math.pi])
     agent, drv = _hunting(w, (80.0, 35.0))
