@@ -430,3 +430,34 @@ def test_a_hunt_that_comes_no_nearer_looks_from_where_it_is(monkeypatch):
             break
     assert 1 not in agent.memory.camps and agent.state != "hunt", (hunted, agent.state, agent.machine.trace)
     assert hunted >= HUNT_STALL
+
+
+# ------------------------------------------------------------------ lying in wait
+def test_an_enemy_heard_coming_behind_cover_is_waited_for_with_the_gun_on_the_corner():
+    # the enemy's engine behind the thin wall x=60 (z 20-50), nearer its north end: hard
+    # stands, turned from facing away to that end, where the enemy's way round comes
+    # past; normal goes looking
+    from tanktool.sim.agents.combat import WAIT
+
+    w = box_world([(50.0, 35.0), (75.0, 44.0)], headings=[math.pi, 0.0])
+    me, o = w.tanks
+    agent = driver(Agent("hard"), 1)
+    o.vx = ENGINE_FULL
+    agent(w, me)
+    assert agent.bot.state == "lie_in_wait"
+    end = math.atan2(52.0 - me.z, 60.0 - me.x)      # the nearer end of the wall
+    for _ in range(int(0.75 * WAIT / w.dt)):
+        o.vx = ENGINE_FULL                      # still heard coming
+        w.step(None, [agent(w, me), IDLE])
+        o.place(75.0, 44.0, 0.0)
+    assert agent.bot.state == "lie_in_wait"
+    assert me.speed() < 1.0
+    assert abs(math.remainder(me.heading - end, 2 * math.pi)) < 0.35
+    for _ in range(int(0.5 * WAIT / w.dt)):       # it does not come: search from the noise
+        w.step(None, [agent(w, me), IDLE])
+    assert agent.bot.state == "search"
+    normal = driver(Agent("normal"), 1)
+    w2 = box_world([(50.0, 35.0), (75.0, 44.0)], headings=[math.pi, 0.0])
+    w2.tanks[1].vx = ENGINE_FULL
+    normal(w2, w2.tanks[0])
+    assert normal.bot.state == "search"

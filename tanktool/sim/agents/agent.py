@@ -7,7 +7,7 @@ the state machine (``machine.StateMachine``) over ``TRANSITIONS``, dodges the sh
 it sees (``dodge.Evasion``) and backs out when it is stuck (``driving.Pilot``).
 
 The states (``explore``: wander, watch, ambush, search; ``combat``: attack, evade,
-hunt, return_fire) and when it goes from one to another are the table
+hunt, return_fire, lie_in_wait) and when it goes from one to another are the table
 ``TRANSITIONS``, rows ``(from, when, to, why)`` checked in this order (the first that
 holds is taken; ``done``: the state has nothing more to do); ``transition_table()``
 prints it, and docs/agents.md shows it (``tools/agent_docs.py`` writes it there).
@@ -27,7 +27,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..bots import IDLE, Command
-from .combat import CAMP_MEMORY, CAMP_SPEED, Attack, Evade, Hunt, ReturnFire
+from .combat import CAMP_MEMORY, CAMP_SPEED, WAIT_COOLDOWN, WAIT_NEAR, Attack, Evade, Hunt, LieInWait, ReturnFire
 from .difficulty import DIFFICULTIES, Difficulty, difficulty
 from .dodge import Evasion
 from .driving import Pilot
@@ -42,7 +42,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..bots import View
     from .perception import Percept
 
-_ALL = ("wander", "watch", "ambush", "search", "attack", "evade", "hunt", "return_fire")
+_ALL = ("wander", "watch", "ambush", "search", "attack", "evade", "hunt", "return_fire", "lie_in_wait")
 STATES = _ALL
 _ROAM = ("wander", "watch")
 
@@ -66,6 +66,9 @@ TRANSITIONS = tuple(Transition(*row) for row in (
     (_but("evade", "attack", "return_fire"), "heard_near", "return_fire",
      "a shot or engine heard within 30 m from a place in sight: face it"),
     (("return_fire",), "done", "search", "facing the shot: from there"),
+    (("wander", "watch", "search"), "coming", "lie_in_wait",
+     "an engine heard within 35 m behind cover (Difficulty.wait): gun on where it comes in"),
+    (("lie_in_wait",), "done", "search", "it did not come in 3 s: from the noise"),
     (("wander", "watch", "search"), "camp_known", "hunt", "an enemy seen standing (cover levels)"),
     (("hunt",), "done", "wander", "it was not there"),
     (("attack",), "enemy_killed", "wander", "it comes back at a spawn point"),
@@ -135,7 +138,7 @@ class Agent(Pilot):
         self.route: list[tuple[float, float]] = []
         self.walker: tuple[tuple[int, int], str] | None = None
         states: list[State[Agent]] = [Wander(), Watch(False), Watch(True), Search(), Attack(), Evade(), Hunt(),
-                                      ReturnFire()]
+                                      ReturnFire(), LieInWait()]
         self.machine = StateMachine({s.name: s for s in states}, TRANSITIONS, GUARDS, "wander",
                                     on_change=Agent._clear_way)
 
@@ -285,6 +288,17 @@ def _heard_near(a: Agent, view: "View", p: "Percept") -> Any:
     return None
 
 
+def _coming(a: Agent, view: "View", p: "Percept") -> Any:
+    """An engine heard now within ``WAIT_NEAR`` m from a place out of our line of
+    sight, by a level that lies in wait, not within ``WAIT_COOLDOWN`` s of the last."""
+    h, me = p.heard, view.me
+    if a.level.wait and p.sight is None and h is not None and h.engine and h.t >= p.t - 1e-9 \
+            and p.t - a.memory.waited_until > WAIT_COOLDOWN and math.hypot(h.x - me.x, h.z - me.z) < WAIT_NEAR \
+            and not _in_open(view, h):
+        return h
+    return None
+
+
 def _enemy_acquired(a: Agent, view: "View", p: "Percept") -> Any:
     return p.sight is not None and p.reacted
 
@@ -333,7 +347,7 @@ def _vantage(a: Agent, view: "View", p: "Percept") -> Any:
 
 
 GUARDS = {"ambushed": _ambushed, "losing": _losing, "shot_from_open": _shot_from_open, "heard_near": _heard_near,
-          "enemy_acquired": _enemy_acquired, "camp_known": _camp_known, "enemy_killed": _enemy_killed,
+          "enemy_acquired": _enemy_acquired, "coming": _coming, "camp_known": _camp_known, "enemy_killed": _enemy_killed,
           "enemy_lost": _enemy_lost, "heard": _heard, "hit_unseen": _hit_unseen, "heard_again": _heard_again,
           "leading": _leading, "vantage": _vantage}
 

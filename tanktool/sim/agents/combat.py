@@ -55,6 +55,12 @@ CAMP_MEMORY = 90.0
 CAMP_SPEED = 7.0
 #: hunting: no nearer to the place to look from for this long, it looks from where it is [s]
 HUNT_STALL = 4.0
+#: lying in wait (``Difficulty.wait``): an engine heard within WAIT_NEAR m behind cover
+#: is waited for at most WAIT s, the gun on where its way to us comes into our sight;
+#: not again for WAIT_COOLDOWN s after [m, s, s]
+WAIT_NEAR = 35.0
+WAIT = 3.0
+WAIT_COOLDOWN = 6.0
 #: evading lasts at most this long [s]; then no new evasion for EVADE_COOLDOWN s
 EVADE_TIME = 5.0
 EVADE_COOLDOWN = 8.0
@@ -406,3 +412,56 @@ class Hunt(State["Agent"]):
             free = free if g.layers is not None else free[0]   # the flat sight table's nodes are (i, j)
             self._room = np.array([free[tuple(n)] for n in agent.nav.views.nodes])
         return self._room
+
+
+class LieInWait(State["Agent"]):
+    """An enemy heard coming (its engine, behind cover, close): stand with the gun on
+    the place where its way to us comes into our sight, so that the first shot is
+    ours; hands the noise on to a search when it does not come."""
+
+    name = "lie_in_wait"
+
+    def __init__(self) -> None:
+        self.until = self.aimed = -math.inf
+        self.face = 0.0
+        self.heard: list[Any] = []          # the engines heard while waiting
+
+    def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
+        """``arg``: the engine heard (``Heard``)."""
+        self.until = view.t + WAIT
+        self.heard = [arg]
+        self._aim(agent, view)
+
+    def exit(self, agent: "Agent", view: "View") -> None:
+        agent.memory.waited_until = view.t
+
+    def _aim(self, agent: "Agent", view: "View") -> None:
+        """Face the last point of the A* way from us to the noise (the mean of the
+        engines heard while waiting: each is off by 15 % of the distance, and one
+        apart from the next may put the way round the other end of a wall) that we
+        see, before the first we do not: the corner the enemy comes round."""
+        me = view.me
+        n = len(self.heard)
+        x, z = sum(h.x for h in self.heard) / n, sum(h.z for h in self.heard) / n
+        y = self.heard[-1].y
+        self.handoff, self.aimed = (x, z, y), view.t
+        way = view.map.path((me.x, me.z, me.y), (x, z, y), agent.nav.grid)  # type: ignore[union-attr]
+        entry = (x, z)
+        for q in way:
+            if view.map.line_blocked(me.x, me.z, q[0], q[1], me.eye):
+                break
+            entry = q
+        else:
+            entry = way[-1] if way else entry
+        self.face = math.atan2(entry[1] - me.z, entry[0] - me.x)
+
+    def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
+        me = view.me
+        if view.t >= self.until:
+            return None
+        h = p.heard
+        if h is not None and h.engine and h is not self.heard[-1]:
+            self.heard.append(h)
+            if view.t - self.aimed >= 1.0:
+                self._aim(agent, view)
+        return agent.drive(view, 0.0, 0.0, agent.turn(me, wrap(self.face - me.heading)))

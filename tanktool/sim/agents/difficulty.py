@@ -58,6 +58,11 @@ class Difficulty:
     #: box, paper2002 and maze (6 each) 7-6-5 with it and 12-2-4 without; most deaths
     #: came while it drove off with the enemy hitting its back
     break_off: bool = False
+    #: lies in wait for an enemy heard coming (its engine within ``combat.WAIT_NEAR`` m,
+    #: behind cover): stands with the gun on where it comes into sight, the first
+    #: shot its own (False: goes looking for it, and meets it round the corner with
+    #: the gun wherever the way pointed it)
+    wait: bool = False
     #: on relief, drives to where the hull's pitch carries a shot onto the enemy when it
     #: does not where it stands (``relief``; False: holds its fire and stares)
     relief: bool = True
@@ -76,7 +81,8 @@ DIFFICULTIES: dict[str, Difficulty] = {
                          dodge_reaction=0.45, engage=40.0, stand_off=45.0, cover=True),
     "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.3), vision_range=130.0,
                        hearing_radius=120.0, think_hz=20.0, engine_radius=40.0, lead=1.0, fire_tolerance=0.5,
-                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, scoot=False),
+                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, scoot=False,
+                       wait=True),
 }
 
 

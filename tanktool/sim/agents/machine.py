@@ -74,7 +74,9 @@ def table_text(table: Sequence[Transition], states: Sequence[str]) -> str:
         return ", ".join(row.source)
 
     rows = [("from", "when", "to", "")] + [(source(r), r.when, r.target, r.why) for r in table]
-    return "\n".join(f"{a:<30}{w:<18}{b:<13}{why}".rstrip() for a, w, b, why in rows)
+    # each column as wide as its widest cell and two spaces
+    wa, ww, wb = (max(len(r[k]) for r in rows) + 2 for k in range(3))
+    return "\n".join(f"{a:<{wa}}{w:<{ww}}{b:<{wb}}{why}".rstrip() for a, w, b, why in rows)
 
 
 class StateMachine(Generic[A]):

@@ -50,6 +50,7 @@ class AgentMemory:
         self.seen_at: dict[int, float] = {}        # when each enemy was last in sight (before this think)
         self.evade_cooldown = -math.inf
         self.faced_t = self.faced_at = -math.inf     # the noise it last turned to: heard at, turned at
+        self.waited_until = -math.inf                # the end of its last lying in wait
         self.last_seen: dict[int, Sighting] = {}   # the view's memory (the same dict)
         self.heard: Heard | None = None
         #: an enemy has been seen or heard since the match began (it outlives a death)
