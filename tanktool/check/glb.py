@@ -29,7 +29,7 @@ def _read(path: str | Path):
 def read_glb_triangles(path: str | Path) -> tuple[np.ndarray, np.ndarray] | None:
     """(vertices (n, 3) float64, triangles (m, 3) int64) of the default scene, or None
     when the file is not a glTF this tool reads (:func:`load_triangles` says why)."""
-    from ..formats.gltf import scene_triangles
+    from ..formats.gltf_scene import scene_triangles
 
     try:
         v, f = scene_triangles(_read(path))
@@ -41,7 +41,7 @@ def read_glb_triangles(path: str | Path) -> tuple[np.ndarray, np.ndarray] | None
 def load_triangles(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     """Vertices and triangles of any model file, Y up as stored: .glb read here, the
     rest through trimesh.  Raises FormatError naming the file and the place."""
-    from ..formats.gltf import scene_triangles
+    from ..formats.gltf_scene import scene_triangles
 
     path = Path(path)
     if path.suffix.lower() == ".glb":

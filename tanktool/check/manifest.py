@@ -237,7 +237,7 @@ def _texture_problem(bundle: Path, name: str) -> str:
     """'' when ``name`` is a usable texture of ``bundle``, else what is wrong with it."""
     import warnings
 
-    from ..formats.gltf import MAX_IMAGE_PIXELS
+    from ..formats.limits import MAX_IMAGE_PIXELS
     from ..formats.materials import IMAGE_SUFFIXES
 
     f = safe_file(bundle, name) if name else None

@@ -26,11 +26,13 @@ past the buffer crashes whatever uses the mesh, an external URI reads any file.
 
 * images: only PNG or JPEG held in a bufferView, at most ``MAX_IMAGE_PIXELS`` by
   their header (read without decoding); any other image, the textures naming it and
-  the materials' references to those are dropped (the colour stays).
+  the materials' references to those are dropped (the colour stays)
+  (:mod:`.gltf_images`).
 
 It returns a :class:`Gltf` whose document is *sanitised*: one binary buffer, no
 URIs, cameras, skins or animations, only the keys meshes and their colour textures need,
 so :func:`sanitized_glb` hands trimesh a file that cannot read anything else.
+:mod:`.gltf_scene` reads the triangles of a validated glTF without trimesh.
 Errors are FormatErrors naming the file and the place: a byte offset for the
 container, a JSON path (``accessors[3].byteStride``) for the document.
 """
@@ -49,6 +51,7 @@ from urllib.parse import unquote
 import numpy as np
 
 from ..errors import FormatError
+from .gltf_images import sanitized_materials, sanitized_textures
 from .limits import MAX_DEPTH, MAX_FACES, MAX_MODEL_BYTES, MAX_OBJECTS, nesting_depth
 
 GLB_MAGIC = b"glTF"
@@ -62,9 +65,6 @@ INDEX_TYPES = (5121, 5123, 5125)
 #: attributes each span the whole view; 8 leaves room for real files)
 ACCESSOR_BUDGET = 8
 #: extensions that change how geometry is stored: without them the numbers are wrong
-#: the largest embedded texture (pixels, by its header): 4096 x 4096
-MAX_IMAGE_PIXELS = 4096 * 4096
-_IMAGE_TYPES = {"image/png": b"\x89PNG\r\n\x1a\n", "image/jpeg": b"\xff\xd8"}
 _GEOMETRY_EXTENSIONS = ("KHR_draco_mesh_compression", "EXT_meshopt_compression", "KHR_mesh_quantization")
 TRIANGLES, STRIP, FAN = 4, 5, 6
 
@@ -383,126 +383,6 @@ def _meshes(d: _Doc, doc: dict, g: Gltf, materials: int) -> tuple[list[dict], li
     return out, faces
 
 
-def _image_size(data: bytes) -> tuple[int, int] | None:
-    """(width, height) from an image's header, without decoding it; None if unreadable."""
-    import io
-
-    try:
-        from PIL import Image
-
-        with Image.open(io.BytesIO(data)) as im:
-            return im.size
-    except Exception:  # PIL raises many kinds for a damaged header
-        return None
-
-
-def _decode_error(data: bytes) -> str | None:
-    """Why an image's pixels cannot be decoded (its size is checked first), or None."""
-    import io
-
-    from PIL import Image
-
-    try:
-        with Image.open(io.BytesIO(data)) as im:
-            im.load()
-    except Exception as e:  # PIL raises OSError, SyntaxError, ValueError, zlib.error ...
-        return " ".join(str(e).split())[:160] or type(e).__name__
-    return None
-
-
-def _textures(doc: dict, g: Gltf) -> tuple[list[dict], list[dict], list[dict], dict[int, int]]:
-    """Sanitised images, samplers and textures, and old texture index -> new.
-
-    An image is kept only when it is a PNG or JPEG in a bufferView, no larger than
-    MAX_IMAGE_PIXELS by its header; the rest (URIs, other kinds, damaged or huge ones)
-    are dropped with the textures that name them: a model keeps its colours."""
-    views = g.doc["bufferViews"]
-    images: list[dict] = []
-    image_map: dict[int, int] = {}
-    raw_images = doc.get("images", [])
-    for i, im in enumerate(raw_images if isinstance(raw_images, list) else []):
-        if not isinstance(im, dict):
-            continue
-        vi, mime = im.get("bufferView"), im.get("mimeType")
-        if isinstance(vi, bool) or not isinstance(vi, int) or not 0 <= vi < len(views) or mime not in _IMAGE_TYPES:
-            continue
-        v = views[vi]
-        data = g.binary[v["byteOffset"]: v["byteOffset"] + v["byteLength"]]
-        if not data.startswith(_IMAGE_TYPES[mime]):
-            continue
-        size = _image_size(data)
-        if size is None or size[0] < 1 or size[1] < 1 or size[0] * size[1] > MAX_IMAGE_PIXELS:
-            continue
-        damage = _decode_error(data)
-        if damage:  # a header that reads but pixels that do not: trimesh decodes lazily, far from here
-            name = im.get("name")
-            named = f" {name!r:.60}" if isinstance(name, str) and name else ""
-            raise FormatError(f"{g.label}: images[{i}]{named} ({mime} in bufferView {vi}): "
-                              f"the image is damaged: {damage}")
-        image_map[i] = len(images)
-        images.append({"bufferView": vi, "mimeType": mime})
-    samplers: list[dict] = []
-    sampler_map: dict[int, int] = {}
-    raw_samplers = doc.get("samplers", [])
-    for i, sm in enumerate(raw_samplers if isinstance(raw_samplers, list) else []):
-        if isinstance(sm, dict):
-            sampler_map[i] = len(samplers)
-            samplers.append({k: sm[k] for k in ("magFilter", "minFilter", "wrapS", "wrapT")
-                             if isinstance(sm.get(k), int) and not isinstance(sm.get(k), bool)
-                             and sm[k] in (9728, 9729, 9984, 9985, 9986, 9987, 33071, 33648, 10497)})
-    textures: list[dict] = []
-    texture_map: dict[int, int] = {}
-    raw_textures = doc.get("textures", [])
-    for i, t in enumerate(raw_textures if isinstance(raw_textures, list) else []):
-        src = t.get("source") if isinstance(t, dict) else None
-        if isinstance(src, bool) or not isinstance(src, int) or src not in image_map:
-            continue
-        tex: dict[str, Any] = {"source": image_map[src]}
-        smp = t.get("sampler")
-        if isinstance(smp, int) and not isinstance(smp, bool) and smp in sampler_map:
-            tex["sampler"] = sampler_map[smp]
-        texture_map[i] = len(textures)
-        textures.append(tex)
-    return images, samplers, textures, texture_map
-
-
-def _materials(d: _Doc, doc: dict, texture_map: dict[int, int] | None = None) -> list[dict]:
-    """Materials with their colours and colour textures (``texture_map``: the textures
-    kept, old index -> new; a reference to any other is dropped)."""
-    texture_map = texture_map or {}
-    out = []
-    for i, m in enumerate(d.array(doc, "materials")):
-        where = f"materials[{i}]"
-        mat: dict[str, Any] = {}
-        pbr = m.get("pbrMetallicRoughness", {})
-        if not isinstance(pbr, dict):
-            raise d.fail(f"{where}.pbrMetallicRoughness", "must be an object")
-        colour = d.numbers(pbr, "baseColorFactor", f"{where}.pbrMetallicRoughness", 4)
-        p2: dict[str, Any] = {}
-        if colour is not None:
-            p2["baseColorFactor"] = [min(max(c, 0.0), 1.0) for c in colour]
-        tex = pbr.get("baseColorTexture")
-        if isinstance(tex, dict):
-            k = tex.get("index")
-            uv = tex.get("texCoord", 0)
-            if isinstance(k, int) and not isinstance(k, bool) and k in texture_map and uv == 0:
-                p2["baseColorTexture"] = {"index": texture_map[k]}
-        for key in ("metallicFactor", "roughnessFactor"):
-            v = pbr.get(key)
-            if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v):
-                p2[key] = min(max(float(v), 0.0), 1.0)
-        if p2:
-            mat["pbrMetallicRoughness"] = p2
-        if m.get("alphaMode") in ("OPAQUE", "MASK", "BLEND"):
-            mat["alphaMode"] = m["alphaMode"]
-        if m.get("doubleSided") is True:
-            mat["doubleSided"] = True
-        if isinstance(m.get("name"), str):
-            mat["name"] = m["name"][:200]
-        out.append(mat)
-    return out
-
-
 def _nodes(d: _Doc, doc: dict, meshes: int) -> tuple[list[dict], list[int]]:
     """Sanitised nodes and the parent of each (-1 for none); refuses cycles."""
     nodes = d.array(doc, "nodes")
@@ -578,8 +458,8 @@ def read_gltf(data: bytes, label: str, folder: Path | None = None) -> Gltf:
     g.doc["bufferViews"] = views
     g.doc["accessors"] = _accessors(d, doc, views, lengths, ACCESSOR_BUDGET * total + (1 << 20))
     g.binary = b"".join(b + b"\0" * (-len(b) % 4) for b in buffers)
-    images, samplers, textures, texture_map = _textures(doc, g)
-    materials = _materials(d, doc, texture_map)
+    images, samplers, textures, texture_map = sanitized_textures(doc, g)
+    materials = sanitized_materials(d, doc, texture_map)
     meshes, faces = _meshes(d, doc, g, len(materials))
     nodes, parent = _nodes(d, doc, len(meshes))
     scenes_in = d.array(doc, "scenes")
@@ -637,58 +517,3 @@ def sanitized_glb(g: Gltf) -> bytes:
         parts += [struct.pack("<II", len(g.binary), CHUNK_BIN), g.binary]
     body = b"".join(parts)
     return struct.pack("<4sII", GLB_MAGIC, 2, 12 + len(body)) + body
-
-
-def node_matrix(node: dict) -> np.ndarray:
-    """A validated node's local transform (column vectors): matrix, or T x R x S."""
-    if "matrix" in node:
-        return np.asarray(node["matrix"], dtype=np.float64).reshape(4, 4).T
-    m = np.eye(4)
-    x, y, z, w = node.get("rotation", [0.0, 0.0, 0.0, 1.0])
-    m[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-    m[:3, :3] *= np.asarray(node.get("scale", [1.0, 1.0, 1.0]))[None, :]
-    m[:3, 3] = node.get("translation", [0.0, 0.0, 0.0])
-    return m
-
-
-def scene_triangles(g: Gltf) -> tuple[np.ndarray, np.ndarray]:
-    """(vertices (n, 3) float64, triangles (m, 3) int64) of the default scene's
-    triangle primitives in the scene's frame (node transforms applied)."""
-    doc = g.doc
-    nodes, meshes = doc["nodes"], doc["meshes"]
-    verts: list[np.ndarray] = []
-    tris: list[np.ndarray] = []
-    base = 0
-    stack = [(r, np.eye(4)) for r in doc["scenes"][doc["scene"]]["nodes"]]
-    while stack:
-        v, parent = stack.pop()
-        node = nodes[v]
-        world = parent @ node_matrix(node)
-        stack += [(c, world) for c in node.get("children", ())]
-        if "mesh" not in node:
-            continue
-        for prim in meshes[node["mesh"]]["primitives"]:
-            mode = prim["mode"]
-            if mode not in (TRIANGLES, STRIP, FAN):
-                continue
-            pos = read_accessor(g, prim["attributes"]["POSITION"]).astype(np.float64)
-            idx = (read_accessor(g, prim["indices"]).astype(np.int64) if "indices" in prim
-                   else np.arange(len(pos), dtype=np.int64))
-            if mode == TRIANGLES:
-                t = idx.reshape(-1, 3)
-            elif len(idx) < 3:
-                continue
-            elif mode == STRIP:
-                k = np.arange(len(idx) - 2)
-                t = np.column_stack([idx[k], idx[k + 1 + (k % 2)], idx[k + 2 - (k % 2)]])
-            else:
-                k = np.arange(1, len(idx) - 1)
-                t = np.column_stack([np.full(len(k), idx[0]), idx[k], idx[k + 1]])
-            verts.append(pos @ world[:3, :3].T + world[:3, 3])
-            tris.append(t + base)
-            base += len(pos)
-    if not verts:
-        return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
-    return np.concatenate(verts), np.concatenate(tris)

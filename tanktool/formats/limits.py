@@ -30,6 +30,8 @@ MAX_OBJECTS = 100_000
 #: more objects than this are merged into one mesh (keeps the scene graph small, so
 #: the cost of a model stays linear in its number of objects)
 MERGE_OBJECTS = 64
+#: the largest texture, by its header (a glTF's embedded image, a bundle's texture file)
+MAX_IMAGE_PIXELS = 4096 * 4096
 #: a model's extent after --scale, metres: beyond these it is a unit mistake
 MAX_EXTENT = 1.0e5
 MIN_EXTENT = 1.0e-3

@@ -150,7 +150,7 @@ def _check_image(path: Path) -> str:
     243 MB and took seconds to scale down)."""
     import warnings
 
-    from .gltf import MAX_IMAGE_PIXELS
+    from .limits import MAX_IMAGE_PIXELS
 
     try:
         from PIL import Image
