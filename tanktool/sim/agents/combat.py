@@ -320,10 +320,11 @@ class Hunt(State["Agent"]):
         self.camp: tuple[float, float] | None = None
         self.replan = -math.inf
         self.best, self.best_at = math.inf, 0.0      # nearest to the path's end so far, since
+        self.closing = False                         # on the way to the camp itself
         self._room: np.ndarray | None = None
 
     def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
-        self.camp, self.replan = None, -math.inf
+        self.camp, self.replan, self.closing = None, -math.inf, False
         self.best, self.best_at = math.inf, view.t
 
     @staticmethod
@@ -339,33 +340,54 @@ class Hunt(State["Agent"]):
     def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
         """To the nearest place (by path) that sees the camp from ``stand_off`` +- 15 m
         (the blocks' line-of-sight table), the gun on it where the way comes into its
-        sight.  There and not seeing it: it has gone, forget it.  None: no camp."""
+        sight.  There (or stalled) and not seeing it: along the way to the camp itself,
+        gun on it.  The camp in our cone and line of sight and nobody there, or the way
+        to it driven: it has gone, forget it.  None: no camp."""
         t, me, mem = view.t, view.me, agent.memory
         idx = agent.camp_known(t)
         if idx is None:
             return None
         cx, cz, seen_t, face = mem.camps[idx]
-        if self._looked(agent, view, cx, cz):
+        if p.sight is None and self._looked(agent, view, cx, cz):
             del mem.camps[idx]                # in our cone and line of sight, and not there
             return None
+        if self.closing and self.camp == (cx, cz):
+            return self._close_in(agent, view, idx)
         if self.camp != (cx, cz) or t >= self.replan or not agent.path:
             if not self._plan(agent, view, (cx, cz), face):
                 del mem.camps[idx]             # nowhere to see it from: give it up
                 return None
         trim(agent.path, me.x, me.z)
-        end = agent.path[-1]
-        d_end = math.hypot(end[0] - me.x, end[1] - me.z)
-        if d_end < self.best - 1.0:
-            self.best, self.best_at = d_end, t
-        if d_end < 3.0 or t - self.best_at > HUNT_STALL:
-            # there, or no nearer for HUNT_STALL s (circling a place it cannot stand
-            # on: seen on a hillside of the hills for 70 s): look from here
-            err = wrap(math.atan2(cz - me.z, cx - me.x) - me.heading)
-            if abs(err) < 0.3:
-                del mem.camps[idx]            # looking at where it was, and it is not there
-                return None
-            return agent.drive(view, 0.0, 0.0, agent.turn(me, err))
+        if self._stalled(agent, view):
+            # there (the block's point sees the camp, but not the place a few metres off
+            # it where we stand: the camp is not in sight), or no nearer for HUNT_STALL s
+            # (circling a place it cannot stand on: seen on a hillside of the hills for
+            # 70 s): close in on the camp itself, the gun on it
+            self.closing = True
+            agent.path = view.map.path((me.x, me.z, me.y), (cx, cz), agent.nav.grid)  # type: ignore[union-attr]
+            self.best, self.best_at = math.inf, t
+            return self._close_in(agent, view, idx)
         return agent.follow(view, agent.path, speed=1.0, lookahead=4.0, corner=agent.corner())
+
+    def _stalled(self, agent: "Agent", view: "View") -> bool:
+        """At the path's end (within 3 m, or no path), or no nearer to it for ``HUNT_STALL`` s."""
+        me = view.me
+        if not agent.path:
+            return True
+        d_end = math.hypot(agent.path[-1][0] - me.x, agent.path[-1][1] - me.z)
+        if d_end < self.best - 1.0:
+            self.best, self.best_at = d_end, view.t
+        return d_end < 3.0 or view.t - self.best_at > HUNT_STALL
+
+    def _close_in(self, agent: "Agent", view: "View", idx: int) -> Command | None:
+        """Along the A* way to the camp, gun on it, until it is in sight (``_looked``
+        ends the hunt); at its end, or stalled, it is not there: forget it."""
+        cx, cz = agent.memory.camps[idx][:2]
+        trim(agent.path, view.me.x, view.me.z)
+        if self._stalled(agent, view):
+            del agent.memory.camps[idx]
+            return None
+        return agent.approach(view, agent.path, (cx, cz), CAMP_SPEED)
 
     def _plan(self, agent: "Agent", view: "View", camp: tuple[float, float], face: float) -> bool:
         """A path to the best place to see ``camp`` from (facing ``face``)."""
@@ -394,7 +416,7 @@ class Hunt(State["Agent"]):
         score = pd - np.where(roomy, 2.0 * top, 0.0) - np.where(unseen, 4.0 * top, 0.0)
         b = int(np.argmin(np.where(ok, score, np.inf)))
         if self.camp != camp:
-            self.best, self.best_at = math.inf, view.t
+            self.best, self.best_at, self.closing = math.inf, view.t, False
         self.camp, self.replan = camp, view.t + 5.0
         agent.path = view.map.path((me.x, me.z, me.y), (float(pts[b][0]), float(pts[b][1]), float(v.heights[b])),
                                    agent.nav.grid)
