@@ -227,3 +227,29 @@ def test_parked_hellos_and_silent_connections_do_not_keep_real_joiners_out():
     assert all(n.core.number for n in joiners), [n.join_error for n in joiners]
     assert_one_session(net)
     assert len(silent) == 60 and host.core.dropped["pending_timeout"] + host.core.dropped["evicted"] >= 60
+
+
+# ---------------------------------------------------------------- partitions
+@pytest.mark.parametrize("side_a, seconds", [((1, 2), 8.0), ((1, 2, 3), 8.0), ((1, 2), 30.0), ((1,), 20.0)])
+def test_a_partition_heals_to_one_host(side_a, seconds):
+    """Players 1-5; ``side_a`` (with the host) is cut from the others for ``seconds``.
+    The other side elects a host under a higher term; when the cut heals, the probes of
+    the players each side lost find it, the old host steps down and sends its members
+    after it: one session again, one host, one table."""
+    net = SimCluster(seed=10, **BAD)
+    host = net.host("alice")
+    nodes = [host] + [net.join(name, host) for name in ("bob", "carol", "dave", "erin")]
+    net.run(1.0)
+    a = [n.ip for n in nodes if n.core.number in side_a]
+    b = [n.ip for n in nodes if n.core.number not in side_a]
+    net.udp.partition(net.now, net.now + seconds, a, b)
+    net.run(seconds - 0.5)
+    other = [n for n in nodes if n.core.number not in side_a]
+    assert all(n.core.term > 1 and n.core.host_number == min(side_b_numbers(nodes, side_a)) for n in other)
+    net.run(12.0)
+    assert_one_session(net)
+    assert len(live(net)) == 5 and host.core.term >= 2 and not host.core.is_host
+
+
+def side_b_numbers(nodes, side_a):
+    return [n.core.number for n in nodes if n.core.number not in side_a]

@@ -120,6 +120,9 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
         self.session_offset = 0.0       # session time = now - session_offset
         self.closed = False
         self._pruned = now
+        #: a new host sends its table (and term) again then: members that were still
+        #: waiting out the old host's silence dropped the first one
+        self.announce_at: float | None = None
 
     def start_host(self, address: tuple[str, int, int], now: float) -> None:
         """Start a session as player 1, the host, reachable at (ip, tcp port, udp port)."""
@@ -221,6 +224,10 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
             if n in self.table and n != self.number and not self.table[n].is_bot \
                     and now - self.last_heard.get(n, now) > self.silence:
                 self._remove(n, "silent")
+        if self.announce_at is not None and now >= self.announce_at:
+            self.announce_at = None
+            if self.is_host:
+                self._send_table()
         self._probe_tick(now)
 
     # ------------------------------------------------------------------ leaving
@@ -249,19 +256,27 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
             self.term += 1                    # every peer sees the same departures: same term
             self.host_changes.append((self.session_time(), self.host_number))
             self.events.append(NetEvent("host", self.host_number))
+            if self.is_host:
+                # once every member has timed out what we did, tell them our term again
+                self.announce_at = self.now + self.silence
         # its computer opponents go on, run by the host (the new one if it was the host)
         for k, x in list(self.table.items()):
             if x.owner == n:
                 self.table[k] = replace(x, owner=self.host_number)
                 if self.host_number == self.number:
                     self.events.append(NetEvent("adopt", k, self.table[k]))
-        if self.is_host and self.links and not self.closed:
-            table = self._pack(P.Assign(self.number, self.session_time(), self._table(), self.term),
-                               P.MessageType.TABLE)
-            for link in list(self.links.values()):
-                if not link.outgoing:
-                    self._queue(link, table)
+        if self.is_host:
+            self._send_table()
         self._lost_player(e, reason)
+
+    def _send_table(self) -> None:
+        """The host's table (and term) to every member."""
+        if not self.links or self.closed:
+            return
+        table = self._pack(P.Assign(self.number, self.session_time(), self._table(), self.term), P.MessageType.TABLE)
+        for link in list(self.links.values()):
+            if not link.outgoing:
+                self._queue(link, table)
 
     def leave(self, now: float, send_exit: bool = True) -> None:
         """Leave: an EXIT to everyone linked (``send_exit``), every link closed."""

@@ -232,6 +232,17 @@ class LinksMixin:
         if isinstance(m.body, P.Refuse) and link.initiated:
             link.refused = True                # a duplicate link lost the tie-break
             return
+        if isinstance(m.body, P.Refuse) and m.sender == self.host_number and not self.is_host \
+                and m.body.code == P.RefuseCode.NOT_HOST:
+            # our host stepped down to a newer session (terms.py): follow it there
+            try:
+                addr = parse_address(m.body.text, need_host=True)
+            except NetError:
+                self.dropped["garbage"] += 1
+                return
+            if self.step_down_to is None:
+                self._step_down(addr, m.sender, f"the host moved to the session at {addr[0]}:{addr[1]}")
+            return
         if isinstance(m.body, P.Refuse) and m.sender == self.host_number and not self.is_host:
             # the host disconnected us (a kick): leave, rather than elect ourselves
             self.events.append(NetEvent("kicked", m.sender, reason=m.body.text))
@@ -244,7 +255,9 @@ class LinksMixin:
             if m.sender != self.host_number:
                 self.dropped["not_host"] += 1
                 return
-            self.term = max(self.term, body.term)
+            # the host's term is its session's: members that saw departures in another
+            # order (and so counted host changes differently) take it (terms.py)
+            self.term = body.term
             if m.type == P.MessageType.TABLE:
                 # the host's table is the reference: who is not in it has left (for
                 # example a player whose EXIT reached only the host)

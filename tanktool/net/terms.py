@@ -4,17 +4,21 @@ Every host change raises the **term** by one on every peer (they all see the sam
 departures, so they agree without a vote); the host's NUMBER, NEW_PLAYER and TABLE
 carry it, and every listener's CHALLENGE carries its term, host and player count.
 
-A peer that lost every other player at once — links closed or silent, not goodbyes —
-may be the one left behind: a host frozen (SIGSTOP) for longer than the silence while
-the others elected a new one, or the small side of a partition.  So it **probes**: it
-dials the addresses of the players it lost, once every ``PROBE_EVERY`` for
-``PROBE_TIME``, and reads their CHALLENGE.  When one of them stands in a newer session
-— a higher term, or the same term with more players — it **steps down**: its
-computer opponents are dropped (the new host adopted them: no duplicates), joiners
-are redirected to that session, and :meth:`TermsMixin.rejoin` joins it as a member
-(a new number).  Until its first round of probes has been answered, it refuses joins
-with "try again" so that a joiner dialling a stale host's address is not taken into a
-split session.  No I/O: part of :class:`~tanktool.net.core.Core` (a probe is a
+A peer that lost players uncleanly — links closed or silent, not goodbyes — may be on
+the side left behind: a host frozen (SIGSTOP) for longer than the silence while the
+others elected a new one, or one side of a partition.  So it **probes**: it dials the
+addresses of the players it lost, once every ``PROBE_EVERY`` for ``PROBE_TIME``, then
+every ``PROBE_SLOW`` until ``PROBE_LONG`` (a partition may last), and reads their
+CHALLENGE.  When one of them stands in a newer session — a higher term, or the same
+term with more players — it **steps down**: a host first tells its members where that
+session is (a NOT_HOST refusal on their links, so they follow it), its computer
+opponents are dropped (the new host adopted them: no duplicates), joiners are
+redirected to that session, and ``Peer.rejoin`` joins it as a member (a new number).
+So when a partition heals, every peer ends in the session of the highest (term,
+players).  A peer left alone refuses joins with "try again" until its first round of
+probes has been answered, so that a joiner dialling a stale host's address is not taken
+into a split session.  (Two sides that each changed hosts the same number of times and
+kept as many players stay apart: a tie has no winner.)  No I/O: part of :class:`~tanktool.net.core.Core` (a probe is a
 ``Connect`` action; the answer comes back as any link's bytes).
 """
 
@@ -25,9 +29,12 @@ from typing import Any
 from . import protocol as P
 from .links import Connect, Link, NetEvent
 
-#: how long after losing everyone a peer probes their addresses, and how often [s]
+#: how long after losing players a peer probes their addresses, and how often [s]:
+#: often at first, then seldom for as long as a partition may last
 PROBE_TIME = 6.0
 PROBE_EVERY = 1.0
+PROBE_SLOW = 5.0
+PROBE_LONG = 60.0
 #: a probe's connection gives up after this long [s]
 PROBE_TIMEOUT = 1.0
 #: why a player left that says nothing about the session going on elsewhere
@@ -50,6 +57,7 @@ class TermsMixin:
         self.lost = {}                       # (ip, tcp port) of players lost uncleanly -> when
         self.probes = []                     # probe links open
         self.probe_until = -1.0
+        self.probe_fast_until = -1.0
         self.next_probe = 0.0
         self.first_round = False
         self.step_down_to = None             # a newer session's member we will rejoin through
@@ -58,13 +66,19 @@ class TermsMixin:
         return [k for k, x in self.table.items() if not x.is_bot and k != self.number]  # type: ignore[attr-defined]
 
     def _lost_player(self, e: P.Entry, reason: str) -> None:
-        """Called when player ``e`` left: if that left us alone and not by goodbyes, probe."""
+        """Called when player ``e`` left: if not by goodbyes, probe its address (and
+        while that left us alone, hold joins until the first round is answered)."""
         if reason in CLEAN or reason.startswith("disconnected") or e.is_bot:
             return
         now = self.now                                             # type: ignore[attr-defined]
         self.lost[(e.ip, e.tcp_port)] = now
-        if not self._others() and not self.closed:                 # type: ignore[attr-defined]
-            self.probe_until = now + PROBE_TIME
+        if self.closed:                                            # type: ignore[attr-defined]
+            return
+        if now > self.probe_until:
+            self.next_probe = now
+        self.probe_until = now + PROBE_LONG
+        self.probe_fast_until = now + PROBE_TIME
+        if not self._others():
             self.next_probe = now
             self.first_round = True
 
@@ -80,11 +94,15 @@ class TermsMixin:
             if not self.probes and now >= self.next_probe:
                 self.first_round = False
             return
-        if self._others():                       # someone is back (or joined): nothing to find
+        here = {(e.ip, e.tcp_port) for e in self.table.values()}          # type: ignore[attr-defined]
+        for addr, when in list(self.lost.items()):
+            if addr in here or now - when > PROBE_LONG:     # back with us, or given up on
+                del self.lost[addr]
+        if not self.lost:
             self.probe_until = -1.0
             self.first_round = False
             return
-        self.next_probe = now + PROBE_EVERY
+        self.next_probe = now + (PROBE_EVERY if now < self.probe_fast_until else PROBE_SLOW)
         for addr in list(self.lost):
             self._dial_probe(addr, now)
         if not self.probes:
@@ -108,12 +126,20 @@ class TermsMixin:
             return
         mine = (self.term, len(self._others()) + 1)
         if (body.term, body.players) > mine:
-            self.step_down_to = link.addr
-            self.first_round = False
-            self.dropped["stepped_down"] += 1                          # type: ignore[attr-defined]
-            self.events.append(NetEvent("stepdown", body.host, link.addr,  # type: ignore[attr-defined]
-                                        f"term {body.term} with {body.players} players at "
-                                        f"{link.addr[0]}:{link.addr[1]}"))
+            if self.is_host:                     # type: ignore[attr-defined]
+                # our members follow us there, rather than electing one of them
+                redirect = self._pack(P.Refuse(P.RefuseCode.NOT_HOST, f"{link.addr[0]}:{link.addr[1]}"))  # type: ignore[attr-defined]
+                for member in list(self.links.values()):                 # type: ignore[attr-defined]
+                    if not member.outgoing:
+                        self._queue(member, redirect)                    # type: ignore[attr-defined]
+            self._step_down(link.addr, body.host, f"term {body.term} with {body.players} players at "
+                                                  f"{link.addr[0]}:{link.addr[1]}")
+
+    def _step_down(self, addr: tuple[str, int], host: int, why: str) -> None:
+        self.step_down_to = addr
+        self.first_round = False
+        self.dropped["stepped_down"] += 1                          # type: ignore[attr-defined]
+        self.events.append(NetEvent("stepdown", host, addr, why))  # type: ignore[attr-defined]
 
     def forget_session(self, now: float) -> None:
         """Leave what is left of our session (our computer opponents with it) before
@@ -128,7 +154,7 @@ class TermsMixin:
         self.window.anchors.clear()                                   # type: ignore[attr-defined]
         self.number = self.host_number = 0                            # type: ignore[attr-defined]
         self.lost.clear()
-        self.probe_until = -1.0
+        self.probe_until = self.probe_fast_until = -1.0
         self.first_round = False
         self.step_down_to = None
         self.used_numbers, self.freed, self.max_epoch = set(), [], 0   # type: ignore[attr-defined]
