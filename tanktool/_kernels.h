@@ -26,6 +26,6 @@ static inline i64 max64(i64 a, i64 b) { return a > b ? a : b; }
 PyObject *tanktool_raster(PyObject *self, PyObject *args);
 
 /* the grid (_kernels_grid.c) */
-PyObject *tanktool_grid_reach(PyObject *self, PyObject *args);
+PyObject *tanktool_grid_labels(PyObject *self, PyObject *args);
 
 #endif

@@ -1,14 +1,16 @@
 /* tanktool._kernels: loops over the navigation grid's nodes (see _kernels.c).
  *
- *   grid_reach(valid, link, L, nz, nx, seeds, out)
- *       valid: bool (L, nz, nx); link: int8 (L, nz, nx, 4) the level each node's link in
- *       direction d (+x, +z, -x, -z) reaches, -1 for none; seeds: int64 flat node
- *       indices; out: bool (L, nz, nx) written: the valid nodes connected through links
- *       between valid nodes to a valid seed (navgrid.layered_reachable)
+ *   grid_labels(valid, link, L, nz, nx, out) -> k
+ *       valid: bool (L, nz, nx); link: int8 (L, nz, nx, 4) the level each node's step in
+ *       direction d (+x, +z, -x, -z) reaches, -1 for none; out: int32 (L, nz, nx)
+ *       written: the component of each valid node over the steps between valid nodes
+ *       (either way), numbered 1..k in the order of each component's first node, as
+ *       scipy's connected_components numbers them; 0 where there is no valid node
+ *       (arena_levels.grid_components, navgrid.layered_reachable)
  *
- * Why in C: numpy's way builds the link graph as (source, target) index pairs and
+ * Why in C: numpy's way builds the step graph as (source, target) index pairs and
  * hands it to scipy, some 70 bytes a node at its peak (a gigabyte on a 1 km terrain at
- * 0.5 m); union-find over the grid itself needs 4 bytes a node.
+ * 0.5 m); union-find over the grid itself needs the 4 bytes a node of the labels.
  */
 #include "_kernels.h"
 
@@ -23,29 +25,22 @@ static inline int32_t root32(int32_t *parent, int32_t a) {
     return a;
 }
 
-PyObject *tanktool_grid_reach(PyObject *self, PyObject *args) {
-    Py_buffer valid, link, seeds, out;
+PyObject *tanktool_grid_labels(PyObject *self, PyObject *args) {
+    Py_buffer valid, link, out;
     long long L, nz, nx;
-    if (!PyArg_ParseTuple(args, "y*y*LLLy*w*", &valid, &link, &L, &nz, &nx, &seeds, &out)) return NULL;
+    if (!PyArg_ParseTuple(args, "y*y*LLLw*", &valid, &link, &L, &nz, &nx, &out)) return NULL;
     const Py_ssize_t n = (Py_ssize_t)(L * nz * nx);
-    const Py_ssize_t k = seeds.len / 8;
     PyObject *ret = NULL;
-    int32_t *P = NULL;
-    if (!need(&valid, n, 1, "valid") || !need(&link, 4 * n, 1, "link") || !need(&out, n, 1, "out")) goto done;
+    long long k = 0;
+    if (!need(&valid, n, 1, "valid") || !need(&link, 4 * n, 1, "link") || !need(&out, n, 4, "out")) goto done;
     if (n >= INT32_MAX) {
-        PyErr_SetString(PyExc_ValueError, "grid_reach: more than 2**31 nodes");
-        goto done;
-    }
-    P = malloc(sizeof(int32_t) * (n > 0 ? n : 1));
-    if (P == NULL) {
-        PyErr_NoMemory();
+        PyErr_SetString(PyExc_ValueError, "grid_labels: more than 2**31 nodes");
         goto done;
     }
     {
         const uint8_t *V = valid.buf;
         const int8_t *K = link.buf;
-        const i64 *S = seeds.buf;
-        uint8_t *O = out.buf;
+        int32_t *P = out.buf;  /* the union-find's parents first, then the labels */
         const i64 per = nz * nx;
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t s = 0; s < n; ++s) P[s] = (int32_t)s;
@@ -60,30 +55,25 @@ PyObject *tanktool_grid_reach(PyObject *self, PyObject *args) {
                 if (!V[t]) continue;
                 int32_t a = root32(P, (int32_t)s), b = root32(P, (int32_t)t);
                 if (a == b) continue;
-                if (a < b) P[b] = a; else P[a] = b;
+                if (a < b) P[b] = a; else P[a] = b;  /* a root is its set's first node */
             }
         }
-        /* the seeds' roots (a handful): a node is kept when its root is one of them */
-        for (Py_ssize_t s = 0; s < n; ++s) O[s] = 0;
-        for (Py_ssize_t q = 0; q < k; ++q) {
-            const i64 s = S[q];
-            if (s < 0 || s >= n || !V[s]) continue;
-            O[root32(P, (int32_t)s)] = 1;  /* marks roots; non-roots are cleared below */
-        }
+        /* in node order (a parent always comes before its child: a root is its set's
+           first node, and path halving only moves a parent earlier): a root takes the
+           next label, any other node its parent's, which is labelled already; kept
+           negative meanwhile, so a label is never read as a parent */
         for (Py_ssize_t s = 0; s < n; ++s) {
-            if (!V[s]) continue;
-            const int32_t r = root32(P, (int32_t)s);
-            if (r != s && O[r]) O[s] = 1;
+            if (!V[s]) P[s] = 0;
+            else if (P[s] == s) P[s] = (int32_t)(-(++k));
+            else P[s] = P[P[s]];
         }
+        for (Py_ssize_t s = 0; s < n; ++s) P[s] = -P[s];
         Py_END_ALLOW_THREADS
     }
-    ret = Py_None;
-    Py_INCREF(ret);
+    ret = PyLong_FromLongLong(k);
 done:
-    free(P);
     PyBuffer_Release(&valid);
     PyBuffer_Release(&link);
-    PyBuffer_Release(&seeds);
     PyBuffer_Release(&out);
     return ret;
 }

@@ -126,7 +126,7 @@ def test_a_random_triangle_soup_cropped_by_the_grid_rasterises_the_same(seed):
 @needs_kernels
 @pytest.mark.parametrize("seed", range(6))
 def test_random_layered_grids_reach_the_same_nodes(seed):
-    """navgrid.layered_reachable: the grid's union-find (grid_reach) and numpy + scipy's
+    """navgrid.layered_reachable: the grid's union-find (grid_labels) and numpy + scipy's
     components keep the same nodes, links to invalid nodes, off the grid and to other
     levels included."""
     from tanktool.nav.navgrid import layered_reachable
@@ -143,4 +143,27 @@ def test_random_layered_grids_reach_the_same_nodes(seed):
     with use_kernels(False):
         b = layered_reachable(valid, link, seeds)
     assert a.dtype == b.dtype == bool and a.any()
+    np.testing.assert_array_equal(a, b)
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(6))
+def test_random_layered_grids_have_the_same_components(seed):
+    """arena_levels.grid_components: the compiled labels are scipy's, numbered alike."""
+    from tanktool.nav.arena_levels import grid_components
+    from tanktool.nav.navgrid import NavGrid
+
+    rng = np.random.default_rng(100 + seed)
+    L, nz, nx = int(rng.integers(1, 4)), int(rng.integers(2, 30)), int(rng.integers(2, 40))
+    valid = rng.random((L, nz, nx)) < 0.6
+    link = rng.integers(-1, L, size=(L, nz, nx, 4)).astype(np.int8)
+    link[rng.random(link.shape) < 0.4] = -1
+    link[:, :, -1, 0] = link[:, -1, :, 1] = link[:, :, 0, 2] = link[:, 0, :, 3] = -1  # no step off the grid
+    grid = NavGrid(np.zeros(2), 1.0, (nz, nx), valid, *(np.zeros((L, nz, nx), dtype=np.int32) for _ in range(4)),
+                   valid.copy(), 1.0, link=link)
+    with use_kernels(True):
+        a, ka = grid_components(grid)
+    with use_kernels(False):
+        b, kb = grid_components(grid)
+    assert ka == kb > 1
     np.testing.assert_array_equal(a, b)

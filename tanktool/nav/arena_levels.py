@@ -95,10 +95,13 @@ def grid_components(grid: NavGrid) -> tuple[np.ndarray, int]:
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from .navgrid import STEPS
+    from .navgrid import STEPS, compiled_labels
 
     valid = grid.valid
     link = grid.links()
+    compiled = compiled_labels(valid, link)
+    if compiled is not None:  # the same labels, in 4 bytes a node
+        return compiled
     L, nz, nx = valid.shape
     ids = np.full(valid.shape, -1, dtype=np.int64)
     pts = np.nonzero(valid)

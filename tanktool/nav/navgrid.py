@@ -596,25 +596,37 @@ def _runs_joined(valid: np.ndarray, joined: np.ndarray) -> tuple[np.ndarray, np.
     return index.reshape(m, n), total.reshape(m, n)
 
 
+def compiled_labels(valid: np.ndarray, link: np.ndarray) -> tuple[np.ndarray, int] | None:
+    """(labels, k): the components of a layered grid's valid nodes over its links
+    (either way), int32 (L, nz, nx) numbered 1..k in the order of each one's first node
+    as scipy numbers them, 0 off the valid nodes -- by the compiled union-find over the
+    grid (4 bytes a node, where index pairs and scipy's graph take ~70); None without
+    the compiled kernels (callers then use scipy)."""
+    from ..geometry.kernels import active
+
+    kern = active()
+    if kern is None or valid.size >= 2**31 or link.dtype != np.int8:
+        return None
+    L, nz, nx = valid.shape
+    out = np.empty(valid.shape, dtype=np.int32)
+    k = kern.grid_labels(np.ascontiguousarray(valid, dtype=bool), np.ascontiguousarray(link), L, nz, nx, out)
+    return out, int(k)
+
+
 def layered_reachable(valid: np.ndarray, link: np.ndarray, seeds: list) -> np.ndarray:
     """Valid nodes connected through links to any seed node ``(level, i, j)``."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
-    from ..geometry.kernels import active
-
     L, nz, nx = valid.shape
     n = valid.size
     if not seeds:
         return valid.copy()
-    kern = active()
-    if kern is not None and n < 2**31 and link.dtype == np.int8:
-        # union-find over the grid itself: 4 bytes a node, where the pairs below and
-        # scipy's graph take ~70 (the peak of a large import); the same nodes
-        out = np.zeros(valid.shape, dtype=bool)
-        flat = np.array([np.ravel_multi_index(tuple(int(v) for v in s), valid.shape) for s in seeds], dtype=np.int64)
-        kern.grid_reach(np.ascontiguousarray(valid, dtype=bool), np.ascontiguousarray(link), L, nz, nx, flat, out)
-        return out
+    compiled = compiled_labels(valid, link)
+    if compiled is not None:
+        label = compiled[0]
+        keep = np.unique([label[s] for s in seeds])
+        return np.isin(label, keep[keep > 0])
     src, dst = [], []
     base = np.arange(n).reshape(L, nz, nx)
     for d, (di, dj) in enumerate(STEPS.values()):
