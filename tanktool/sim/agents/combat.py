@@ -278,7 +278,13 @@ class Evade(State["Agent"]):
         if agent.path:
             if math.hypot(agent.path[-1][0] - me.x, agent.path[-1][1] - me.z) < 3.0:
                 return None
-            return agent.follow(view, agent.path, speed=1.0, lookahead=4.0, corner=agent.corner())
+            # backing and sliding along the way with the hull (and gun) kept on the
+            # threat, firing when the shot is good: turning round to drive it first
+            # left the tank crawling (about 1 m/s) in the threat's sight for seconds
+            threat = (p.sight.x, p.sight.z) if p.sight is not None else self.handoff[:2]
+            cmd = agent.approach(view, agent.path, threat, me.vehicle.top_speed)
+            fire = aim_and_fire(agent, view, p.sight)[1] if p.sight is not None else False
+            return Command(cmd.advance, cmd.rotate, cmd.strafe, fire)
         # no cover near: strafe hard across the threat's line, gun on it when seen
         if p.sight is not None:
             rotate, fire, _ = aim_and_fire(agent, view, p.sight)

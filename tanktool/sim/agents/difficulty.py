@@ -44,14 +44,16 @@ class Difficulty:
     #: holds vantage points and, leading, hiding places (``Agent(watch=...)`` too)
     watch: bool = True
     #: fights like a player who knows cover: closes in on a known enemy with the gun
-    #: on it, goes back behind the corner it came from while reloading (``scoot``), and breaks off
-    #: a fight it is losing
+    #: on it, hunts a camper, goes back behind the corner it came from while reloading
+    #: (``scoot``: no level), breaks off a fight it is losing (``break_off``: no level)
     cover: bool = False
     #: with ``cover``: goes back behind the corner it came round while it reloads
-    #: (False: keeps strafing.  A strafe builds up at about 1.5 m/s^2, so a tank that
-    #: shuttles to cover hardly moves across the line of fire: hard's median sideways
-    #: speed in its fights with the camper in the box was 0.5 m/s with it, 1.5 without)
-    scoot: bool = True
+    #: (False: keeps strafing.  No level does: a strafe builds up at about 1.5 m/s^2,
+    #: so a tank that shuttles to cover hardly moves across the line of fire: hard's
+    #: median sideways speed in its fights with the camper in the box was 0.5 m/s with
+    #: it, 1.5 without; normal with it drove 17 m in the first demo, play --headless
+    #: --seconds 10 --bots 2, without it 22 m)
+    scoot: bool = False
     #: with ``cover``: breaks off a fight it is losing (the ``losing`` row: to cover).
     #: No level does: hard against the robot and the duellist on box and paper2002 (8
     #: duels each) won 5-7 of 8 with it and 7 of 8 without, normal against the robot on
@@ -81,8 +83,7 @@ DIFFICULTIES: dict[str, Difficulty] = {
                          dodge_reaction=0.45, engage=40.0, stand_off=45.0, cover=True),
     "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.3), vision_range=130.0,
                        hearing_radius=120.0, think_hz=20.0, engine_radius=40.0, lead=1.0, fire_tolerance=0.5,
-                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, scoot=False,
-                       wait=True),
+                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, wait=True),
 }
 
 
