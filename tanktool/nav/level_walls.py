@@ -40,6 +40,7 @@ from ..geometry import contours, slivers
 from ..geometry import walls as cut
 from ..geometry.wall_pairs import Repairs, pair_tolerance, repair_walls
 from ..geometry.heightfield import FLAT_GAP, flat_heights
+from .inner_walls import inner_walls
 from .walkable import DIRS, Surface, surface_layers
 
 #: simplification of cell outlines as Recast does: the maximum edge error (cells) and
@@ -50,8 +51,6 @@ EDGE_MAX_LEN = contours.EDGE_MAX_LEN
 #: the foot of a steep obstacle (free below the cut, too low for a tank in the cells)
 #: can be two cells wide
 MARGIN = 2.5
-#: a thin wall of a higher cut within this of one already found is the same wall (m)
-THIN_MERGE = 0.15
 #: flat floors smaller than this (m^2) keep the cells' outline (stair treads)
 MIN_EXACT_AREA = 4.0
 #: a floor the exact cut replaces is mostly (by area) of faces horizontal to within
@@ -261,6 +260,159 @@ def _portal_pieces(pieces: np.ndarray, level: int, region_cells: np.ndarray, sur
     return out
 
 
+@dataclass
+class _Cut:
+    """What every region's walls are drawn from, prepared once by :func:`level_walls`."""
+
+    surface: Surface
+    origin: np.ndarray
+    cell: float
+    cell_h: float               # the height field's cell height (m)
+    exists: np.ndarray          # (L, nz, nx): a cell of the level
+    height: np.ndarray          # (L, nz, nx): its surface's height
+    span_of: np.ndarray         # (L, nz, nx): its surface span, -1 for none
+    span_flat: np.ndarray       # (L, nz, nx): its surface is a horizontal face
+    span_rim: np.ndarray        # (L, nz, nx): the rim of a steep obstacle, walkable below the climb
+    same: np.ndarray            # (L, nz, nx, 4): linked to the cell beside on the same level
+    cuts: ExactCuts
+    flat_h: np.ndarray          # heights of the model's floors (modelled_floors)
+    tolerance: float
+    climb_m: float
+    edge_error: float
+    edge_max_len: float | None
+    smooth_margin: bool
+
+    def simplify(self, poly):
+        """A cell outline simplified as Recast does (the module docstring's ``V``)."""
+        return contours.simplify_contour(poly, self.edge_error * self.cell, self.edge_max_len)
+
+
+@dataclass
+class _Floors:
+    """The exact floors of one region (the module docstring's ``E_h`` and ``M_h``)."""
+
+    exact: list = field(default_factory=list)      # E_h & M_h of each floor
+    removed: list = field(default_factory=list)    # M_h - E_h of each floor
+    chains: list = field(default_factory=list)     # (the cut's open chains near a floor, its E_h & M_h)
+    heights: list[tuple[float, float]] = field(default_factory=list)   # (height, area) of each floor
+    cells: np.ndarray | None = None                # cells of the floors (their walls are the cut's)
+
+
+def _prepare(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_height: float, headroom: float,
+             climb_m: float, tolerance: float, max_slope: float, edge_error: float, edge_max_len: float | None,
+             smooth_margin: bool) -> _Cut:
+    hf = surface.hf
+    exists, height, _, span_of = surface_layers(surface)
+    L, nz, nx = exists.shape
+    cuts = ExactCuts(vertices, faces, cut_height, headroom, tolerance, math.cos(math.radians(max_slope)), climb_m)
+    span_flat = np.zeros((L, nz, nx), dtype=bool)
+    span_rim = np.zeros((L, nz, nx), dtype=bool)
+    m = span_of >= 0
+    w_idx = np.flatnonzero(hf.walkable)  # surface spans are the walkable spans, in order
+    span_flat[m] = hf.flat[w_idx[span_of[m]]]
+    span_rim[m] = ~hf.top_walkable[w_idx[span_of[m]]]
+    lev = np.arange(L)[:, None, None]
+    same = np.stack([surface_link_level(surface, span_of, d) == lev for d in range(4)], axis=-1) & exists[..., None]
+    return _Cut(surface, hf.origin[[0, 2]], hf.cs, hf.ch, exists, height, span_of, span_flat, span_rim, same, cuts,
+                modelled_floors(vertices, faces), tolerance, climb_m, edge_error, edge_max_len, smooth_margin)
+
+
+def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
+    """The region's flat cells grouped by the model's floor they stand on; each floor
+    big enough is cut exactly (:func:`_cut_floor`)."""
+    from scipy import ndimage
+
+    fl = _Floors(cells=np.zeros_like(cells))
+    flat_cells = cells & c.span_flat[level]
+    if not (flat_cells.any() and len(c.flat_h)):
+        return fl
+    flat_h, cell = c.flat_h, c.cell
+    hy = c.height[level][flat_cells]
+    # the cluster whose height the span's top rounds up from (within a cell height)
+    pos = np.searchsorted(flat_h, hy + 1e-6, side="right") - 1
+    okc = (pos >= 0) & (hy - flat_h[np.maximum(pos, 0)] <= c.cell_h + 1e-6)
+    fi, fj = np.nonzero(flat_cells)
+    rim = cells & c.span_rim[level]
+    for k in np.unique(pos[okc]):
+        sel = okc & (pos == k)
+        mask = np.zeros_like(cells)
+        mask[fi[sel], fj[sel]] = True
+        # small patches (stair treads, bumps) keep the cells' outline
+        lab, nlab = ndimage.label(mask)
+        big = np.bincount(lab.ravel())[1:] * cell * cell >= MIN_EXACT_AREA
+        if not big.any():
+            continue
+        mask = np.isin(lab, np.flatnonzero(big) + 1)
+        present = flat_h[np.unique(pos[okc])]
+        base = float(present[present >= flat_h[k] - c.climb_m - 1e-9].min())
+        # the rims of steep obstacles standing on this floor (walkable only
+        # because they rise less than the climb) belong to it too
+        mask |= rim & (np.abs(c.height[level] - flat_h[k]) <= c.climb_m)
+        fl.cells |= mask
+        _cut_floor(c, cells, mask, float(flat_h[k]), base, fl)
+        fl.heights.append((float(flat_h[k]), float(mask.sum() * cell * cell)))
+    return fl
+
+
+def _cut_floor(c: _Cut, cells: np.ndarray, mask: np.ndarray, h: float, base: float, fl: _Floors) -> None:
+    """Add the exact free space of the floor at height ``h`` (its cells ``mask``) near
+    its cells, and what it takes away from the cells' outline, to ``fl``."""
+    origin, cell = c.origin, c.cell
+    sub, sub_origin = _crop(mask, _mask_box(mask, origin, cell, MARGIN + 1), origin, cell)
+    # simplified as V is: where the exact floor reaches past the region's cells
+    # (a walkable face beside a steep one in the same cell), M's outline is
+    # the region's, and a staircase there is voxel steps again
+    M = cells_polygon(sub, sub_origin, cell, c.tolerance)
+    M = shapely.buffer(c.simplify(M) if c.smooth_margin else M, MARGIN * cell, join_style="mitre")
+    box = M.bounds
+    # the region's other cells (terrain, ramps rising from the floor or
+    # coming up to a deck) are no obstacle of this floor: their outline stays
+    rising = _crop(cells & ~mask, box, origin, cell)
+    if rising is not None:
+        up = cells_polygon(rising[0], rising[1], cell, c.tolerance)
+        if c.smooth_margin:
+            up = c.simplify(up)
+        M = shapely.difference(M, up)
+    E, chains = c.cuts.at(h, box, base)
+    fl.exact.append(shapely.intersection(E, M))
+    fl.removed.append(shapely.difference(M, E))
+    for step in chains:
+        if step:
+            near = shapely.intersects(np.array(step, dtype=object), shapely.box(*box))
+            fl.chains.append(([ch for ch, k in zip(step, near) if k], fl.exact[-1]))
+
+
+def _region_free(c: _Cut, cells: np.ndarray, fl: _Floors):
+    """The region's free space ``R = (U_h E_h & M_h) | (V - U_h (M_h - E_h))``, cleaned
+    of slivers and simplified to the tolerance (empty when nothing is left)."""
+    tolerance = c.tolerance
+    V = c.simplify(cells_polygon(cells, c.origin, c.cell, tolerance))
+    R = shapely.difference(V, shapely.union_all(fl.removed)) if fl.removed else V
+    if fl.exact:
+        R = shapely.union_all([R, *fl.exact])
+    R = shapely.set_precision(R, tolerance)
+    R = slivers.drop_slivers(R, tolerance)
+    R = slivers.fill_sliver_holes(R, tolerance, c.cell)
+    if R.is_empty:
+        return R
+    return shapely.simplify(R, tolerance, preserve_topology=True)
+
+
+def _outline(c: _Cut, R, level: int, cells: np.ndarray) -> tuple[np.ndarray, float]:
+    """The walls of ``R``'s boundary, less the portals to other levels, and the
+    portals' length (m)."""
+    outline = cut.outline_walls(R, c.tolerance)
+    if not len(outline):
+        return outline, 0.0
+    pieces, owner = _pieces(outline, c.cell / 2)
+    if c.exists.shape[0] > 1:
+        portal = _portal_pieces(pieces, level, cells, c.surface, c.span_of, c.origin, c.cell)
+    else:
+        portal = np.zeros(len(pieces), dtype=bool)
+    length = float(np.hypot(*(pieces[portal, 1] - pieces[portal, 0]).T).sum())
+    return _rejoin(pieces, owner, ~portal), length
+
+
 def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_height: float,
                 headroom: float, climb_m: float, tolerance: float, max_slope: float,
                 edge_error: float = EDGE_ERROR, edge_max_len: float | None = EDGE_MAX_LEN,
@@ -270,133 +422,40 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     cells' outlines; ``smooth_margin`` simplifies the margins ``M_h`` so too (False,
     with ``edge_error=0.6, edge_max_len=None``: the walls before Recast's
     simplification, for bench/walls.py)."""
-    from scipy import ndimage
-
-    hf = surface.hf
-    cell = hf.cs
-    origin = hf.origin[[0, 2]]
-    exists, height, _, span_of = surface_layers(surface)
-    L, nz, nx = exists.shape
-    cuts = ExactCuts(vertices, faces, cut_height, headroom, tolerance, math.cos(math.radians(max_slope)), climb_m)
-    flat_h = modelled_floors(vertices, faces)
-    span_flat = np.zeros((L, nz, nx), dtype=bool)
-    span_rim = np.zeros((L, nz, nx), dtype=bool)
-    m = span_of >= 0
-    w_idx = np.flatnonzero(hf.walkable)  # surface spans are the walkable spans, in order
-    span_flat[m] = hf.flat[w_idx[span_of[m]]]
-    span_rim[m] = ~hf.top_walkable[w_idx[span_of[m]]]
-    lev = np.arange(L)[:, None, None]
-    same = np.stack([surface_link_level(surface, span_of, d) == lev for d in range(4)], axis=-1) & exists[..., None]
-    out_seg, out_dir, out_lev, out_reg = [], [], [], []
+    c = _prepare(surface, vertices, faces, cut_height, headroom, climb_m, tolerance, max_slope, edge_error,
+                 edge_max_len, smooth_margin)
+    L, nz, nx = c.exists.shape
+    origin, cell = c.origin, c.cell
+    out_seg, out_lev, out_reg = [], [], []
     regions: list[RegionWalls] = []
     thin_total = 0
     portal_len = 0.0
     repairs = Repairs()
     pair_tol = pair_tolerance(np.array([origin, origin + [nx * cell, nz * cell]]))
-    rid = 0
     for level in range(L):
-        labels, n = _region_labels(exists[level], same[level])
+        labels, n = _region_labels(c.exists[level], c.same[level])
         for k in range(1, n + 1):
             cells = labels == k
-            ys = height[level][cells]
-            V = cells_polygon(cells, origin, cell, tolerance)
-            V = contours.simplify_contour(V, edge_error * cell, edge_max_len)
-            exact_parts, removed, chains_in = [], [], []
-            used_h = []
-            floor = np.zeros_like(cells)  # cells of the exact floors (their walls are the cut's)
-            flat_cells = cells & span_flat[level]
-            if flat_cells.any() and len(flat_h):
-                hy = height[level][flat_cells]
-                # the cluster whose height the span's top rounds up from (within a cell height)
-                pos = np.searchsorted(flat_h, hy + 1e-6, side="right") - 1
-                okc = (pos >= 0) & (hy - flat_h[np.maximum(pos, 0)] <= hf.ch + 1e-6)
-                fi, fj = np.nonzero(flat_cells)
-                rim = cells & span_rim[level]
-                for c in np.unique(pos[okc]):
-                    sel = okc & (pos == c)
-                    mask = np.zeros_like(cells)
-                    mask[fi[sel], fj[sel]] = True
-                    # small patches (stair treads, bumps) keep the cells' outline
-                    lab, nlab = ndimage.label(mask)
-                    big = np.bincount(lab.ravel())[1:] * cell * cell >= MIN_EXACT_AREA
-                    if not big.any():
-                        continue
-                    mask = np.isin(lab, np.flatnonzero(big) + 1)
-                    present = flat_h[np.unique(pos[okc])]
-                    base = float(present[present >= flat_h[c] - climb_m - 1e-9].min())
-                    # the rims of steep obstacles standing on this floor (walkable only
-                    # because they rise less than the climb) belong to it too
-                    mask |= rim & (np.abs(height[level] - flat_h[c]) <= climb_m)
-                    floor |= mask
-                    sub, sub_origin = _crop(mask, _mask_box(mask, origin, cell, MARGIN + 1), origin, cell)
-                    # simplified as V is: where the exact floor reaches past the region's cells
-                    # (a walkable face beside a steep one in the same cell), M's outline is
-                    # the region's, and a staircase there is voxel steps again
-                    M = cells_polygon(sub, sub_origin, cell, tolerance)
-                    M = shapely.buffer(contours.simplify_contour(M, edge_error * cell, edge_max_len)
-                                       if smooth_margin else M, MARGIN * cell, join_style="mitre")
-                    box = M.bounds
-                    # the region's other cells (terrain, ramps rising from the floor or
-                    # coming up to a deck) are no obstacle of this floor: their outline stays
-                    rising = _crop(cells & ~mask, box, origin, cell)
-                    if rising is not None:
-                        up = cells_polygon(rising[0], rising[1], cell, tolerance)
-                        if smooth_margin:
-                            up = contours.simplify_contour(up, edge_error * cell, edge_max_len)
-                        M = shapely.difference(M, up)
-                    E, chains = cuts.at(float(flat_h[c]), box, base)
-                    exact_parts.append(shapely.intersection(E, M))
-                    removed.append(shapely.difference(M, E))
-                    for step in chains:
-                        if step:
-                            near = shapely.intersects(np.array(step, dtype=object), shapely.box(*box))
-                            chains_in.append(([ch for ch, k in zip(step, near) if k], exact_parts[-1]))
-                    used_h.append((float(flat_h[c]), float(mask.sum() * cell * cell)))
-            R = shapely.difference(V, shapely.union_all(removed)) if removed else V
-            if exact_parts:
-                R = shapely.union_all([R, *exact_parts])
-            R = shapely.set_precision(R, tolerance)
-            R = slivers.drop_slivers(R, tolerance)
-            R = slivers.fill_sliver_holes(R, tolerance, cell)
+            fl = _exact_floors(c, level, cells)
+            R = _region_free(c, cells, fl)
             if R.is_empty:
                 continue
-            R = shapely.simplify(R, tolerance, preserve_topology=True)
-            outline = cut.outline_walls(R, tolerance)
-            if len(outline):
-                pieces, owner = _pieces(outline, cell / 2)
-                portal = _portal_pieces(pieces, level, cells, surface, span_of, origin, cell) if L > 1 else \
-                    np.zeros(len(pieces), dtype=bool)
-                portal_len += float(np.hypot(*(pieces[portal, 1] - pieces[portal, 0]).T).sum())
-                outline = _rejoin(pieces, owner, ~portal)
-            thin = []
-            taken = None  # thin walls so far: a higher cut through the same slanted face
-            for chains, free in chains_in:  # finds them again a few cm aside
-                if taken is not None:
-                    free = shapely.difference(free, taken)
-                t = cut.thin_walls(chains, free, tolerance)
-                if len(t):
-                    thin.append(t)
-                    near = shapely.buffer(shapely.multilinestrings(list(t)), THIN_MERGE, cap_style="flat")
-                    taken = near if taken is None else shapely.union(taken, near)
-            thin = _unique_segments(np.concatenate(thin), tolerance) if thin else np.zeros((0, 2, 2))
-            ledges = ledge_walls(cells, same[level], origin, cell, cells & ~floor)
-            if smooth_margin:  # a ledge across terrain is cell steps too: simplified as outlines are
-                ledges = contours.simplify_chains(ledges, edge_error * cell)
-            if len(ledges):
-                thin = np.concatenate([thin, ledges])
-            thin = _split_crossings(_clip_crossings(thin, outline, R, tolerance), tolerance)
+            outline, length = _outline(c, R, level, cells)
+            portal_len += length
+            thin = inner_walls(fl.chains, outline, R, cells, c.same[level], cells & ~fl.cells, origin, cell,
+                               tolerance, edge_error * cell if smooth_margin else None)
             # what check would find (repeats, overlaps, normals into solid) repaired here
             segs, n_thin = repair_walls(outline, thin, R, pair_tol, repairs)
             thin_total += n_thin
+            rid = len(regions)
             out_seg.append(segs)
-            out_dir.append(np.ones(len(segs), dtype=np.int8))
             out_lev.append(np.full(len(segs), level))
             out_reg.append(np.full(len(segs), rid))
+            ys = c.height[level][cells]
             regions.append(RegionWalls(level, rid, R, float(np.nanmin(ys)), float(np.nanmax(ys)),
-                                       float(cells.sum() * cell * cell), used_h))
-            rid += 1
+                                       float(cells.sum() * cell * cell), fl.heights))
     seg = np.concatenate(out_seg) if out_seg else np.zeros((0, 2, 2))
-    walls = WallList(seg, np.concatenate(out_dir) if out_dir else np.zeros(0, dtype=np.int8), None, None, None,
+    walls = WallList(seg, np.ones(len(seg), dtype=np.int8), None, None, None,
                      np.concatenate(out_lev) if out_lev else None, np.concatenate(out_reg) if out_reg else None,
                      {r.region: (r.level, r.y_lo, r.y_hi) for r in regions})
     pts = seg.reshape(-1, 2) if len(seg) else np.array([origin, origin + [nx * cell, nz * cell]])
@@ -404,116 +463,6 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     hi = pts.max(axis=0) + AUX_MARGIN
     walls.aux = aux_rectangle(lo[0], lo[1], hi[0], hi[1])
     return LevelWalls(walls, regions, thin_total, portal_len, repairs)
-
-
-#: thin walls cut where they cross the outline end this far inside it [m]
-CLIP_INSET = 0.001
-
-
-def _crossings(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Proper crossings (an X, ends excluded) of the segments of ``a`` with those of
-    ``b``, both (n, 2, 2): (index in a, index in b, parameter along the a segment).
-    Candidate pairs come from an STR tree, so the cost follows the crossings found."""
-    if len(a) == 0 or len(b) == 0:
-        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0)
-    tree = shapely.STRtree(shapely.linestrings(b))
-    i, j = tree.query(shapely.linestrings(a), predicate="intersects")
-    p, r = a[i, 0], a[i, 1] - a[i, 0]
-    q, s = b[j, 0], b[j, 1] - b[j, 0]
-    den = r[:, 0] * s[:, 1] - r[:, 1] * s[:, 0]
-    qp = q - p
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (qp[:, 0] * s[:, 1] - qp[:, 1] * s[:, 0]) / den
-        u = (qp[:, 0] * r[:, 1] - qp[:, 1] * r[:, 0]) / den
-    eps = 1e-6
-    hit = (np.abs(den) > 1e-12) & (t > eps) & (t < 1 - eps) & (u > eps) & (u < 1 - eps)
-    return i[hit], j[hit], t[hit]
-
-
-def _split_crossings(seg: np.ndarray, tolerance: float) -> np.ndarray:
-    """Walls that cross each other (two cuts or a cut and a ledge through the same
-    steps) split at the crossing: they then meet at a point, an X becomes four walls
-    ending there."""
-    i, _, t = _crossings(seg, seg)
-    if len(i) == 0:
-        return seg
-    out = [seg[np.setdiff1d(np.arange(len(seg)), i)]]
-    for k in np.unique(i):
-        ts = np.concatenate([[0.0], np.sort(t[i == k]), [1.0]])
-        a, d = seg[k, 0], seg[k, 1] - seg[k, 0]
-        pts = a + ts[:, None] * d
-        pieces = np.stack([pts[:-1], pts[1:]], axis=1)
-        out.append(pieces[np.hypot(*(pieces[:, 1] - pieces[:, 0]).T) >= tolerance / 2])
-    return np.concatenate(out)
-
-
-def _clip_crossings(thin: np.ndarray, outline: np.ndarray, R, tolerance: float) -> np.ndarray:
-    """Thin walls that cross the region's outline (a fence found by the cut a few cm
-    past where the simplified outline runs) end on it instead: the part inside the
-    region is kept, so the two meet in a T, never an X."""
-    bad = np.zeros(len(thin), dtype=bool)
-    bad[_crossings(thin, outline)[0]] = True
-    if not bad.any():
-        return thin
-    # a millimetre inside: the written coordinates (0.1 mm) stay on this side of it
-    inside = shapely.intersection(shapely.linestrings(thin[bad]),
-                                  shapely.buffer(shapely.set_precision(R, 0.0), -CLIP_INSET, join_style="mitre"))
-    if shapely.is_empty(inside).all():
-        return thin[~bad]
-    return np.concatenate([thin[~bad], cut.line_segments(shapely.get_parts(shapely.line_merge(inside)), tolerance)])
-
-
-def ledge_walls(cells: np.ndarray, same: np.ndarray, origin: np.ndarray, cell: float,
-                loose: np.ndarray | None = None) -> np.ndarray:
-    """Walls across the *ledges* of a region: between two of its cells side by side
-    that do not link (a ramp's side high above the ground beside it, a step too high
-    across terrain), and along the middle of a one-cell gap between two of its cells
-    (Recast's ledge filter takes the rim of a ramp's side off the surface).  The
-    region's outline misses both, as the cells on either side are in it and the exact
-    floor beside a ramp reaches up to its side.  Only where one side at least is in
-    ``loose`` (cells off the exact floors, whose cut draws their walls; default all).
-    Runs along a row or column are one segment each; (k, 2, 2), one way."""
-    out = []
-    loose = cells if loose is None else loose
-    for axis in (1, 0):  # lines across +x (x = const), then across +z (z = const)
-        c = cells if axis == 1 else cells.T
-        lo_ = loose if axis == 1 else loose.T
-        sm = same if axis == 1 else same.transpose(1, 0, 2)
-        fwd_d, back_d = (0, 2) if axis == 1 else (1, 3)
-        n = c.shape[1]
-        edges = []
-        if n >= 2:   # neighbours not linked: the line between column k and k + 1
-            e = c[:, :-1] & c[:, 1:] & ~(sm[:, :-1, fwd_d] & sm[:, 1:, back_d]) & (lo_[:, :-1] | lo_[:, 1:])
-            edges.append((e, 1.0))
-        if n >= 3:   # a one-cell gap: the line through the middle of column k + 1
-            e = c[:, :-2] & ~c[:, 1:-1] & c[:, 2:] & (lo_[:, :-2] | lo_[:, 2:])
-            edges.append((e, 1.5))
-        for e, shift in edges:
-            if not e.any():
-                continue
-            lines = e.T                                 # rows: the lines, along them the runs
-            pad = np.zeros((lines.shape[0], lines.shape[1] + 2), dtype=np.int8)
-            pad[:, 1:-1] = lines
-            dif = np.diff(pad, axis=1)
-            line, start = np.nonzero(dif == 1)
-            _, stop = np.nonzero(dif == -1)
-            pos = (line + shift) * cell
-            lo, hi = start * cell, stop * cell
-            a = np.column_stack([pos, lo]) if axis == 1 else np.column_stack([lo, pos])
-            b = np.column_stack([pos, hi]) if axis == 1 else np.column_stack([hi, pos])
-            out.append(np.stack([a, b], axis=1) + origin)
-    return np.concatenate(out) if out else np.zeros((0, 2, 2))
-
-
-def _unique_segments(seg: np.ndarray, tolerance: float) -> np.ndarray:
-    """Segments snapped to the tolerance grid, each kept once whichever way it runs (the
-    cuts at several heights meet the same vertical face)."""
-    q = np.round(seg / tolerance).astype(np.int64)
-    a, b = q[:, 0], q[:, 1]
-    swap = (a[:, 0] > b[:, 0]) | ((a[:, 0] == b[:, 0]) & (a[:, 1] > b[:, 1]))
-    key = np.where(swap[:, None], np.concatenate([b, a], axis=1), np.concatenate([a, b], axis=1))
-    _, first = np.unique(key, axis=0, return_index=True)
-    return seg[np.sort(first)]
 
 
 def _mask_box(mask: np.ndarray, origin: np.ndarray, cell: float, grow: float) -> tuple[float, float, float, float]:
