@@ -43,7 +43,8 @@ class ImportResult:
     thin_walls: int
     seconds: float
     warnings: list[str] = field(default_factory=list)   # non-fatal remarks (a .bzw's unknown objects)
-    levels: Any = None  # nav.arena_levels.ArenaLevels: levels, what was left out, the tank grid
+    levels: Any = None  # nav.arena_levels.ArenaLevels: levels, what was left out, the tank grid (its surface
+    #                     is let go (None) once the pictures are drawn: the import's peak memory)
     params: Any = None  # the WalkableParams used
     defaults: dict[str, str] = field(default_factory=dict)  # where each default came from
     grid: Any = None    # grid_files.BuiltGrid: the navigation grid written with the bundle (None: not built)
@@ -143,6 +144,9 @@ def import_arena(
         doc = _manifest(tmp, model, companions, name, source, textures, height, tolerance, params, fits,
                         result, nav)
         write_toml(tmp / MANIFEST, doc)
+        # the surface (~100 bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m) is not
+        # needed past the pictures, and the grid below builds its own: let go before it
+        result.surface = None
         # the same files, built the same way, as build-navgrid on the bundle
         built = _stage_grid(tmp, fits, remark, progress) if grid else None
     return ImportResult(target, name, result.walls.walls, result.spawns, result.floor_y, len(mesh.faces),
