@@ -88,17 +88,17 @@ def test_exact_floors_are_modelled_floors_not_hilltops():
 def test_cells_polygon_looks_cells_up_as_the_winding_number_counts():
     """cells_polygon classifies the faces of the cells' outline by their cells: the
     same region as the crossing count of the generic winding rule."""
-    from tanktool.geometry import walls as cut
+    from tanktool.geometry import cross_section as xs
     from tanktool.nav.level_walls import cells_polygon
 
     rng = np.random.default_rng(5)
     mask = rng.random((40, 50)) < 0.55
     origin, cell = np.array([-3.25, 7.5]), 0.5
     fast = cells_polygon(mask, origin, cell, 0.01)
-    saved = cut._winding_region
+    saved = xs.winding_region
     try:
-        cut._winding_region = lambda seg, tol, inside=None: saved(seg, tol)
+        xs.winding_region = lambda seg, tol, inside=None: saved(seg, tol)
         slow = cells_polygon(mask, origin, cell, 0.01)
     finally:
-        cut._winding_region = saved
+        xs.winding_region = saved
     assert shapely.equals(fast, slow) and abs(fast.area - mask.sum() * cell * cell) < 1e-6

@@ -16,11 +16,11 @@ The pipeline, each step a function below:
    shared edge always yields the same cut point and loops close.
    Each cut segment keeps the horizontal part of its face normal: it says which
    side is solid.
-3. :func:`cross_sections` -- group the segments into components (connected
+3. :func:`cross_sections` (:mod:`.cross_section`) -- group the segments into components (connected
    through shared cut points).  Segments are ordered "face normal on the right", so
    a closed component with consistent normals that point out of it runs
    counter-clockwise and bounds solid; the solid cross-section is the set of points
-   of positive winding number over all such components (:func:`_winding_region`),
+   of positive winding number over all such components (:func:`winding_region`),
    so overlapping or nested boxes are one solid and no wall is left buried inside
    solid material.  A closed component whose normals point into it is a hole when
    it lies wholly in solid (a room inside a thick wall ring), a box wound inside
@@ -53,6 +53,7 @@ import shapely
 
 from ..errors import ArenaError
 from ..formats.walls_txt import WallList, aux_rectangle
+from .cross_section import cross_sections, winding_region
 from .thin_walls import line_segments, thin_walls, thin_walls_reference  # noqa: F401
 
 #: an upward face has a normal within ~25 degrees of +y
@@ -289,104 +290,6 @@ def slice_mesh(vertices: np.ndarray, faces: np.ndarray, y: float,
 
 
 # ---------------------------------------------------------------------------
-# 3. rings, chains and the solid cross-section
-
-
-def _components(nodes: np.ndarray) -> np.ndarray:
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    m = int(nodes.max()) + 1 if len(nodes) else 0
-    graph = coo_matrix((np.ones(len(nodes)), (nodes[:, 0], nodes[:, 1])), shape=(m, m))
-    _, label = connected_components(graph, directed=False)
-    return label[nodes[:, 0]]
-
-
-def cross_sections(segments: np.ndarray, normals: np.ndarray, nodes: np.ndarray, tolerance: float,
-                   floor: Any = None):
-    """Solid cross-section and thin-wall chains from oriented cut segments.
-
-    The segments come ordered "face normal on the right", so around a solid with
-    outward normals they run counter-clockwise: the solid is where the winding
-    number of the segments is positive.  Segments are grouped into components
-    (connected through shared cut points):
-
-    * closed (every cut point used an even number of times) and *consistent*
-      (as many segments enter each cut point as leave it) with positive area: the
-      boundary of solid material;
-    * the same with negative area (normals point into the loop): free space inside
-      solid when it lies within a positive solid (a room inside a thick wall ring),
-      otherwise, with floor all around its outside, a solid wound inside out
-      (taken as solid), and without, a one-sided shell seen from inside (levels
-      built of single faces): thin walls;
-    * open, or closed with inconsistent normals: thin walls, since nothing says
-      which side is solid.
-
-    Returns ``(solid, chains, n_closed)``: a shapely geometry, a list of shapely
-    LineStrings (thin walls before clipping) and the number of closed components.
-    """
-    if len(segments) == 0:
-        return shapely.Polygon(), [], 0
-    comp = _components(nodes)
-    ncomp = int(comp.max()) + 1
-    nn = int(nodes.max()) + 1
-    out_deg = np.bincount(nodes[:, 0], minlength=nn)
-    in_deg = np.bincount(nodes[:, 1], minlength=nn)
-    odd = (out_deg + in_deg) % 2 == 1
-    unbalanced = out_deg != in_deg
-    comp_odd = np.bincount(comp, weights=odd[nodes].any(axis=1), minlength=ncomp) > 0
-    comp_unbal = np.bincount(comp, weights=unbalanced[nodes].any(axis=1), minlength=ncomp) > 0
-    x0, z0 = segments[:, 0, 0], segments[:, 0, 1]
-    x1, z1 = segments[:, 1, 0], segments[:, 1, 1]
-    signed = np.bincount(comp, weights=(x0 * z1 - x1 * z0) / 2, minlength=ncomp)
-    consistent = ~comp_odd & ~comp_unbal
-    positive = consistent & (signed > 0)
-    negative = consistent & (signed < 0)
-    seg_pos = positive[comp]
-    solid = _winding_region(segments[seg_pos], tolerance) if seg_pos.any() else shapely.Polygon()
-    hole = np.zeros(ncomp, dtype=bool)
-    if negative.any() and not solid.is_empty:
-        seg_neg = negative[comp]
-        mid = segments[seg_neg].mean(axis=1)
-        # a negative loop lying within solid (up to its own outline) is a hole in it
-        near = shapely.dwithin(solid, shapely.points(mid), tolerance)
-        votes = np.bincount(comp[seg_neg], weights=near, minlength=ncomp)
-        total = np.bincount(comp[seg_neg], minlength=ncomp)
-        # all of it (but round-off): an inverted box overlapping a solid one is no hole
-        hole = negative & (votes >= 0.95 * np.maximum(total, 1))
-        if hole.any():
-            solid = _winding_region(segments[(positive | hole)[comp]], tolerance)
-    lone = negative & ~hole
-    if lone.any() and floor is not None and not floor.is_empty:
-        # a lone inward loop with floor all around its outside is a solid whose
-        # faces are wound inside out; with no floor outside it is a room's shell
-        sel = lone[comp]
-        n = normals[sel]
-        n = n / np.maximum(np.hypot(n[:, 0], n[:, 1]), 1e-300)[:, None]
-        probe = segments[sel].mean(axis=1) - 4 * tolerance * n
-        outside = shapely.contains_xy(floor, probe[:, 0], probe[:, 1])
-        votes = np.bincount(comp[sel], weights=outside, minlength=ncomp)
-        total = np.bincount(comp[sel], minlength=ncomp)
-        inverted = lone & (votes > 0.5 * np.maximum(total, 1))
-        if inverted.any():
-            flip = inverted[comp]
-            segments = segments.copy()
-            segments[flip] = segments[flip][:, ::-1]
-            positive = positive | inverted
-            solid = _winding_region(segments[(positive | hole)[comp]], tolerance)
-    thin = ~(positive | hole)
-    chains: list = []
-    if thin.any():
-        sel = thin[comp]
-        order = np.argsort(comp[sel], kind="stable")
-        s = segments[sel][order]
-        lines = shapely.linestrings(s.reshape(-1, 2), indices=np.repeat(np.arange(len(s)), 2))
-        groups = shapely.multilinestrings(lines, indices=np.unique(comp[sel][order], return_inverse=True)[1])
-        chains = list(shapely.get_parts(shapely.line_merge(groups)))
-    return solid, chains, int((~comp_odd).sum())
-
-
-# ---------------------------------------------------------------------------
 # 4-5. free space and its outline
 
 
@@ -415,42 +318,7 @@ def floor_region(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
     _, inv, count = np.unique(key, return_inverse=True, return_counts=True)
     boundary = count[inv.reshape(-1)] == 1
     seg = vertices[ev[boundary]][:, :, [0, 2]]
-    return _winding_region(seg, tolerance)
-
-
-def _winding_region(seg: np.ndarray, tolerance: float, inside: Callable[[np.ndarray], np.ndarray] | None = None):
-    """Points of positive winding number about directed segments (region on their left).
-
-    ``inside``, when given, says for (k, 2) points strictly inside the faces of the
-    segments' arrangement which are in the region, instead of counting crossings with
-    every segment (a mask of cells knows it by looking a point's cell up)."""
-    if len(seg) == 0:
-        return shapely.Polygon()
-    lines = shapely.linestrings(seg.reshape(-1, 2), indices=np.repeat(np.arange(len(seg)), 2))
-    chains = shapely.get_parts(shapely.line_merge(shapely.multilinestrings(lines), directed=True))
-    chains = shapely.simplify(chains, tolerance / 2)
-    coords, index = shapely.get_coordinates(chains, return_index=True)
-    same = index[1:] == index[:-1]
-    a = coords[:-1][same]
-    b = coords[1:][same]
-    noded = shapely.union_all(chains)
-    faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
-    if len(faces) == 0:
-        return shapely.Polygon()
-    rep = shapely.get_coordinates(shapely.point_on_surface(faces))
-    if inside is not None:
-        return shapely.union_all(faces[inside(rep)])
-    winding = np.zeros(len(rep))
-    # crossing number with signs, a block of faces at a time to bound memory
-    block = max(1, 2_000_000 // max(1, len(a)))
-    for s in range(0, len(rep), block):
-        p = rep[s:s + block, None, :]
-        up = (a[None, :, 1] <= p[..., 1]) & (b[None, :, 1] > p[..., 1])
-        down = (a[None, :, 1] > p[..., 1]) & (b[None, :, 1] <= p[..., 1])
-        side = (b[None, :, 0] - a[None, :, 0]) * (p[..., 1] - a[None, :, 1]) - \
-               (p[..., 0] - a[None, :, 0]) * (b[None, :, 1] - a[None, :, 1])
-        winding[s:s + block] = (up & (side > 0)).sum(axis=1) - (down & (side < 0)).sum(axis=1)
-    return shapely.union_all(faces[winding > 0])
+    return winding_region(seg, tolerance)
 
 
 def free_space(solid, floor):

@@ -37,6 +37,7 @@ import shapely
 
 from ..formats.walls_txt import WallList, aux_rectangle
 from ..geometry import contours, slivers
+from ..geometry import cross_section as xs
 from ..geometry import walls as cut
 from ..geometry.wall_pairs import Repairs, pair_tolerance, repair_walls
 from ..geometry.heightfield import FLAT_GAP, flat_heights
@@ -117,7 +118,7 @@ def cells_polygon(mask: np.ndarray, origin: np.ndarray, cell: float, tolerance: 
         ij = np.floor((p - origin) / cell).astype(np.int64)
         return m[ij[:, 1] + 1, ij[:, 0] + 1]
 
-    return cut._winding_region(seg, tolerance, in_cells)
+    return xs.winding_region(seg, tolerance, in_cells)
 
 
 class ExactCuts:
@@ -176,14 +177,14 @@ class ExactCuts:
             seg, nrm, nodes = cut.slice_mesh(v, self.cut_faces, y, self.merge)
             if len(seg):
                 # whole loops only: the components of the cut with a segment in the box
-                comp = cut._components(nodes)
+                comp = xs.components(nodes)
                 inside = (seg[:, :, 0].max(axis=1) >= x0) & (seg[:, :, 0].min(axis=1) <= x1) & \
                     (seg[:, :, 1].max(axis=1) >= z0) & (seg[:, :, 1].min(axis=1) <= z1)
                 keep = np.isin(comp, np.unique(comp[inside]))
                 seg, nrm = seg[keep], nrm[keep]
                 _, nodes = np.unique(nodes[keep], return_inverse=True)
                 nodes = nodes.reshape(-1, 2)
-            solid, ch, _ = cut.cross_sections(seg, nrm, nodes, tol, floor_poly)
+            solid, ch, _ = xs.cross_sections(seg, nrm, nodes, tol, floor_poly)
             solids.append(solid)
             chains.append(ch)
         solid = shapely.union_all(solids)
