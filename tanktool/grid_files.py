@@ -236,7 +236,7 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
     levels = max(surface.levels, 1)
     tc = walls_too_close(target.walls, origin, params.cell, shape, levels, clearance)
     grid = grid_from_surface(surface, clearance, origin, seeds=target.spawns, too_close=tc)
-    exists = surface_layers(surface)[0]
+    exists = surface_layers(surface, clearance=False)[0]
     return grid, (exists[0] if grid.levels == 1 else None)
 
 

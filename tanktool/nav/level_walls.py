@@ -303,7 +303,7 @@ def _prepare(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_heig
              climb_m: float, tolerance: float, max_slope: float, edge_error: float, edge_max_len: float | None,
              smooth_margin: bool) -> _Cut:
     hf = surface.hf
-    exists, height, _, span_of = surface_layers(surface)
+    exists, height, _, span_of = surface_layers(surface, clearance=False)
     L, nz, nx = exists.shape
     cuts = ExactCuts(vertices, faces, cut_height, headroom, tolerance, math.cos(math.radians(max_slope)), climb_m)
     span_flat = np.zeros((L, nz, nx), dtype=bool)

@@ -575,9 +575,27 @@ def layered_runs(valid: np.ndarray, link: np.ndarray) -> tuple[np.ndarray, ...]:
     return out[0], out[1], out[2], out[3]
 
 
+#: rows of _runs_joined worked on at once (about this many nodes): its temporaries are
+#: ~60 bytes a node, which on a whole large grid was the import's peak
+RUN_BLOCK = 1 << 20
+
+
 def _runs_joined(valid: np.ndarray, joined: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Runs along the last axis where each node's run continues to the next node only
-    when ``joined`` (and that node is valid)."""
+    when ``joined`` (and that node is valid); rows are independent, so they are worked
+    on in blocks of about RUN_BLOCK nodes."""
+    m, n = valid.shape
+    step = max(1, RUN_BLOCK // max(n, 1))
+    if m <= step:
+        return _runs_block(valid, joined)
+    index = np.empty((m, n), dtype=np.int32)
+    total = np.empty((m, n), dtype=np.int32)
+    for a in range(0, m, step):
+        index[a:a + step], total[a:a + step] = _runs_block(valid[a:a + step], joined[a:a + step])
+    return index, total
+
+
+def _runs_block(valid: np.ndarray, joined: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     m, n = valid.shape
     cont = np.zeros((m, n), dtype=bool)
     cont[:, :-1] = joined[:, :-1] & valid[:, 1:]

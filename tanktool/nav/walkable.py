@@ -393,23 +393,28 @@ def _main_region(hf: Heightfield, col, floor, region, seeds) -> np.ndarray:
     return region == int(np.argmax(sizes))
 
 
-def surface_layers(surface: Surface) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def surface_layers(surface: Surface, clearance: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray | None,
+                                                                       np.ndarray]:
     """The main region's spans as ``(L, nz, nx)`` layers: (node exists, height, voxel
-    clearance in metres, span index or -1)."""
+    clearance in metres (None when not asked for), span index or -1; int32 when the
+    spans' indices fit, as they do but on levels of billions of spans)."""
     nz, nx = surface.shape
     L = max(surface.levels, 1)
     m = np.flatnonzero(surface.level >= 0)
     at = surface.level[m] * (nz * nx) + surface.col[m]  # flat index into (L, nz, nx)
     exists = np.zeros(L * nz * nx, dtype=bool)
     height = np.full(L * nz * nx, np.nan)
-    clear = np.zeros(L * nz * nx)
-    span = np.full(L * nz * nx, -1, dtype=np.int64)
+    span = np.full(L * nz * nx, -1, dtype=np.int32 if len(surface.col) < 2**31 else np.int64)
     exists[at] = True
     height[at] = surface.y[m]
-    clear[at] = surface.clearance[m]
     span[at] = m
     shape = (L, nz, nx)
-    return exists.reshape(shape), height.reshape(shape), clear.reshape(shape), span.reshape(shape)
+    clear = None
+    if clearance:  # 8 bytes a node: only for those who read it
+        clear = np.zeros(L * nz * nx)
+        clear[at] = surface.clearance[m]
+        clear = clear.reshape(shape)
+    return exists.reshape(shape), height.reshape(shape), clear, span.reshape(shape)
 
 
 def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray, seeds: np.ndarray | None = None,
@@ -424,11 +429,12 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
     """
     from .navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3
 
-    exists, height, clear, span = surface_layers(surface)
+    exists, height, clear, span = surface_layers(surface, clearance=too_close is None)
     if too_close is None:
         valid = exists & (clear >= clearance)
     else:
         valid = exists & ~too_close
+    del clear
     L, nz, nx = valid.shape
     # each node's span, and the node its link reaches: flat indices throughout.  Links
     # and heights are kept for every node of the surface, valid (a tank fits) or not:

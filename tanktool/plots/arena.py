@@ -176,7 +176,7 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     panel_w = 9.0 if cols == 1 else 6.0
     fig_h = float(np.clip(rows * (panel_w * h / w + 0.9) + 0.6, 3.5, 22.0))
     fig = Figure(figsize=(panel_w * cols + 1.2, fig_h), dpi=size_px / (panel_w * cols + 1.2))
-    exists, height, _, _ = surface_layers(surface)
+    exists, height, _, _ = surface_layers(surface, clearance=False)
     nz, nx = hf.shape
     extent = (hf.origin[0], hf.origin[0] + nx * hf.cs, hf.origin[2], hf.origin[2] + nz * hf.cs)
     ys = height[exists]

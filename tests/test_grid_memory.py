@@ -1,0 +1,23 @@
+"""The grid's memory-bounded paths give the same results as the whole-array ones."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tanktool.nav import navgrid
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_runs_in_blocks_of_rows_are_the_runs_of_the_whole_grid(seed, monkeypatch):
+    rng = np.random.default_rng(seed)
+    L, nz, nx = int(rng.integers(1, 4)), int(rng.integers(5, 60)), int(rng.integers(5, 70))
+    valid = rng.random((L, nz, nx)) < 0.75
+    link = rng.integers(-1, L, size=(L, nz, nx, 4)).astype(np.int8)
+    whole = navgrid.layered_runs(valid, link)
+    for block in (1, 7, nx + 3, 3 * nx):  # one row a block, a row per block, several rows, uneven ends
+        monkeypatch.setattr(navgrid, "RUN_BLOCK", block)
+        for a, b in zip(navgrid.layered_runs(valid, link), whole):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+    assert whole[1].max() > 1  # runs longer than one node were found
