@@ -77,15 +77,23 @@ def test_a_respawned_member_is_protected_at_the_host_as_in_its_own_world(peers):
     match = NetMatch(host, load_match_arena("box"), load_tank_spec("light"), seed=3)
     w = match.world
     host.table[2] = P.Entry(2, 2, LOOPBACK, 40001, 40001, "member")
+    host.window.anchor(2, 0, host.clock())
+    sent = iter(range(1, 100))
+
+    def state(s: P.State) -> None:        # a state as the core takes it (and judges it)
+        now = host.clock()
+        assert host.core._on_state(P.Message(P.MessageType.STATE, 2, next(sent), now, s), now)
+        match._on_net(host.core.take_events())
+
     sx, sz, _ = w.spawns[1]
     t = host.session_time()
-    match._on_net([NetEvent("state", 2, P.State(2, t, 20.0, 20.0, 0, 0, 0, 0, 0, True))])
+    state(P.State(2, t, 20.0, 20.0, 0, 0, 0, 0, 0, True))
     match.judge.hit(2, 0.0, True, t)                      # the host killed it
     w.protected_until[1] = -math.inf                      # (it had fired before)
     t += w.respawn_delay + 0.1
     host.session_offset -= w.respawn_delay + 0.1          # the session clock moves on as much
     w.t = t
-    match._on_net([NetEvent("state", 2, P.State(2, t, sx, sz, 0, 0, 0, 0, 0, True))])
+    state(P.State(2, t, sx, sz, 0, 0, 0, 0, 0, True))
     assert match.judge.alive(2) and w.protected_until[1] > w.t
     match._on_net([NetEvent("shot", 2, P.Shot(2, t + 0.01, sx, sz, 0.0, 0.0, 0.0))])
     assert w.protected_until[1] == -math.inf

@@ -113,9 +113,15 @@ def test_no_shots_while_dead_and_no_early_respawn():
     f = _Feed()
     f.send(10.0, 10.0)
     f.judge.hit(2, 0.0, True, f.t)                       # the host says it died
-    assert f.shoot(10.0, 10.0) == "dead"
+    assert f.shoot(10.0, 10.0, t=f.t + 0.05) == "dead"
+    assert f.shoot(10.0, 10.0, t=f.t - 0.01) is None       # fired just before (the HIT overtook it)
     sx, sz, _ = f.judge.world.spawns[1]
-    assert f.send(sx, sz, alive=True).alive is False     # back at once: no
+    # alive just after: a state its peer sent before it heard of its death (the HIT
+    # overtook it): dropped, neither shown nor counted as a cheat
+    assert f.send(sx, sz, alive=True) is None and f.judge.corrections == {}
+    for _ in range(int(0.5 / STATE_DT)):
+        f.send(10.0, 10.0, alive=False)
+    assert f.send(sx, sz, alive=True).alive is False     # back long before the delay: no
     assert f.judge.corrections["respawn"] == 1
     for _ in range(int(3.0 / STATE_DT)):
         f.send(10.0, 10.0, alive=False)

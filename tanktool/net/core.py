@@ -123,6 +123,9 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
         #: a new host sends its table (and term) again then: members that were still
         #: waiting out the old host's silence dropped the first one
         self.announce_at: float | None = None
+        #: what every state and shot from the network goes through (a :class:`~.judge.Judge`
+        #: on the game's world; None: taken as they come)
+        self.judge: Any = None
 
     def start_host(self, address: tuple[str, int, int], now: float) -> None:
         """Start a session as player 1, the host, reachable at (ip, tcp port, udp port)."""
@@ -224,11 +227,28 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
             if n in self.table and n != self.number and not self.table[n].is_bot \
                     and now - self.last_heard.get(n, now) > self.silence:
                 self._remove(n, "silent")
+        if self.judge is not None and self.is_host:
+            self._kick_cheaters()
         if self.announce_at is not None and now >= self.announce_at:
             self.announce_at = None
             if self.is_host:
                 self._send_table()
         self._probe_tick(now)
+
+    def _kick_cheaters(self) -> None:
+        """The host disconnects a member the judge corrected too often for too long."""
+        t = self.session_time()
+        for e in self.players():
+            if e.number != self.number and not e.is_bot and self.judge.to_kick(e.number, t):
+                why = f"corrected more than {self.judge.config.kick_rate} times a second for " \
+                      f"{self.judge.config.kick_seconds} seconds"
+                self.kick(e.number, why, self.now)
+                self.events.append(NetEvent("cheater", e.number, e, why))
+
+    def _forget(self, n: int) -> None:
+        """Player ``n`` joined or left: the judge starts it afresh."""
+        if self.judge is not None:
+            self.judge.forget(n)
 
     # ------------------------------------------------------------------ leaving
     def _remove(self, n: int, reason: str) -> None:
@@ -249,6 +269,7 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
             return
         self.departed.add((n, e.epoch))
         self.freed.append(n)
+        self._forget(n)
         self.events.append(NetEvent("left", n, e, reason))
         players = [k for k, x in self.table.items() if not x.is_bot]
         if n == self.host_number and players:

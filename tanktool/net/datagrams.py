@@ -133,5 +133,15 @@ class DatagramsMixin:
         self.counters["states_received"] += 1
         self.states_from[m.sender] += 1
         self.latencies.append(P.age(now, m.timestamp))
-        self.events.append(NetEvent("state", m.sender, m.body))
+        body, reason = m.body, ""
+        if self.judge is not None:
+            # what its vehicle could have done (judge.py): a state beyond it shows the
+            # last valid pose; None: older than what the judge holds
+            was_alive = self.judge.alive(body.tank)
+            body = self.judge.state(body, self.session_time())
+            if body is None:
+                return True
+            if body.alive and not was_alive:
+                reason = "respawn"
+        self.events.append(NetEvent("state", m.sender, body, reason))
         return True

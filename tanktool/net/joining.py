@@ -153,6 +153,7 @@ class JoiningMixin:
         for k, other in list(self.links.items()):
             if k != n:
                 self._queue(other, news)
+        self._forget(n)
         self.events.append(NetEvent("joined", n, self.table[n]))
 
     def _refuse(self, link: Link, code: P.RefuseCode, text: str) -> None:
@@ -206,6 +207,7 @@ class JoiningMixin:
         for link in list(self.links.values()):
             if not link.outgoing:
                 self._queue(link, news)
+        self._forget(n)
         self.events.append(NetEvent("joined", n, self.table[n]))
         return n
 
@@ -243,6 +245,7 @@ class JoiningMixin:
                 self.table[e.number] = e
                 self._saw(e)
                 self.last_heard[e.number] = self.now
+                self._forget(e.number)
                 self.events.append(NetEvent("joined", e.number, e))
         for link in list(self.pending):
             if link.hello is not None:

@@ -202,6 +202,10 @@ class Judge:
         r = self.record(n)
         if s.t <= (r.last.t if r.last is not None else -math.inf) or (not r.alive and s.t <= r.died_at):
             return None                   # older than what we hold, or from before its death
+        if not r.alive and s.alive and s.t - r.died_at < self.config.jitter:
+            # sent before its peer heard of its death: the host's HIT overtook it (or the
+            # clocks differ by that much): not a respawn, and no cheat either
+            return None
         fault = self._fault(n, s, now)
         if fault is None:
             if not r.alive and s.alive:
@@ -241,7 +245,10 @@ class Judge:
                 return "ahead"
             return None if self.near_spawn(shot.x, shot.z) and self.on_surface(shot.x, shot.z) else "pose"
         if not r.alive or last is None or not last.alive:
-            return "dead"
+            # a shot fired just before its death may arrive after the host's HIT: taken
+            # (from its last pose, within its reload) when it says so by at most ``jitter``
+            if r.alive or last is None or not r.died_at - c.jitter <= shot.t <= r.died_at:
+                return "dead"
         if shot.t > now + c.ahead:
             return "ahead"
         reload = self._reload(n) * c.reload_factor

@@ -99,8 +99,9 @@ class Link:
 
 @dataclass(frozen=True)
 class NetEvent:
-    """What the core saw: ``kind`` is joined, left, host, state, shot, hit, adopt,
-    kicked or stepdown."""
+    """What the core saw: ``kind`` is joined, left, host, state (``reason`` "respawn"
+    when the judge saw it come back), shot, hit, adopt, kicked, cheater (the host
+    disconnected it) or stepdown."""
 
     kind: str
     number: int
@@ -270,11 +271,15 @@ class LinksMixin:
             if not self._may_speak(m.sender, body.tank):
                 self.dropped["impostor"] += 1
                 return
+            if self.judge is not None and self.judge.shot(body, self.session_time()) is not None:
+                return                         # refused (too soon, from afar, dead): the judge counts it
             self.events.append(NetEvent("shot", m.sender, body))
         elif isinstance(body, P.Hit):
             if m.sender != self.host_number:     # only the host decides a hit
                 self.dropped["not_host"] += 1
                 return
+            if self.judge is not None:
+                self.judge.hit(body.victim, body.hp, body.killed, body.t)
             self.events.append(NetEvent("hit", m.sender, body))
         elif isinstance(body, P.Exit):
             self._remove(link.number, "exit")

@@ -95,6 +95,8 @@ class SimCluster:
         self.on_events: Callable[[SimNode, list[NetEvent]], None] | None = None
         #: a node that stepped down rejoins the newer session at once, as a game does
         self.auto_rejoin = True
+        #: called at the start of every step (a game world moving on), with the time
+        self.on_step: Callable[[float], None] | None = None
 
     @property
     def now(self) -> float:
@@ -176,6 +178,8 @@ class SimCluster:
         end = self.now + seconds - 1e-9
         while self.now < end:
             self.udp.advance(self.step)
+            if self.on_step is not None:
+                self.on_step(self.now)
             self._deliver()
             for node in list(self.nodes.values()):
                 if not node.paused and not node.dead:
