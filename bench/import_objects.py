@@ -118,18 +118,18 @@ def main() -> None:
     ap.add_argument("--max", type=int, default=20000, help="largest number of objects (default 20000)")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
-    import fuzz_inputs
+    import fuzz_files
 
     rows, plans = [], []
     peer_ok = True
     with tempfile.TemporaryDirectory() as tmp:
         warm = Path(tmp) / "warm.3ds"          # imports and first calls out of the timings
-        warm.write_bytes(fuzz_inputs.threeds_objects(20))
+        warm.write_bytes(fuzz_files.threeds_objects(20))
         ours_3ds(warm)
         peer_3ds(warm)
         for n in [k for k in (250, 500, 1000, 2000, 5000, 10000, 20000) if k <= args.max]:
             p = Path(tmp) / f"m{n}.3ds"
-            p.write_bytes(fuzz_inputs.threeds_objects(n))
+            p.write_bytes(fuzz_files.threeds_objects(n))
             ours = timed(lambda: ours_3ds(p))
             peer = timed(lambda: peer_3ds(p)) if peer_ok else None
             peer_ok = peer_ok and peer is not None and peer * 4.5 < 60   # the next size would pass a minute

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from fuzz_inputs import line_op
+from fuzz_mutators import line_op
 from tanktool.check import RULES, run_check
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -38,7 +38,7 @@ def sources() -> list[tuple[str, Path | None]]:
     return out
 
 
-#: the mutations shared with every line-based format (tests/fuzz_inputs.py line_op)
+#: the mutations shared with every line-based format (tests/fuzz_mutators.py line_op)
 COMMON = {0: "delete", 1: "duplicate", 2: "swap", 3: "field", 9: "cut_line", 10: "cut_file"}
 
 

@@ -9,10 +9,8 @@ memory out of proportion to the file.
 from __future__ import annotations
 
 import json
-import math
 import os
 import shutil
-import struct
 import subprocess
 import sys
 import time
@@ -24,6 +22,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+import fuzz_files
 import fuzz_inputs as F
 from tanktool.check import run_check
 from tanktool.cli.main import cli
@@ -43,12 +42,12 @@ def _glb_bundle(tmp_path: Path, data: bytes) -> Path:
 
 # ------------------------------------------------------------------ glTF (issue 21)
 
-@pytest.mark.parametrize("case", sorted(F.named_glb_cases()))
+@pytest.mark.parametrize("case", sorted(fuzz_files.named_glb_cases()))
 def test_hostile_glb_is_refused_before_its_buffers_are_read(tmp_path, case):
     from tanktool.check.glb import load_triangles
     from tanktool.formats.models import load_scene
 
-    data = F.named_glb_cases()[case]
+    data = fuzz_files.named_glb_cases()[case]
     path = tmp_path / f"{case}.glb"
     path.write_bytes(data)
     tracemalloc.start()
@@ -69,7 +68,7 @@ def test_hostile_glb_is_refused_before_its_buffers_are_read(tmp_path, case):
 
 def test_negative_stride_glb_does_not_crash_check(tmp_path):
     """The 604-byte model.glb that ended ``tanktool check`` with a segmentation fault."""
-    bundle = _glb_bundle(tmp_path, F.named_glb_cases()["negative_stride"])
+    bundle = _glb_bundle(tmp_path, fuzz_files.named_glb_cases()["negative_stride"])
     p = subprocess.run([sys.executable, "-m", "tanktool", "check", str(bundle)], capture_output=True, text=True,
                        timeout=300)
     assert p.returncode == 1, (p.returncode, p.stderr)
@@ -78,7 +77,7 @@ def test_negative_stride_glb_does_not_crash_check(tmp_path):
 
 
 def test_self_listing_node_glb_is_an_error_in_check(tmp_path):
-    bundle = _glb_bundle(tmp_path, F.named_glb_cases()["node_lists_itself"])
+    bundle = _glb_bundle(tmp_path, fuzz_files.named_glb_cases()["node_lists_itself"])
     report = run_check([bundle])
     msgs = [d.message for d in report.diagnostics if d.severity == "error"]
     assert any("a node cannot be its own child" in m for m in msgs), msgs
@@ -92,7 +91,7 @@ def test_valid_glb_with_strides_and_nodes_reads_the_same_everywhere(tmp_path):
     from tanktool.formats.models import load_model
 
     path = tmp_path / "box.glb"
-    path.write_bytes(F.box_glb(interleaved=True))
+    path.write_bytes(fuzz_files.box_glb(interleaved=True))
     v, f = load_triangles(path)
     mesh = load_model(path, up="y")
     assert len(f) == len(mesh.faces) == 24                     # two instances of a 12-face box
@@ -107,7 +106,7 @@ def test_valid_glb_with_strides_and_nodes_reads_the_same_everywhere(tmp_path):
 def test_svg_arc_bomb_and_dxf_circle_bomb_are_refused_quickly(tmp_path):
     from tanktool.formats.models import load_scene
 
-    for name, data in (("arc.svg", F.svg_arc_bomb()), ("circle.dxf", F.dxf_circle_bomb())):
+    for name, data in (("arc.svg", fuzz_files.svg_arc_bomb()), ("circle.dxf", fuzz_files.dxf_circle_bomb())):
         p = tmp_path / name
         p.write_bytes(data)
         tracemalloc.start()
@@ -135,12 +134,12 @@ def test_many_3ds_objects_are_merged_and_linear(tmp_path):
     from tanktool.formats.models import load_scene
 
     p = tmp_path / "many.3ds"
-    p.write_bytes(F.threeds_objects(3000))
+    p.write_bytes(fuzz_files.threeds_objects(3000))
     scene = load_scene(p)
     (mesh,) = scene.geometry.values()
     assert len(mesh.faces) == 3000 * 12 and scene.metadata.get("3ds_instances") == []
     few = tmp_path / "few.3ds"
-    few.write_bytes(F.threeds_objects(30))
+    few.write_bytes(fuzz_files.threeds_objects(30))
     assert len(load_scene(few).geometry) == 30                 # small files keep their objects
 
 
@@ -149,7 +148,7 @@ def test_twenty_thousand_3ds_objects(tmp_path):
     from tanktool.formats.models import load_scene
 
     p = tmp_path / "many.3ds"
-    p.write_bytes(F.threeds_objects(20000))
+    p.write_bytes(fuzz_files.threeds_objects(20000))
     t0 = time.process_time()
     (mesh,) = load_scene(p).geometry.values()
     assert len(mesh.faces) == 240000
@@ -235,7 +234,7 @@ def test_bindings_of_the_wrong_types(tmp_path):
 
 @pytest.fixture(scope="module")
 def tape(tmp_path_factory) -> bytes:
-    return F.make_replay(tmp_path_factory.mktemp("tape"))
+    return fuzz_files.make_replay(tmp_path_factory.mktemp("tape"))
 
 
 @pytest.mark.parametrize("fields,match", [
@@ -260,7 +259,7 @@ def test_replay_header_fields_are_checked(tmp_path, tape, fields, match):
     from tanktool.sim.replay import read_replay
 
     p = tmp_path / "bad.ttr"
-    p.write_bytes(F.replay_with(tape, **fields))
+    p.write_bytes(fuzz_files.replay_with(tape, **fields))
     with pytest.raises(FormatError, match=match) as e:
         read_replay(p)
     assert str(p) in str(e.value) and "byte " in str(e.value)
@@ -270,7 +269,7 @@ def test_replay_zlib_bomb_is_refused_without_inflating(tmp_path, tape):
     from tanktool.sim.replay import read_replay
 
     p = tmp_path / "bomb.ttr"
-    p.write_bytes(F.zlib_bomb_replay(tape, 128 << 20))     # ~130 KB inflating to 128 MB
+    p.write_bytes(fuzz_files.zlib_bomb_replay(tape, 128 << 20))     # ~130 KB inflating to 128 MB
     tracemalloc.start()
     with pytest.raises(FormatError, match="zlib bomb"):
         read_replay(p)
@@ -281,7 +280,7 @@ def test_replay_zlib_bomb_is_refused_without_inflating(tmp_path, tape):
 
 def test_replay_with_a_path_for_an_integrator_through_the_cli(tmp_path, tape):
     p = tmp_path / "evil.ttr"
-    p.write_bytes(F.replay_with(tape, integrator="../../../../etc/passwd", arena_ref="../../../../etc"))
+    p.write_bytes(fuzz_files.replay_with(tape, integrator="../../../../etc/passwd", arena_ref="../../../../etc"))
     r = CliRunner().invoke(cli, ["play", "--replay", str(p), "--headless"])
     assert r.exit_code == 2 and "integrator" in r.output and "Traceback" not in r.output, r.output
 
@@ -375,14 +374,14 @@ def test_a_texture_name_too_long_for_the_file_system_is_not_found(tmp_path):
 
 
 def test_a_texture_huge_by_its_header_is_refused_before_decoding(tmp_path):
-    (tmp_path / "skin.jpg").write_bytes(F.jpeg_claiming(9000, 9000))   # 632 bytes, 243 MB decoded
+    (tmp_path / "skin.jpg").write_bytes(fuzz_files.jpeg_claiming(9000, 9000))   # 632 bytes, 243 MB decoded
     obj = _textured_obj(tmp_path, "newmtl skin\nmap_Kd skin.jpg\n")
     data, copied, said = _import_textures(obj)
     assert copied == [] and len(said) == 1 and "too large (9000 x 9000 pixels" in said[0]
 
 
 def test_texture_coordinates_of_the_wrong_shape_keep_the_colour(tmp_path):
-    (tmp_path / "skin.png").write_bytes(F.png_bytes(8, 8))
+    (tmp_path / "skin.png").write_bytes(fuzz_files.png_bytes(8, 8))
     obj = _textured_obj(tmp_path, "newmtl skin\nKd 1 0 0\nmap_Kd skin.png\n", vt="vt 0\nvt 1\nvt 0.5\n")
     data, copied, said = _import_textures(obj)        # was IndexError in trimesh's glb export
     assert data[:4] == b"glTF" and any("texture coordinates of shape" in s for s in said), said
@@ -398,7 +397,7 @@ def test_an_embedded_4096_image_is_kept_at_2048_in_model_glb(tmp_path):
     from tanktool.formats.gltf import _split_glb
 
     glb = tmp_path / "case.glb"
-    glb.write_bytes(F.glb_bytes(*F.textured_box_gltf(F.full_size_png(), "image/png")))
+    glb.write_bytes(fuzz_files.glb_bytes(*fuzz_files.textured_box_gltf(fuzz_files.full_size_png(), "image/png")))
     data, _, _ = _import_textures(glb)
     text, binary = _split_glb(data, "model.glb")
     doc = json.loads(text)
