@@ -137,10 +137,11 @@ def bench_arena(name: str, frames: int, rounds: int, size: tuple[int, int], seed
             fps[p].append(frame_time(lambda r=r: r.render(1.0, 30.0), p))
 
         def no_readback() -> None:
-            first.own_ctx = False
-            first.render(1.0, 30.0)
-            first.ctx.finish()
-            first.own_ctx = True
+            with first.ctx:                     # each renderer has its own context: make it current
+                first.own_ctx = False
+                first.render(1.0, 30.0)
+                first.ctx.finish()
+                first.own_ctx = True
 
         fps["draw"].append(frame_time(no_readback, "draw"))
     row["reference_fps"] = round(statistics.median(ref[DEFAULT]), 1)

@@ -210,3 +210,27 @@ def test_quality_option_picks_the_preset_for_the_run(tmp_path, monkeypatch):
     assert r.exit_code == 0 and (tmp_path / "q.png").is_file(), r.output
     r = CliRunner().invoke(cli, ["play", "--headless", "--quality", "ultra"])
     assert r.exit_code == 2 and "ultra" in r.output
+
+
+def test_renderers_in_one_process_each_draw_in_their_own_context():
+    """Each headless renderer has its own EGL context; one made after another must not
+    steal the first one's drawing (bench/render.py keeps one per preset side by side)."""
+    from tanktool.game.quality import PRESETS
+    from tanktool.game.render3d import Renderer3D
+    from tanktool.game.thumbnails import vehicle_picture
+
+    s = GameSession("box", bots=2, seed=1, player=False)
+    run_frames(s, 10)
+    a = Renderer3D(s, SIZE, quality=PRESETS["low"])
+    try:
+        before = a.render(hud=False)
+        b = Renderer3D(s, SIZE, quality=PRESETS["high"])
+        try:
+            b.render(hud=False)
+            vehicle_picture("light", (64, 48))           # the previews' own context, too
+            assert np.array_equal(a.render(hud=False), before)
+            assert np.array_equal(a.render_reference(), a.render_reference())
+        finally:
+            b.release()
+    finally:
+        a.release()

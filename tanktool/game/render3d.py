@@ -30,10 +30,11 @@ context and draws into its own framebuffer, so screenshots work without any disp
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -57,6 +58,19 @@ LOD_PIXELS = 70.0
 #: attenuation and fog come from the vertices
 ARENA_EDGE = 16.0
 HUD_VERTEX, HUD_FRAGMENT = shaders.HUD_VERTEX, shaders.HUD_FRAGMENT
+
+
+def _in_context(method: Callable) -> Callable:
+    """Run a method with the renderer's own (headless) context current: several renderers
+    or previews in one process each have one, and OpenGL draws in whichever is current
+    (another's object names there draw nothing or garbage)."""
+    @functools.wraps(method)
+    def run(self: "Renderer3D", *args: Any, **kw: Any) -> Any:
+        if not self.own_ctx:
+            return method(self, *args, **kw)
+        with self.ctx:
+            return method(self, *args, **kw)
+    return run
 
 
 # ---------------------------------------------------------------- GPU side of a model
@@ -197,6 +211,7 @@ class Renderer3D:
             out.append(GpuBatch(vao, depth, flat, self._texture(b), b.closed, b.mean_luma(), b.triangles))
         return out
 
+    @_in_context
     def set_quality(self, quality: Quality) -> None:
         """Switch the quality (shaders, shadow map, particle level)."""
         if quality != self.quality:
@@ -296,6 +311,7 @@ class Renderer3D:
         return math.atan2(fwd[2], fwd[0])
 
     # ------------------------------------------------------------------ frame
+    @_in_context
     def render(self, alpha: float = 1.0, fps: float = 0.0, message: str | None = None,
                hud: bool = True, controls: list[tuple[str, str]] | None = None) -> np.ndarray | None:
         """Draw one frame; headless, return it as an (h, w, 3) uint8 array (top row first)."""
@@ -430,6 +446,7 @@ class Renderer3D:
         self.ctx.disable(moderngl.BLEND)
 
     # ------------------------------------------------------------------ benchmark reference
+    @_in_context
     def render_reference(self, alpha: float = 1.0) -> np.ndarray | None:
         """The benchmark's reference: the same triangles (arena and tanks) with depth
         test, one colour, no light, texture, shadow, sky, effects or HUD; read back

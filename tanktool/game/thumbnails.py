@@ -44,12 +44,20 @@ def _bundle(kind: str, ref: Any) -> Path | None:
 def render_model(model: Any, size: tuple[int, int], eye: Any, target: Any, light: Any, ctx: Any = None,
                  tint: Any = None, span: float = 50.0, tint_amount: float = 0.8) -> np.ndarray:
     """(h, w, 3) uint8 picture of a :class:`~tanktool.game.meshes.Model`."""
+    window = ctx is not None
+    ctx = _context(ctx)
+    if window:
+        return _draw_model(ctx, True, model, size, eye, target, light, tint, span, tint_amount)
+    with ctx:                 # made current: a headless renderer's context may be the current one
+        return _draw_model(ctx, False, model, size, eye, target, light, tint, span, tint_amount)
+
+
+def _draw_model(ctx: Any, window: bool, model: Any, size: tuple[int, int], eye: Any, target: Any, light: Any,
+                tint: Any, span: float, tint_amount: float) -> np.ndarray:
     import moderngl
 
     from .render3d import SKY, _gl, look_at, perspective, set_uniform, vertex_format
 
-    window = ctx is not None
-    ctx = _context(ctx)
     w, h = size
     fbo = ctx.framebuffer(color_attachments=[ctx.renderbuffer(size)], depth_attachment=ctx.depth_renderbuffer(size))
     d = dict(SHADOWS=0, PER_PIXEL=1)
