@@ -21,3 +21,14 @@ def test_runs_in_blocks_of_rows_are_the_runs_of_the_whole_grid(seed, monkeypatch
             assert a.dtype == b.dtype
             np.testing.assert_array_equal(a, b)
     assert whole[1].max() > 1  # runs longer than one node were found
+
+
+def test_a_grid_image_samples_every_kth_cell_beyond_the_picture_size():
+    from tanktool.plots.arena import MAX_IMAGE_SIDE, image_step
+
+    step, extent = image_step((10, 20), np.array([-1.0, 2.0]), 0.5)
+    assert step == 1 and extent == (-1.0, 9.0, 2.0, 7.0)  # small grids: every cell, the grid's own extent
+    n = 2 * MAX_IMAGE_SIDE + 1
+    step, extent = image_step((7, n), np.array([0.0, 0.0]), 0.5)
+    assert step == 3 and -(-n // step) <= MAX_IMAGE_SIDE
+    assert extent[1] >= n * 0.5 and extent[1] - n * 0.5 < step * 0.5  # covers the grid, less than a sample over

@@ -17,6 +17,10 @@ from ..formats.walls_txt import WallList
 
 #: the free space's fill, the walls, their normals' ticks
 FREE_COLOUR = "#e8efe6"
+#: a grid image has at most this many samples a side: more than a panel has pixels (so
+#: the picture looks the same), while matplotlib's copies of a 4000 x 4000 grid (float
+#: RGBA at several stages) took gigabytes on a 2 km terrain
+MAX_IMAGE_SIDE = 1200
 WALL_COLOUR = "#202020"
 NORMAL_COLOUR = "#d04020"
 
@@ -178,7 +182,7 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     fig = Figure(figsize=(panel_w * cols + 1.2, fig_h), dpi=size_px / (panel_w * cols + 1.2))
     exists, height, _, _ = surface_layers(surface, clearance=False)
     nz, nx = hf.shape
-    extent = (hf.origin[0], hf.origin[0] + nx * hf.cs, hf.origin[2], hf.origin[2] + nz * hf.cs)
+    step, extent = image_step((nz, nx), hf.origin[[0, 2]], hf.cs)
     ys = height[exists]
     lo, hi = (float(ys.min()), float(ys.max())) if len(ys) else (0.0, 1.0)
     flat = hi - lo <= 2 * hf.ch
@@ -191,13 +195,13 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
         if flat:
             fill_region(ax, result.walls.free(lv), FREE_COLOUR)
         else:
-            img = np.where(exists[lv], height[lv], np.nan)
+            img = np.where(exists[lv, ::step, ::step], height[lv, ::step, ::step], np.nan)
             image = ax.imshow(img, origin="lower", extent=extent, cmap=cmap, vmin=lo, vmax=max(hi, lo + 1e-6),
                               interpolation="nearest", zorder=0)
         handles = []
         if lv == 0:
-            handles = _left_out_layers(ax, result, hf, surface, extent, PolyCollection, Patch, steep_faces, too_small,
-                                       low_headroom, unreachable)
+            handles = _left_out_layers(ax, result, hf, surface, (step, extent), PolyCollection, Patch, steep_faces,
+                                       too_small, low_headroom, unreachable)
         sel = walls.level == lv
         seg = walls.segments[sel]
         draw_segments(ax, seg, WALL_COLOUR, 1.2, zorder=3)
@@ -233,6 +237,17 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     return buf.getvalue()
 
 
+def image_step(shape: tuple[int, int], origin: np.ndarray, cell: float) -> tuple[int, tuple[float, ...]]:
+    """(step, extent) of a grid's image: every step-th cell each way (1 up to
+    MAX_IMAGE_SIDE cells a side), and the (x0, x1, z0, z1) those samples cover, each
+    drawn step cells wide."""
+    nz, nx = shape
+    step = max(1, -(-max(nz, nx) // MAX_IMAGE_SIDE))
+    w = step * float(cell)
+    return step, (float(origin[0]), float(origin[0]) + -(-nx // step) * w,
+                  float(origin[1]), float(origin[1]) + -(-nz // step) * w)
+
+
 def _spawns_on_level(result: Any, level: int) -> np.ndarray:
     """Which spawns stand on ``level`` (by the tank grid's node under them)."""
     sp = np.asarray(result.spawns, dtype=np.float64)
@@ -248,19 +263,22 @@ def _spawns_on_level(result: Any, level: int) -> np.ndarray:
     return best == level
 
 
-def _left_out_layers(ax, result, hf, surface, extent, PolyCollection, Patch, steep_faces, too_small, low_headroom,
+def _left_out_layers(ax, result, hf, surface, sampled, PolyCollection, Patch, steep_faces, too_small, low_headroom,
                      unreachable) -> list:
-    """Draw what the surface left out on ``ax``; returns legend handles."""
+    """Draw what the surface left out on ``ax`` (``sampled``: the image's step and
+    extent, image_step); returns legend handles."""
     nz, nx = hf.shape
+    step, extent = sampled
     handles = []
-    rgba = np.zeros((nz, nx, 4))
+    rgba = np.zeros((-(-nz // step), -(-nx // step), 4))
 
     def paint(cols, colour, label, area):
         if len(cols) == 0:
             return
         i, j = np.divmod(cols, nx)
+        on = (i % step == 0) & (j % step == 0)  # the cells the image samples
         c = matplotlib_rgba(colour)
-        rgba[i, j] = (*c[:3], 0.75)
+        rgba[i[on] // step, j[on] // step] = (*c[:3], 0.75)
         handles.append(Patch(color=colour, label=f"{label}: {area:,.0f} m^2"))
 
     cell2 = hf.cs ** 2

@@ -112,17 +112,23 @@ def _draw_nodes(ax, grid: Any, states: np.ndarray, fr: _Frame, labelling: bool) 
     edges when cells are big enough to show them."""
     from matplotlib.colors import ListedColormap
 
+    from .arena import image_step
+
     b = grid.bounds
+    extent = (b[0, 0], b[1, 0], b[0, 1], b[1, 1])
+    k, sampled = image_step(states.shape, grid.origin, grid.cell)
+    if k > 1:  # a grid of more cells than the picture has pixels: every k-th node
+        extent = sampled
     cmap = ListedColormap(list(STATE_COLOURS.values()))
     ax.imshow(
-        states, origin="lower", cmap=cmap, vmin=-0.5, vmax=3.5, interpolation="nearest",
-        extent=(b[0, 0], b[1, 0], b[0, 1], b[1, 1]), zorder=0,
+        states[::k, ::k], origin="lower", cmap=cmap, vmin=-0.5, vmax=3.5, interpolation="nearest",
+        extent=extent, zorder=0,
     )
     relief = fr.relief
     if relief is not None:  # reachable nodes shaded by their height
-        shade = np.where(states == 2, grid.heights()[0], np.nan)
+        shade = np.where(states[::k, ::k] == 2, grid.heights()[0, ::k, ::k], np.nan)
         ax.imshow(shade, origin="lower", cmap=HEIGHT_CMAP, vmin=relief[0], vmax=max(relief[1], relief[0] + 1e-6),
-                  alpha=0.85, interpolation="nearest", extent=(b[0, 0], b[1, 0], b[0, 1], b[1, 1]), zorder=0)
+                  alpha=0.85, interpolation="nearest", extent=extent, zorder=0)
     cell_pt = fr.cell_pt
     if cell_pt < 6:  # node centres and cell edges would turn into a smear
         return
