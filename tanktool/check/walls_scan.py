@@ -11,23 +11,50 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
-
 from ..errors import FormatError
-from ..formats.walls_txt import _MARKER_RE, AUX_MARKER, WallList, _is_enclosing_rectangle, _parse_marker
+from ..formats.walls_txt import (_MARKER_RE, AUX_MARKER, WallList, WallRows, _is_enclosing_rectangle,
+                                 _parse_marker)
 from .diagnostics import Diagnostic, diag
 
 MAX_COORD = 1e6  # m
 
 
+def _scan_wall(raw: str, path: str, lineno: int, out: list[Diagnostic]) -> tuple[list[float], int] | None:
+    """A wall line's coordinates and Direction, or None (blank, or a diagnostic added to ``out``)."""
+    body = raw.split("#", 1)[0].split()
+    if not body:
+        return None
+    if len(body) != 5:
+        out.append(diag("A101", path, lineno, f"expected 5 fields 'X1 Z1 X2 Z2 Direction', got {len(body)}"))
+        return None
+    try:
+        vals = [float(v) for v in body[:4]]
+    except ValueError:
+        out.append(diag("A101", path, lineno, f"expected 4 numbers then the Direction, got {' '.join(body[:4])!r}"))
+        return None
+    if not all(math.isfinite(v) for v in vals):
+        out.append(diag("A102", path, lineno, f"coordinates must be finite, got {' '.join(body[:4])}"))
+        return None
+    if max(abs(v) for v in vals) > MAX_COORD:
+        # no arena is 1000 km wide; such numbers are typos, and they would drown
+        # every other wall in floating-point rounding
+        out.append(diag("A102", path, lineno, f"coordinates beyond +-{MAX_COORD:g} m: {' '.join(body[:4])}",
+                        "check the number: walls are in metres"))
+        return None
+    try:
+        d = float(body[4])
+    except ValueError:
+        d = math.nan
+    if d not in (1.0, -1.0):
+        out.append(diag("A103", path, lineno, f"Direction must be +1 or -1, got {body[4]!r}"))
+        return None
+    return vals, int(d)
+
+
 def scan_walls_text(text: str, path: str) -> tuple[WallList, list[Diagnostic]]:
     """Parse what can be parsed; return the walls and one diagnostic per bad line."""
     out: list[Diagnostic] = []
-    segs: list[list[float]] = []
-    dirs: list[int] = []
-    lines: list[int] = []
-    levels: list[int] = []
-    region_of: list[int] = []
+    rows = WallRows()
     regions: dict = {}
     current = (0, 0)
     aux_start: int | None = None
@@ -46,67 +73,37 @@ def scan_walls_text(text: str, path: str) -> tuple[WallList, list[Diagnostic]]:
                 out.append(diag("A101", path, lineno, f"a second '{AUX_MARKER}' marker (the first is on line {marker_line})",
                                 "keep one marker, right before the 4 auxiliary walls"))
                 continue
-            aux_start, marker_line = len(segs), lineno
+            aux_start, marker_line = len(rows), lineno
             continue
-        body = raw.split("#", 1)[0].split()
-        if not body:
-            continue
-        if len(body) != 5:
-            out.append(diag("A101", path, lineno, f"expected 5 fields 'X1 Z1 X2 Z2 Direction', got {len(body)}"))
-            continue
-        try:
-            vals = [float(v) for v in body[:4]]
-        except ValueError:
-            out.append(diag("A101", path, lineno, f"expected 4 numbers then the Direction, got {' '.join(body[:4])!r}"))
-            continue
-        if not all(math.isfinite(v) for v in vals):
-            out.append(diag("A102", path, lineno, f"coordinates must be finite, got {' '.join(body[:4])}"))
-            continue
-        if max(abs(v) for v in vals) > MAX_COORD:
-            # no arena is 1000 km wide; such numbers are typos, and they would drown
-            # every other wall in floating-point rounding
-            out.append(diag("A102", path, lineno, f"coordinates beyond +-{MAX_COORD:g} m: {' '.join(body[:4])}",
-                            "check the number: walls are in metres"))
-            continue
-        try:
-            d = float(body[4])
-        except ValueError:
-            d = math.nan
-        if d not in (1.0, -1.0):
-            out.append(diag("A103", path, lineno, f"Direction must be +1 or -1, got {body[4]!r}"))
-            continue
-        segs.append(vals)
-        dirs.append(int(d))
-        lines.append(lineno)
-        levels.append(current[0])
-        region_of.append(current[1])
-    seg = np.array(segs, dtype=np.float64).reshape(-1, 2, 2)
-    direction = np.array(dirs, dtype=np.int8)
-    line_arr = np.array(lines, dtype=np.int64)
-    lev = np.array(levels, dtype=np.int64)
-    reg = np.array(region_of, dtype=np.int64)
+        wall = _scan_wall(raw, path, lineno, out)
+        if wall is not None:
+            rows.add(wall[0], wall[1], lineno, current)
+    return _with_aux(rows, regions, aux_start, marker_line, path, out), out
 
-    def wl(sl: slice, aux=None) -> WallList:
-        return WallList(seg[sl], direction[sl], aux, line_arr[sl], path, lev[sl], reg[sl], regions)
 
+def _with_aux(rows: WallRows, regions: dict, aux_start: int | None, marker_line: int, path: str,
+              out: list[Diagnostic]) -> WallList:
+    """The walls with their auxiliary rectangle taken apart (after the marker, else
+    the last 4 walls when they enclose the rest); what is wrong with it added to ``out``."""
+    wl, seg, line_arr = rows.wall_lists(path, regions)
     if aux_start is not None:
         n_aux = len(seg) - aux_start
         if n_aux != 4:
             out.append(diag("A104", path, marker_line,
                             f"expected 4 auxiliary walls after '{AUX_MARKER}', got {n_aux}"))
             # keep every wall as a wall: the checks below still see the arena's shape
-            return wl(slice(None)), out
+            return wl(slice(None))
         aux = seg[aux_start:]
         if not _is_enclosing_rectangle(aux, seg[:aux_start]):
             out.append(diag("A105", path, int(line_arr[aux_start]),
                             "the auxiliary walls must form an axis-aligned rectangle enclosing every wall"))
-        return wl(slice(None, aux_start), aux), out
+        return wl(slice(None, aux_start), aux)
     if len(seg) >= 4 and _is_enclosing_rectangle(seg[-4:], seg[:-4]):
-        return wl(slice(None, -4), seg[-4:]), out
+        return wl(slice(None, -4), seg[-4:])
     last = int(line_arr[-1]) if len(line_arr) else 0
     out.append(diag("A104", path, last,
                     f"no '{AUX_MARKER}' marker, and the last 4 walls are not a rectangle enclosing the others"))
-    return wl(slice(None)), out
+    return wl(slice(None))
 
 
 def scan_walls_file(path: str | Path) -> tuple[WallList, list[Diagnostic]]:

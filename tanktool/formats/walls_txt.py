@@ -25,6 +25,7 @@ import math
 import os
 import re
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -157,13 +158,46 @@ def _is_enclosing_rectangle(aux: np.ndarray, rest: np.ndarray) -> bool:
     return True
 
 
+class WallRows:
+    """The walls a reader has taken so far, each with its line, level and region
+    (shared by :func:`parse_walls` and check's tolerant scanner)."""
+
+    def __init__(self) -> None:
+        self.segs: list[list[float]] = []
+        self.dirs: list[int] = []
+        self.lines: list[int] = []
+        self.levels: list[int] = []
+        self.region_of: list[int] = []
+
+    def __len__(self) -> int:
+        return len(self.segs)
+
+    def add(self, vals: list[float], direction: int, lineno: int, current: tuple[int, int]) -> None:
+        """One wall: its coordinates, Direction and line, under the marker ``current`` (level, region)."""
+        self.segs.append(vals)
+        self.dirs.append(direction)
+        self.lines.append(lineno)
+        self.levels.append(current[0])
+        self.region_of.append(current[1])
+
+    def wall_lists(self, path: str, regions: dict) -> tuple[Callable[..., WallList], np.ndarray, np.ndarray]:
+        """A maker of the WallList of a slice of the walls (with ``aux`` as its auxiliary
+        rectangle), and the walls as arrays: (segments (n, 2, 2), lines (n,))."""
+        seg = np.array(self.segs, dtype=np.float64).reshape(-1, 2, 2)
+        direction = np.array(self.dirs, dtype=np.int8)
+        line_arr = np.array(self.lines, dtype=np.int64)
+        lev = np.array(self.levels, dtype=np.int64)
+        reg = np.array(self.region_of, dtype=np.int64)
+
+        def make(sl: slice, aux: np.ndarray | None = None) -> WallList:
+            return WallList(seg[sl], direction[sl], aux, line_arr[sl], path, lev[sl], reg[sl], regions)
+
+        return make, seg, line_arr
+
+
 def parse_walls(text: str, path: str = "<walls>") -> WallList:
     """Parse the text of a wall list.  Raises FormatError naming ``path:line``."""
-    segs: list[list[float]] = []
-    dirs: list[int] = []
-    lines: list[int] = []
-    levels: list[int] = []
-    region_of: list[int] = []
+    rows = WallRows()
     regions: dict[int, tuple[int, float, float]] = {}
     current = (0, 0)
     aux_start: int | None = None
@@ -172,7 +206,7 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
         if stripped.lower().startswith(AUX_MARKER):
             if aux_start is not None:
                 raise FormatError(f"{path}:{lineno}: second '{AUX_MARKER}' marker")
-            aux_start = len(segs)
+            aux_start = len(rows)
             continue
         if _MARKER_RE.match(stripped) and aux_start is None:
             current = _parse_marker(stripped, f"{path}:{lineno}", regions)
@@ -199,16 +233,8 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
             raise FormatError(f"{path}:{lineno}: Direction must be +1 or -1, got {body[4]!r}") from None
         if d not in (1.0, -1.0):
             raise FormatError(f"{path}:{lineno}: Direction must be +1 or -1, got {body[4]}")
-        segs.append(vals)
-        dirs.append(int(d))
-        lines.append(lineno)
-        levels.append(current[0])
-        region_of.append(current[1])
-    seg = np.array(segs, dtype=np.float64).reshape(-1, 2, 2)
-    direction = np.array(dirs, dtype=np.int8)
-    line_arr = np.array(lines, dtype=np.int64)
-    lev = np.array(levels, dtype=np.int64)
-    reg = np.array(region_of, dtype=np.int64)
+        rows.add(vals, int(d), lineno, current)
+    make, seg, line_arr = rows.wall_lists(path, regions)
     if aux_start is not None:
         if len(seg) - aux_start != 4:
             raise FormatError(
@@ -217,14 +243,13 @@ def parse_walls(text: str, path: str = "<walls>") -> WallList:
         aux = seg[aux_start:]
         if not _is_enclosing_rectangle(aux, seg[:aux_start]):
             raise FormatError(
-                f"{path}:{lines[aux_start]}: auxiliary walls must form an axis-aligned "
+                f"{path}:{line_arr[aux_start]}: auxiliary walls must form an axis-aligned "
                 "rectangle enclosing every wall"
             )
-        return WallList(seg[:aux_start], direction[:aux_start], aux, line_arr[:aux_start], path,
-                        lev[:aux_start], reg[:aux_start], regions)
+        return make(slice(None, aux_start), aux)
     if len(seg) >= 4 and _is_enclosing_rectangle(seg[-4:], seg[:-4]):
-        return WallList(seg[:-4], direction[:-4], seg[-4:], line_arr[:-4], path, lev[:-4], reg[:-4], regions)
-    return WallList(seg, direction, None, line_arr, path, lev, reg, regions)
+        return make(slice(None, -4), seg[-4:])
+    return make(slice(None))
 
 
 #: the most levels a wall list may name
