@@ -107,3 +107,74 @@ def test_the_camera_shakes_when_firing_or_hit_then_settles():
     assert hit > 2 * fired
     assert not shake(s, 0, s.t + SHAKE_S + 0.01).any()      # short: gone after SHAKE_S
     assert not shake(s, 1, s.t + 0.01).any()                # the other tank's camera does not shake
+
+
+@pytest.mark.parametrize("arena", sorted(DRIVES))
+def test_the_first_person_eye_never_enters_the_arena_and_looks_along_the_slope(arena):
+    """First person across the hills and through the fort (its ramp, its roof): the eye
+    is never inside a wall, a roof or the ground (the line from the hull's middle to it
+    crosses nothing, and the surface under it is below it), and it looks along the hull
+    up and down the slopes."""
+    points, climbs = DRIVES[arena]
+    s = GameSession(arena, bots=1, seed=1, player=True)
+    w = s.world
+    me = w.tanks[0]
+    w.tanks[1].alive = False
+    mesh = arena_mesh(load_model(str(Path(s.info.path) / "model.glb")))
+    cam = Camera(mesh)
+    me.place(*points[0], 0.0)
+    s.step()
+    inside, buried, late, top, tilted, recent = 0, 0, [], 0.0, 0.0, []
+    for x, z, heading in drive(s, points):
+        me.place(x, z, heading)
+        s.step()
+        top = max(top, me.y)
+        tilted = max(tilted, abs(me.pitch))
+        eye, target = cam.pose(s, 1.0, "first-person")
+        centre = (me.x, me.y + 0.6 * me.spec.height, me.z)
+        inside += mesh.first_hit(centre, tuple(eye)) is not None
+        buried += mesh.first_hit(tuple(eye), tuple(eye - np.array([0.0, 0.2, 0.0]))) is not None
+        look = (target - eye) / np.linalg.norm(target - eye)
+        # the view's pitch against the hull's: off by at most how much the hull tilted in
+        # the last 0.4 s (the smoothing's lag) and a few degrees (it looks a little down)
+        recent = (recent + [me.pitch])[-int(0.4 / s.dt):]
+        lag = max(abs(p - me.pitch) for p in recent)
+        late.append(abs(math.asin(float(look[1])) - me.pitch) - lag)
+    assert top >= climbs and tilted > math.radians(8)        # up the hills / the ramp: real slopes
+    assert (inside, buried) == (0, 0), (inside, buried)
+    assert math.degrees(max(late)) < 6.0, math.degrees(max(late))
+
+
+def test_the_first_person_eye_stays_under_a_roof_and_behind_a_wall():
+    """A roof just over the turret and a wall at the nose (a low passage, a tank pressed
+    against a wall): the eye is pulled in towards the hull's middle, short of both."""
+    from tanktool.sim.ground import MeshIndex
+
+    s = GameSession("box", bots=1, seed=1, player=True)
+    me = s.world.tanks[0]
+    me.place(30.0, 30.0, 0.0)                               # facing +x
+    s.step()
+    h, r = me.spec.height, me.spec.radius
+    y = me.y
+
+    def quad(a, b, c, d):
+        return [a, b, c, a, c, d]
+
+    def pose(tris):
+        v = np.array(tris, dtype=np.float64)
+        cam = Camera(MeshIndex(v, np.arange(len(v), dtype=np.int64).reshape(-1, 3)) if len(v) else None)
+        return cam.pose(s, 1.0, "first-person")
+
+    free, _ = pose([])
+    assert free[1] == pytest.approx(y + h + 0.4, abs=0.05)            # over the turret when nothing is near
+    roof_y = y + h + 0.1
+    roof = quad((20, roof_y, 20), (40, roof_y, 20), (40, roof_y, 40), (20, roof_y, 40))
+    wall_x = 30.0 + 0.3 * max(r, 1.0) - 0.1                 # right at the nose
+    wall = quad((wall_x, y - 1, 20), (wall_x, y + 10, 20), (wall_x, y + 10, 40), (wall_x, y - 1, 40))
+    for tris in (roof, wall, roof + wall):
+        eye, target = pose(tris)
+        assert eye[1] < roof_y or tris is wall
+        assert eye[0] < wall_x or tris is roof
+        mesh = MeshIndex(np.array(tris, float), np.arange(len(tris), dtype=np.int64).reshape(-1, 3))
+        assert mesh.first_hit((me.x, y + 0.6 * h, me.z), tuple(eye)) is None     # the hull's side of both
+        assert target[0] > eye[0] + 5.0                                       # still looking ahead

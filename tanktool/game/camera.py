@@ -14,7 +14,9 @@ tank, not into the ground or over it), and keeps the tank in view:
   constants (the view does not jolt when the hull bumps); it pulls in at once (a wall
   must never hide the tank) and lets out slowly (no swinging near walls).
 
-First person looks along the hull, its pitch smoothed the same way.  Both shake for
+First person sits over the turret, tilted with the hull, and looks along it, its
+heading and pitch smoothed the same way; a roof over the tank or a wall at its nose pulls
+the eye in towards the hull's middle (never into the arena).  Both shake for
 a moment when the tank fires, is hit, or something blows up near by (:func:`shake`).  The pose is a
 pure function of the session and the smoothing state: tests run it without OpenGL.
 """
@@ -29,8 +31,9 @@ import numpy as np
 
 #: behind and above the tank, and the look-ahead, in tank radii (at least 1 m each)
 BACK, UP, AHEAD = 4.5, 2.2, 2.5
-#: the eye stays this far from the arena's surfaces [m]
-CLEARANCE = 0.6
+#: the eye stays this far from the arena's surfaces [m]: the chase camera's, first person's
+#: (the near plane is 0.3 m: a surface closer than that would be cut open)
+CLEARANCE, FP_CLEARANCE = 0.6, 0.35
 #: time constants of the smoothing [s]: heading and pitch, the swing, letting the eye out
 TURN_S, SWING_S, OUT_S = 0.12, 0.25, 0.6
 #: the camera's pitch follows the hull's this much (the rest stays level: the horizon reads)
@@ -103,12 +106,23 @@ class Camera:
         p = np.array([x, y, z])
         jolt = shake(session, t.index, now)
         if mode == "first-person":
-            f = np.array([math.cos(e.heading), 0.0, math.sin(e.heading)])
-            eye = p + np.array([0.0, t.spec.height + 0.4, 0.0]) + f * 0.3 * max(t.spec.radius, 1.0)
-            look = f * math.cos(e.pitch) + np.array([0.0, math.sin(e.pitch), 0.0])
-            return eye + jolt, eye + look * 10.0 + np.array([0.0, -0.6, 0.0]) + 2.0 * jolt
+            return self._first_person(t, p, e, jolt)
         eye, target = self._chase(session, t, p, e)
         return eye + jolt, target + 0.5 * jolt
+
+    # ------------------------------------------------------------------ first person
+    def _first_person(self, t: Any, p: np.ndarray, e: _Eased, jolt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The eye over the turret, tilted with the hull (along its slope's normal), pulled
+        in towards the hull's middle before it would touch the arena (a roof over it, a
+        wall at its nose); it looks along the hull, a little down."""
+        c, s_ = math.cos(e.heading), math.sin(e.heading)
+        cp, sp = math.cos(e.pitch), math.sin(e.pitch)
+        f = np.array([c * cp, sp, s_ * cp])                  # along the hull
+        up = np.array([-c * sp, cp, -s_ * sp])               # the hull's up
+        centre = p + np.array([0.0, 0.6 * t.spec.height, 0.0])
+        want = p + up * (t.spec.height + 0.4) + f * 0.3 * max(t.spec.radius, 1.0) + jolt
+        eye = centre + self._room(centre, want, FP_CLEARANCE) * (want - centre)
+        return eye, eye + f * 10.0 + np.array([0.0, -0.6, 0.0]) + 2.0 * jolt
 
     # ------------------------------------------------------------------ chase
     def _chase(self, session: Any, t: Any, p: np.ndarray, e: _Eased) -> tuple[np.ndarray, np.ndarray]:
@@ -177,19 +191,20 @@ class Camera:
         e.pull += (1.0 - math.exp(-dt / OUT_S)) * (1.0 - e.pull)
         return e
 
-    def _room(self, pivot: np.ndarray, want: np.ndarray) -> float:
-        """How far (0..1) from the pivot towards the wanted eye the arena lets it go."""
+    def _room(self, pivot: np.ndarray, want: np.ndarray, clearance: float = CLEARANCE) -> float:
+        """How far (0..1) from the pivot towards the wanted eye the arena lets it go, the
+        eye ``clearance`` short of what is in the way."""
         if self.mesh is None:
             return 1.0
         d = float(np.linalg.norm(want - pivot))
         if d < 1e-9:
             return 1.0
         # reach past the eye by the clearance: the eye must not touch what is behind it
-        beyond = pivot + (want - pivot) * (1.0 + CLEARANCE / d)
+        beyond = pivot + (want - pivot) * (1.0 + clearance / d)
         hit = self.mesh.first_hit(tuple(pivot), tuple(beyond))
         if hit is None:
             return 1.0
-        return max(hit * (1.0 + CLEARANCE / d) - CLEARANCE / d, 0.08)
+        return max(hit * (1.0 + clearance / d) - clearance / d, 0.08 if clearance >= CLEARANCE else 0.0)
 
     def _clear(self, eye: np.ndarray) -> np.ndarray:
         """Lift the eye to ``CLEARANCE`` over the surface right under it."""
