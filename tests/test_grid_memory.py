@@ -32,3 +32,23 @@ def test_a_grid_image_samples_every_kth_cell_beyond_the_picture_size():
     step, extent = image_step((7, n), np.array([0.0, 0.0]), 0.5)
     assert step == 3 and -(-n // step) <= MAX_IMAGE_SIDE
     assert extent[1] >= n * 0.5 and extent[1] - n * 0.5 < step * 0.5  # covers the grid, less than a sample over
+
+
+@pytest.mark.skipif(not __import__("tanktool.geometry.kernels", fromlist=["x"]).available(),
+                    reason="the compiled kernels are not built")
+@pytest.mark.parametrize("seed", range(4))
+def test_a_levels_regions_are_labelled_alike_compiled_and_by_scipy(seed):
+    from tanktool.geometry.kernels import use_kernels
+    from tanktool.nav.level_walls import _region_labels
+
+    rng = np.random.default_rng(200 + seed)
+    nz, nx = int(rng.integers(3, 50)), int(rng.integers(3, 60))
+    cells = rng.random((nz, nx)) < 0.7
+    same = rng.random((nz, nx, 4)) < 0.6
+    same[:, -1, 0] = same[-1, :, 1] = same[:, 0, 2] = same[0, :, 3] = False  # no link off the grid
+    with use_kernels(True):
+        a, na = _region_labels(cells, same)
+    with use_kernels(False):
+        b, nb = _region_labels(cells, same)
+    assert na == nb > 1
+    np.testing.assert_array_equal(a, b)

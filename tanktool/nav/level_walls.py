@@ -494,10 +494,18 @@ def surface_link_level(surface: Surface, span_of: np.ndarray, d: int) -> np.ndar
 
 
 def _region_labels(cells: np.ndarray, same: np.ndarray) -> tuple[np.ndarray, int]:
-    """Components of a level's cells joined by links that stay on the level."""
+    """Components of a level's cells joined by links that stay on the level (labels
+    1..n in the order of each one's first cell, 0 elsewhere)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
+    from .navgrid import compiled_labels
+
+    steps = np.where(same, np.int8(0), np.int8(-1))[None]  # a one-level grid's links, int8
+    compiled = compiled_labels(cells[None], steps)
+    if compiled is not None:  # the same labels in 5 bytes a cell, where the pairs below take ~70
+        return compiled[0][0], compiled[1]
+    del steps
     nz, nx = cells.shape
     idx = np.full(cells.shape, -1, dtype=np.int64)
     ci, cj = np.nonzero(cells)
