@@ -11,7 +11,9 @@ tree, points sampled over its surface.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 
@@ -33,15 +35,20 @@ SURFACE_SAMPLES = 20_000
 SURFACE_SEED = 2002
 
 
-def scan_hull(path: Path) -> tuple[np.ndarray, list[Diagnostic]]:
-    out: list[Diagnostic] = []
-    rows: list[list[float]] = []
+def _data_lines(path: Path) -> Iterator[tuple[int, str, list[str]]]:
+    """(line number, text without its comment, fields) of each line of ``path`` that
+    holds data (undecodable bytes read as U+FFFD, so such a line is a bad one)."""
     text = path.read_bytes().decode("utf-8", errors="replace")
     for no, raw in enumerate(text.splitlines(), 1):
         line = raw.split("#", 1)[0].strip()
-        if not line:
-            continue
-        parts = line.split()
+        if line:
+            yield no, line, line.split()
+
+
+def scan_hull(path: Path) -> tuple[np.ndarray, list[Diagnostic]]:
+    out: list[Diagnostic] = []
+    rows: list[list[float]] = []
+    for no, line, parts in _data_lines(path):
         try:
             xyz = [float(p) for p in parts]
         except ValueError:
@@ -67,12 +74,7 @@ def scan_spheres(path: Path) -> tuple[SphereTree | None, np.ndarray, list[Diagno
     out: list[Diagnostic] = []
     rows: list[tuple[int, int, int, float, float, float, float]] = []
     lines: list[int] = []
-    text = path.read_bytes().decode("utf-8", errors="replace")
-    for no, raw in enumerate(text.splitlines(), 1):
-        line = raw.split("#", 1)[0].strip()
-        if not line:
-            continue
-        parts = line.split()
+    for no, line, parts in _data_lines(path):
         where = (str(path), no)
         n = len(rows)
         try:
@@ -258,7 +260,30 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
     name = man.get("", "name")
     name = name if isinstance(name, str) and name else bundle.name
     out += file_rules(man, bundle, ("hull.txt", "spheres.txt"))
+    mass, inertia, com = _mass_rules(man, out)
+    _drive_rules(man, mass, out)
+    shapes = _Shapes.read(man, bundle, out)
+    hull = shapes.hull
+    if hull is not None and com is not None and inertia is not None and mass is not None and mass > 0 and inertia > 0:
+        _inertia_rules(man, hull, com, mass, inertia, out)
+    model = man.get("model", "file")
+    mfile = safe_file(bundle, model) if isinstance(model, str) and model else None
+    if model_rules and mfile is not None and mfile.is_file() and (hull is not None or shapes.tree is not None):
+        _model_rules(man, mfile, shapes, out)
+    if hull is not None:
+        return out, VehicleSize(name, float(np.max(np.hypot(hull[:, 0], hull[:, 2]))), mpath,
+                                man.lines.key("", "footprint_radius") or man.lines.key("hull", "file"),
+                                footprint=convex_hull_2d(hull[:, [0, 2]]), height=float(np.ptp(hull[:, 1])))
+    r = man.get("", "footprint_radius")
+    if isinstance(r, (int, float)) and not isinstance(r, bool) and math.isfinite(r) and r > 0:
+        return out, VehicleSize(name, float(r), mpath, man.lines.key("", "footprint_radius"))
+    return out, None
 
+
+def _mass_rules(man: Manifest, out: list[Diagnostic]) -> tuple[float | None, float | None, list | None]:
+    """[mass]: mass and inertia positive, a plausible mass, the centre of mass 3 finite
+    numbers; returns (mass, inertia, centre of mass), None for what is unusable."""
+    mpath = str(man.path)
     mass = man.number("mass", "mass", out)
     inertia = man.number("mass", "inertia", out)
     for key, val in (("mass", mass), ("inertia", inertia)):
@@ -276,94 +301,109 @@ def check_vehicle(bundle: Path, model_rules: bool = True) -> tuple[list[Diagnost
             and all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) for c in com)):
         out.append(man.missing("mass", "centre_of_mass", f"must be 3 finite numbers [x, y, z], got {com!r}"))
         com = None
+    return mass, inertia, com
+
+
+def _drive_rules(man: Manifest, mass: float | None, out: list[Diagnostic]) -> None:
+    """[drive]: present, each figure plausible, shells faster than the tank."""
+    mpath = str(man.path)
     if man.table("drive") is None:
         out.append(diag("B102", mpath, 0, "table [drive] is missing"))
-    else:
-        for key in DRIVE_KEYS:
-            val = man.number("drive", key, out)
-            if val is None:
-                continue
-            why = _why_drive(key, val, mass if mass and mass > 0 else None)
-            if why:
-                out.append(diag(why[0], mpath, man.lines.key("drive", key), f"[drive] {key} = {val:g}: {why[1]}"))
-        top, shell = man.get("drive", "top_speed"), man.get("drive", "shell_speed")
-        if (isinstance(top, (int, float)) and isinstance(shell, (int, float)) and 0 < shell <= top):
-            out.append(diag("V303", mpath, man.lines.key("drive", "shell_speed"),
-                            f"[drive] shell_speed = {shell:g} m/s is not faster than top_speed = {top:g} m/s: "
-                            "the tank would drive into its own shells"))
+        return
+    for key in DRIVE_KEYS:
+        val = man.number("drive", key, out)
+        if val is None:
+            continue
+        why = _why_drive(key, val, mass if mass and mass > 0 else None)
+        if why:
+            out.append(diag(why[0], mpath, man.lines.key("drive", key), f"[drive] {key} = {val:g}: {why[1]}"))
+    top, shell = man.get("drive", "top_speed"), man.get("drive", "shell_speed")
+    if (isinstance(top, (int, float)) and isinstance(shell, (int, float)) and 0 < shell <= top):
+        out.append(diag("V303", mpath, man.lines.key("drive", "shell_speed"),
+                        f"[drive] shell_speed = {shell:g} m/s is not faster than top_speed = {top:g} m/s: "
+                        "the tank would drive into its own shells"))
 
-    def missing_file(table: str, name: str | None, path: Path | None) -> None:
-        if name and (path is None or not path.is_file()) and not any(
-                d.code == "B202" and repr(name) in d.message for d in out):
-            out.append(diag("B202", mpath, man.lines.key(table, "file"), f"derived file {name!r} is missing"))
 
-    hull = None
-    hfile = man.string("hull", "file", out, default="hull.txt")
-    hpath = safe_file(bundle, hfile) if hfile else None
-    missing_file("hull", hfile, hpath)
-    if hpath is not None and hpath.is_file():
-        pts, hd = scan_hull(hpath)
-        out += hd
-        if not hd:
-            hull = pts
-            out += proportion_rules(hull, man)
-    tree = None
-    sfile = man.string("spheres", "file", out, default="spheres.txt")
-    spath = safe_file(bundle, sfile) if sfile else None
-    missing_file("spheres", sfile, spath)
-    if spath is not None and spath.is_file():
-        tree, slines, sd = scan_spheres(spath)
-        out += sd
+@dataclass
+class _Shapes:
+    """The hull and the sphere tree of a bundle, when their files read without fault."""
 
-    if hull is not None and com is not None and inertia is not None and mass is not None and mass > 0 and inertia > 0:
-        with np.errstate(all="ignore"):  # a degenerate hull (repeated corners) makes 0/0: outside
-            com_inside = points_in_prism(hull, np.array([com], dtype=np.float64), tol=GEOM_TOL)[0]
-        if not com_inside:
-            out.append(diag("V104", mpath, man.lines.key("mass", "centre_of_mass"),
-                            f"centre of mass ({com[0]:g}, {com[1]:g}, {com[2]:g}) is outside the hull"))
-        else:
-            # no body has more inertia than with all its mass on the hull's farthest rim
-            with np.errstate(all="ignore"):  # absurd figures overflow to inf, and are then reported
-                r2 = float(np.max((hull[:, 0] - com[0]) ** 2 + (hull[:, 2] - com[2]) ** 2))
-                too_much = inertia > mass * r2 * (1 + 1e-6)
-            if too_much:
-                out.append(diag("V302", mpath, man.lines.key("mass", "inertia"),
-                                f"[mass] inertia = {inertia:g} kg m^2 is more than the {mass * r2:.4g} kg m^2 "
-                                "of all the mass on the hull's rim: impossible"))
+    hull: np.ndarray | None = None
+    hull_path: Path | None = None
+    tree: SphereTree | None = None
+    sphere_lines: np.ndarray | None = None
+    spheres_path: Path | None = None
 
-    model = man.get("model", "file")
-    mfile = safe_file(bundle, model) if isinstance(model, str) and model else None
-    if model_rules and mfile is not None and mfile.is_file() and (hull is not None or tree is not None):
-        from ..errors import FormatError
-        from .glb import load_triangles
+    @classmethod
+    def read(cls, man: Manifest, bundle: Path, out: list[Diagnostic]) -> "_Shapes":
+        """Scan hull.txt (and its proportions) and spheres.txt, naming missing ones."""
 
-        try:
-            verts, faces = load_triangles(mfile)
-        except FormatError as e:
-            out.append(diag("B201", mpath, man.lines.key("model", "file"), f"model file cannot be read: {e}"))
-        else:
-            v = np.unique(verts, axis=0)
-            if hull is not None:
-                with np.errstate(all="ignore"):
-                    outside = np.flatnonzero(~points_in_prism(hull, v, tol=GEOM_TOL))
-                if len(outside):
-                    p = v[outside[0]]
-                    out.append(diag("V103", str(hpath), 0,
-                                    f"{len(outside)} of {len(v)} model vertices are outside the hull, e.g. "
-                                    f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f})"))
-            if tree is not None:
-                out += sphere_rules(tree, slines, v, str(spath), surface_points(verts, faces))
+        def named(table: str, default: str) -> Path | None:
+            file = man.string(table, "file", out, default=default)
+            path = safe_file(bundle, file) if file else None
+            if file and (path is None or not path.is_file()) and not any(
+                    d.code == "B202" and repr(file) in d.message for d in out):
+                out.append(diag("B202", str(man.path), man.lines.key(table, "file"),
+                                f"derived file {file!r} is missing"))
+            return path if path is not None and path.is_file() else None
 
-    size = None
-    if hull is not None:
-        size = VehicleSize(name, float(np.max(np.hypot(hull[:, 0], hull[:, 2]))), mpath,
-                           man.lines.key("", "footprint_radius") or man.lines.key("hull", "file"),
-                           footprint=convex_hull_2d(hull[:, [0, 2]]), height=float(np.ptp(hull[:, 1])))
-    else:
-        r = man.get("", "footprint_radius")
-        if isinstance(r, (int, float)) and not isinstance(r, bool) and math.isfinite(r) and r > 0:
-            size = VehicleSize(name, float(r), mpath, man.lines.key("", "footprint_radius"))
-    return out, size
+        shapes = cls()
+        shapes.hull_path = named("hull", "hull.txt")
+        if shapes.hull_path is not None:
+            pts, hd = scan_hull(shapes.hull_path)
+            out += hd
+            if not hd:
+                shapes.hull = pts
+                out += proportion_rules(pts, man)
+        shapes.spheres_path = named("spheres", "spheres.txt")
+        if shapes.spheres_path is not None:
+            shapes.tree, shapes.sphere_lines, sd = scan_spheres(shapes.spheres_path)
+            out += sd
+        return shapes
+
+
+def _inertia_rules(man: Manifest, hull: np.ndarray, com: list, mass: float, inertia: float,
+                   out: list[Diagnostic]) -> None:
+    """The centre of mass inside the hull, and no more inertia than all the mass on its rim."""
+    mpath = str(man.path)
+    with np.errstate(all="ignore"):  # a degenerate hull (repeated corners) makes 0/0: outside
+        com_inside = points_in_prism(hull, np.array([com], dtype=np.float64), tol=GEOM_TOL)[0]
+    if not com_inside:
+        out.append(diag("V104", mpath, man.lines.key("mass", "centre_of_mass"),
+                        f"centre of mass ({com[0]:g}, {com[1]:g}, {com[2]:g}) is outside the hull"))
+        return
+    # no body has more inertia than with all its mass on the hull's farthest rim
+    with np.errstate(all="ignore"):  # absurd figures overflow to inf, and are then reported
+        r2 = float(np.max((hull[:, 0] - com[0]) ** 2 + (hull[:, 2] - com[2]) ** 2))
+        too_much = inertia > mass * r2 * (1 + 1e-6)
+    if too_much:
+        out.append(diag("V302", mpath, man.lines.key("mass", "inertia"),
+                        f"[mass] inertia = {inertia:g} kg m^2 is more than the {mass * r2:.4g} kg m^2 "
+                        "of all the mass on the hull's rim: impossible"))
+
+
+def _model_rules(man: Manifest, mfile: Path, shapes: _Shapes, out: list[Diagnostic]) -> None:
+    """The model inside the hull (V103) and inside the spheres (sphere_rules)."""
+    from ..errors import FormatError
+    from .glb import load_triangles
+
+    try:
+        verts, faces = load_triangles(mfile)
+    except FormatError as e:
+        out.append(diag("B201", str(man.path), man.lines.key("model", "file"), f"model file cannot be read: {e}"))
+        return
+    v = np.unique(verts, axis=0)
+    if shapes.hull is not None:
+        with np.errstate(all="ignore"):
+            outside = np.flatnonzero(~points_in_prism(shapes.hull, v, tol=GEOM_TOL))
+        if len(outside):
+            p = v[outside[0]]
+            out.append(diag("V103", str(shapes.hull_path), 0,
+                            f"{len(outside)} of {len(v)} model vertices are outside the hull, e.g. "
+                            f"({p[0]:.3f}, {p[1]:.3f}, {p[2]:.3f})"))
+    if shapes.tree is not None:
+        out += sphere_rules(shapes.tree, shapes.sphere_lines, v, str(shapes.spheres_path),
+                            surface_points(verts, faces))
 
 
 def vehicle_fit(size: VehicleSize, arena: ArenaInfo) -> list[Diagnostic]:
