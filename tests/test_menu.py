@@ -2,6 +2,7 @@
 (game/menu.py, game/thumbnails.py), on SDL's dummy video driver."""
 
 import ctypes.util
+import math
 
 import numpy as np
 import pygame
@@ -148,3 +149,46 @@ def test_sound_settings_on_the_page_saved_and_heard(make_app):
     goto(app, "start")
     press(app, pygame.K_RETURN)
     assert app.audio.sound.volume == 0.0 and app.audio.sound.music_volume == 0.0
+
+
+def test_a_bot_file_of_the_users_bots_folder_is_an_opponent(make_app, tmp_path):
+    """The menu lists the bot files of the user's bots folder and the examples (parsed,
+    not run); the one chosen drives the first opponent; a broken one is one notice."""
+    folder = tmp_path / "cfg" / "tanktool" / "bots"          # make_app's XDG_CONFIG_HOME
+    folder.mkdir(parents=True)
+    (folder / "circler.py").write_text(
+        "from tanktool.bots import Bot, Command\n\n"
+        "class Circler(Bot):\n"
+        "    def act(self, view):\n"
+        "        return Command(advance=1.0, rotate=0.5)\n")
+    (folder / "helpers.py").write_text("def aim(x):\n    return x\n")      # no bot class: not listed
+    (folder / "broken.py").write_text("class Broken(:\n")
+    app = make_app((800, 450), bots=1)
+    app.frame(0.016)
+    goto(app, "bot_file")
+    shown = [app.menu.bot_file.value]
+    for _ in range(len(app.menu.bot_file.options) - 1):
+        press(app, pygame.K_RIGHT)
+        shown.append(app.menu.bot_file.value)
+    specs = [s[0] for s in shown if s]
+    assert shown[0] == ()                                         # the built-in players first
+    assert specs[0] == f"{folder / 'broken.py'}" and specs[1] == f"{folder / 'circler.py'}:Circler"
+    assert not any("helpers" in s for s in specs)
+    assert any(s.endswith("charger.py:Charger") for s in specs)  # the examples too
+    app.frame(0.016)                                              # its label is drawn
+    press(app, pygame.K_RIGHT)                                    # round to the built-in players
+    press(app, pygame.K_RIGHT)                                    # broken.py
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    assert app.state == "menu" and "broken.py" in app.notice and "syntax error" in app.notice
+    goto(app, "bot_file")
+    press(app, pygame.K_RIGHT)                                    # circler.py
+    goto(app, "start")
+    press(app, pygame.K_RETURN)
+    assert app.state == "playing"
+    tanks = app.session.world.tanks
+    assert len(tanks) == 2 and tanks[1].name == "Circler"
+    x, z = tanks[1].x, tanks[1].z
+    for _ in range(60):
+        app.frame(1 / 30)
+    assert math.hypot(tanks[1].x - x, tanks[1].z - z) > 1.0        # the user's bot drives it

@@ -166,7 +166,7 @@ class App:
         if m.network.value != "off":
             self.start_network()
             return
-        bots = self.config.opponents.bots       # play --bot: the first computer tanks
+        bots = tuple(m.bot_file.value)          # the menu's bot file (or play --bot's): the first computer tanks
         self.session = GameSession(m.arena.value, m.vehicle.value, bots=max(int(m.bots.value), len(bots)),
                                    seed=self.config.seed, difficulty=str(m.difficulty.value), player=True,
                                    bot=self.config.opponents.driver, rules=self.config.rules, bot_specs=bots)

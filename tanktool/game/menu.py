@@ -73,6 +73,9 @@ class Menu:
     arena: Choice
     vehicle: Choice
     bots: Choice = field(default_factory=lambda: Choice("opponents", list(range(0, 8)), 3))
+    #: who drives the first opponents: () the built-in computer players, or bot specs
+    #: (a bot file of the user's bots folder or the examples, game/bot_files.py; play --bot's)
+    bot_file: Choice = field(default_factory=lambda: Choice("opponent bot", [()]))
     difficulty: Choice = field(default_factory=lambda: Choice("difficulty", list(DIFFICULTY), 1))
     view: Choice = field(default_factory=lambda: Choice("view", ["3d", "top"]))
     resolution: Choice = field(default_factory=lambda: Choice("resolution", list(RESOLUTIONS)))
@@ -95,9 +98,9 @@ class Menu:
     field: str = "address"
 
     #: the main menu; resolution and full screen are on the settings page
-    ITEMS = ("arena", "vehicle", "bots", "difficulty", "view", "network", "address", "name", "password", "settings",
-             "bindings", "start", "quit")
-    CHOICES = ("arena", "vehicle", "bots", "difficulty", "view", "network")
+    ITEMS = ("arena", "vehicle", "bots", "bot_file", "difficulty", "view", "network", "address", "name", "password",
+             "settings", "bindings", "start", "quit")
+    CHOICES = ("arena", "vehicle", "bots", "bot_file", "difficulty", "view", "network")
 
     def item(self) -> str:
         return self.ITEMS[self.cursor]
@@ -122,6 +125,13 @@ def menu_for(cfg: Any, settings: Settings, arenas: list[str], vehicles: list[str
     m.arena.set(arena or default_arena())
     m.vehicle.set(vehicle or default_vehicle())
     m.bots.set(min(max(cfg.opponents.count, 0), 7))
+    from .bot_files import find_bots
+
+    # the bot files found (play --bot's specs first, chosen, when given)
+    m.bot_file.options = [()] + [(spec,) for spec in find_bots()]
+    if cfg.opponents.bots:
+        m.bot_file.options.insert(1, tuple(cfg.opponents.bots))
+        m.bot_file.index = 1
     m.view.set(cfg.view.mode)
     # a first start offers easy; then the menu's last choice (--difficulty wins)
     m.difficulty.set(cfg.opponents.difficulty or settings.difficulty or "easy")
@@ -166,6 +176,10 @@ def item_label(m: Menu, item: str, selected: bool) -> tuple[str, str]:
             shown = value + ("_" if typing else "")
         return item, f"[ {shown} ]" + ("" if m.editing or not selected else "  Enter: type")
     c = getattr(m, item)
+    if item == "bot_file":
+        from .bot_files import short
+
+        return c.label, f"<  {', '.join(short(b) for b in c.value) or 'built-in (difficulty below)'}  >"
     return c.label, f"<  {_shown(c.value)}  >"
 
 
