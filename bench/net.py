@@ -28,7 +28,8 @@ of the host's messages the real peers dropped to their own rate limiters.
 
 Phase 4 (judge, in this process): the CPU a member state costs the host, decoded and
 kept for drawing, with the judge's checks (net/judge.py) and without them, on a flat
-arena (box) and a ground (hills).
+arena (box) and a ground (hills); and the same through the host's protocol core
+(net/core.py), the whole path a datagram takes after the socket.
 
 Phase 5 (flood): a host and an honest joiner as processes; this script joins as a third
 member and floods the host with 20,000 valid states a second from its own address for
@@ -297,8 +298,34 @@ def judge_costs(states: int = 1500) -> dict:
             assert corrected == 0, judge.report()
             return best
 
+        def through_core(judged: bool) -> float:
+            """The whole path of a member's datagram in the host's protocol core (budget,
+            member check, window, rate, judge, event), no socket."""
+            from tanktool.net.core import Core
+
+            best = float("inf")
+            for _ in range(3):
+                core, rt = Core("host"), RemoteTank()
+                core.start_host((LOOPBACK, 5000, 5000), 0.0)
+                core.table[2] = P.Entry(2, 2, LOOPBACK, 5002, 5002, "member")
+                core.window.anchor(2, 0, 0.0)
+                core.judge = Judge(world) if judged else None
+                stamps = [P.decode(d).timestamp for d in msgs]
+                t0 = time.perf_counter()
+                for d, now in zip(msgs, stamps):
+                    core.datagram((LOOPBACK, 5002), d, now)
+                    for ev in core.take_events():
+                        rt.push(ev.body)
+                best = min(best, (time.perf_counter() - t0) / len(msgs) * 1e6)
+                assert core.counters["states_received"] == len(msgs), core.network_report()
+                assert not judged or not core.judge.corrections, core.judge.report()
+            return best
+
         off, on = run(False), run(True)
-        out[arena] = {"off_us": round(off, 2), "on_us": round(on, 2), "ratio": round(on / off, 2)}
+        core_off, core_on = through_core(False), through_core(True)
+        out[arena] = {"off_us": round(off, 2), "on_us": round(on, 2), "ratio": round(on / off, 2),
+                      "core_off_us": round(core_off, 2), "core_on_us": round(core_on, 2),
+                      "core_ratio": round(core_on / core_off, 2)}
     return out
 
 
@@ -445,10 +472,12 @@ def main() -> None:
         print(json.dumps(result))
         return
     if "judge" in parts:
-        print("host CPU per member state (decode + kept for drawing), in this process [us]")
-        print(f"{'arena':<8} {'no judge':>9} {'judged':>9} {'ratio':>6}")
+        print("host CPU per member state, in this process [us]: decode + kept for drawing; and the whole path")
+        print("through the protocol core (net/core.py: budget, member, window, rate, judge, event)")
+        print(f"{'arena':<8} {'no judge':>9} {'judged':>9} {'ratio':>6} {'core, no judge':>15} {'judged':>9} {'ratio':>6}")
         for arena, c in result["judge"].items():
-            print(f"{arena:<8} {c['off_us']:>9.2f} {c['on_us']:>9.2f} {c['ratio']:>6.2f}")
+            print(f"{arena:<8} {c['off_us']:>9.2f} {c['on_us']:>9.2f} {c['ratio']:>6.2f} {c['core_off_us']:>15.2f} "
+                  f"{c['core_on_us']:>9.2f} {c['core_ratio']:>6.2f}")
         print()
     if "flood" in parts:
         f = result["flood"]
