@@ -234,8 +234,8 @@ def test_parked_hellos_and_silent_connections_do_not_keep_real_joiners_out():
 def test_a_partition_heals_to_one_host(side_a, seconds):
     """Players 1-5; ``side_a`` (with the host) is cut from the others for ``seconds``.
     The other side elects a host under a higher term; when the cut heals, the probes of
-    the players each side lost find it, the old host steps down and sends its members
-    after it: one session again, one host, one table."""
+    the players each side lost find the other session, and the smaller side's host steps
+    down and sends its members after it: one session again, one host, one table."""
     net = SimCluster(seed=10, **BAD)
     host = net.host("alice")
     nodes = [host] + [net.join(name, host) for name in ("bob", "carol", "dave", "erin")]
@@ -248,8 +248,28 @@ def test_a_partition_heals_to_one_host(side_a, seconds):
     assert all(n.core.term > 1 and n.core.host_number == min(side_b_numbers(nodes, side_a)) for n in other)
     net.run(12.0)
     assert_one_session(net)
-    assert len(live(net)) == 5 and host.core.term >= 2 and not host.core.is_host
+    assert len(live(net)) == 5
+    if len(side_a) > 5 - len(side_a):        # the host's side is the larger: it goes on
+        assert host.core.is_host and host.core.term == 1 and not kinds(host, "stepdown")
+    else:
+        assert not host.core.is_host and host.core.term > 1 and kinds(host, "stepdown")
 
 
 def side_b_numbers(nodes, side_a):
     return [n.core.number for n in nodes if n.core.number not in side_a]
+
+
+def test_a_member_cut_off_alone_comes_back_and_draws_nobody_away():
+    """Player 3 alone on its side makes itself host under a higher term; when the cut
+    heals the session of four does not step down to it: it rejoins them."""
+    net = SimCluster(seed=11, **BAD)
+    host = net.host("alice")
+    nodes = [host] + [net.join(name, host) for name in ("bob", "carol", "dave", "erin")]
+    carol = nodes[2]
+    net.run(1.0)
+    net.udp.partition(net.now, net.now + 8.0, [carol.ip], [n.ip for n in nodes if n is not carol])
+    net.run(7.5)
+    assert carol.core.is_host and carol.core.term > 1 and host.core.is_host and host.core.term == 1
+    net.run(12.0)
+    assert_one_session(net)
+    assert host.core.is_host and len(live(net)) == 5 and not kinds(host, "stepdown") and kinds(carol, "stepdown")

@@ -9,16 +9,18 @@ the side left behind: a host frozen (SIGSTOP) for longer than the silence while 
 others elected a new one, or one side of a partition.  So it **probes**: it dials the
 addresses of the players it lost, once every ``PROBE_EVERY`` for ``PROBE_TIME``, then
 every ``PROBE_SLOW`` until ``PROBE_LONG`` (a partition may last), and reads their
-CHALLENGE.  When one of them stands in a newer session — a higher term, or the same
-term with more players — it **steps down**: a host first tells its members where that
+CHALLENGE.  When one of them stands in the session that goes on — more players (a
+majority, as Raft elects), or as many under a higher term — it **steps down**: a host first tells its members where that
 session is (a NOT_HOST refusal on their links, so they follow it), its computer
 opponents are dropped (the new host adopted them: no duplicates), joiners are
 redirected to that session, and ``Peer.rejoin`` joins it as a member (a new number).
-So when a partition heals, every peer ends in the session of the highest (term,
-players).  A peer left alone refuses joins with "try again" until its first round of
+So when a partition heals, every peer ends in the session of the highest (players,
+term).  A peer left alone refuses joins with "try again" until its first round of
 probes has been answered, so that a joiner dialling a stale host's address is not taken
 into a split session.  (Two sides that each changed hosts the same number of times and
-kept as many players stay apart: a tie has no winner.)  No I/O: part of :class:`~tanktool.net.core.Core` (a probe is a
+kept as many players stay apart: a tie has no winner.)  A member dropped by the
+others (silence) that made itself host of its own session comes back the same way: the
+larger session does not step down to it.  No I/O: part of :class:`~tanktool.net.core.Core` (a probe is a
 ``Connect`` action; the answer comes back as any link's bytes).
 """
 
@@ -124,8 +126,10 @@ class TermsMixin:
         self._end_probe(link)
         if not isinstance(body, P.Challenge) or self.step_down_to is not None:
             return
-        mine = (self.term, len(self._others()) + 1)
-        if (body.term, body.players) > mine:
+        # the session that goes on is the one with more players (a majority, as Raft
+        # elects); between as many, the higher term.  A member dropped by silence that
+        # made itself host of its own one-player session (term + 1) draws nobody to it
+        if (body.players, body.term) > (len(self._others()) + 1, self.term):
             if self.is_host:                     # type: ignore[attr-defined]
                 # our members follow us there, rather than electing one of them
                 redirect = self._pack(P.Refuse(P.RefuseCode.NOT_HOST, f"{link.addr[0]}:{link.addr[1]}"))  # type: ignore[attr-defined]
