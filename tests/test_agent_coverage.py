@@ -98,3 +98,22 @@ def test_a_sighting_carries_the_enemy_hull_heading():
     w.tanks[1].place(55.0, 10.0, 2.0)
     (s,) = perceiver(w, 0, Senses(math.radians(60), 100.0, 80.0)).look(w, w.tanks[0])
     assert s.index == 1 and s.heading == w.tanks[1].heading
+
+
+def test_a_block_never_looked_at_is_worth_more_than_one_looked_at_long_ago():
+    from tanktool.sim.agents.sight import NEVER_SEEN
+
+    w, grid = box()
+    v = views_for(w, grid)
+    cov = Coverage(v, math.radians(60), 100.0)
+    west, east = v.cell_at(15.0, 35.0), v.cell_at(105.0, 35.0)
+    cov.seen[:] = 0.0                                   # everything looked at long ago
+    cov.seen[east] = -math.inf                          # but one block never
+    worth = cov.worth(1000.0)
+    assert worth[east] == NEVER_SEEN > 1.0 and worth[west] == 1.0
+    assert cov.gain(east, 1000.0) == float(cov.sees[east] @ worth)
+    # all fresh but two blocks: one looked at long ago by us, one far off never
+    cov.seen[:] = 990.0
+    cov.seen[west], cov.seen[east] = 0.0, -math.inf
+    cell, gain = cov.goal(20.0, 35.0, 1000.0)
+    assert cov.sees[cell, east] and gain >= NEVER_SEEN

@@ -467,3 +467,28 @@ def test_an_enemy_heard_coming_behind_cover_is_waited_for_with_the_gun_on_the_co
     w2.tanks[1].vx = ENGINE_FULL
     normal(w2, w2.tanks[0])
     assert normal.bot.state == "search"
+
+
+# ------------------------------------------------------------------ outgunned on relief
+def test_hard_breaks_off_when_no_shot_of_its_carries_and_it_is_hit():
+    from tanktool.sim.agents.combat import OUTGUNNED
+
+    guard = GUARDS["outgunned"]
+    for level, expected in (("hard", True), ("normal", False)):
+        w = box_world([(20.0, 10.0), (50.0, 10.0)])
+        drv = driver(Agent(level), 2)
+        drv(w, w.tanks[0])
+        agent, view = drv.bot, view_of(drv, w)
+        t = view.t + 10.0
+        s = Sighting(1, 50.0, 10.0, 0.0, 0.0, t, 30.0, heading=math.pi)
+        attack = agent.machine.states["attack"]
+        attack.blind_since = t - OUTGUNNED - 0.1            # no shot carried for that long
+
+        def percept(hits):
+            return Percept(t, s, True, None, None, bool(hits), tuple(hits), False, False)
+
+        assert bool(guard(agent, view, percept([t - 0.5]))) is expected
+        assert not guard(agent, view, percept([]))                          # not hit: drive on
+        assert not guard(agent, view, percept([t - OUTGUNNED - 1.0]))     # hit before, not since
+        attack.blind_since = t - 0.5                                          # not long enough
+        assert not guard(agent, view, percept([t - 0.2]))

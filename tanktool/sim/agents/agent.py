@@ -27,7 +27,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..bots import IDLE, Command
-from .combat import CAMP_MEMORY, CAMP_SPEED, WAIT_COOLDOWN, WAIT_NEAR, Attack, Evade, Hunt, LieInWait, ReturnFire
+from .combat import CAMP_MEMORY, CAMP_SPEED, OUTGUNNED, WAIT_COOLDOWN, WAIT_NEAR, Attack, Evade, Hunt, LieInWait, ReturnFire
 from .difficulty import DIFFICULTIES, Difficulty, difficulty
 from .dodge import Evasion
 from .driving import Pilot
@@ -59,6 +59,8 @@ def _but(*names: str) -> tuple[str, ...]:
 TRANSITIONS = tuple(Transition(*row) for row in (
     (_but("evade", "return_fire"), "ambushed", "evade", "hit twice in 4 s, nobody in sight, shot from cover"),
     (("attack",), "losing", "evade", "out-traded (Difficulty.break_off: no level)"),
+    (("attack",), "outgunned", "evade",
+     "on relief, no shot of its carries for 1.5 s and it is hit (Difficulty.outgunned): out of its sight"),
     (("evade",), "done", "search", "in cover or 5 s: from the threat"),
     (_but("evade", "attack", "return_fire"), "shot_from_open", "return_fire",
      "hit, the shot heard from a place in sight"),
@@ -273,6 +275,18 @@ def _losing(a: Agent, view: "View", p: "Percept") -> Any:
     return None
 
 
+def _outgunned(a: Agent, view: "View", p: "Percept") -> Any:
+    """On relief: no shot of ours carries onto the enemy from here (we drive to a place
+    whence one would) for ``OUTGUNNED`` s, and its shots hit us meanwhile: its ground
+    serves it, ours does not.  Out of its sight, then look for it again."""
+    since = a.machine.states["attack"].blind_since  # type: ignore[attr-defined]
+    s = p.sight
+    if a.level.outgunned and s is not None and since is not None and p.t - since >= OUTGUNNED \
+            and p.t >= a.memory.evade_cooldown and any(h >= since for h in p.hits):
+        return (s.x, s.z, s.y)
+    return None
+
+
 def _shot_from_open(a: Agent, view: "View", p: "Percept") -> Any:
     return p.shot if p.sight is None and p.hit and _in_open(view, p.shot) else None
 
@@ -346,7 +360,7 @@ def _vantage(a: Agent, view: "View", p: "Percept") -> Any:
     return True
 
 
-GUARDS = {"ambushed": _ambushed, "losing": _losing, "shot_from_open": _shot_from_open, "heard_near": _heard_near,
+GUARDS = {"ambushed": _ambushed, "losing": _losing, "outgunned": _outgunned, "shot_from_open": _shot_from_open, "heard_near": _heard_near,
           "enemy_acquired": _enemy_acquired, "coming": _coming, "camp_known": _camp_known, "enemy_killed": _enemy_killed,
           "enemy_lost": _enemy_lost, "heard": _heard, "hit_unseen": _hit_unseen, "heard_again": _heard_again,
           "leading": _leading, "vantage": _vantage}

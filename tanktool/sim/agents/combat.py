@@ -64,6 +64,9 @@ WAIT_COOLDOWN = 6.0
 #: evading lasts at most this long [s]; then no new evasion for EVADE_COOLDOWN s
 EVADE_TIME = 5.0
 EVADE_COOLDOWN = 8.0
+#: on relief, a level that is ``outgunned`` breaks off when no shot of its carries for
+#: this long and it is hit meanwhile [s]
+OUTGUNNED = 1.5
 #: on relief, the place to shoot from is looked for again after this long [s]
 SPOT_AGAIN = 1.0
 #: a shot on relief may pass this far over or under the enemy's body [m] (its
@@ -88,9 +91,11 @@ class Attack(State["Agent"]):
         self.flip_at = 0.0
         self.spot: tuple[float, float] | None = None      # where to shoot from on relief
         self.spot_at = -math.inf
+        self.blind_since: float | None = None
 
     def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
         self.spot, self.spot_at = None, -math.inf
+        self.blind_since: float | None = None     # on relief: since when no shot carries from here
 
     def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
         """Turn onto the intercept point, fire when the shot would hit, hold the level's
@@ -105,6 +110,10 @@ class Attack(State["Agent"]):
         rotate, fire, err = aim_and_fire(agent, view, s)
         top = me.vehicle.top_speed
         spot = self.firing_spot(agent, view, s) if lv.relief and view.map.relief else None
+        if spot is None:
+            self.blind_since = None
+        elif self.blind_since is None:
+            self.blind_since = view.t
         if spot is not None:
             # through it, not to a stop on it: a tank standing still is the easiest shot
             ux, uz = spot[0] - me.x, spot[1] - me.z

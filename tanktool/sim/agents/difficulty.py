@@ -65,6 +65,10 @@ class Difficulty:
     #: shot its own (False: goes looking for it, and meets it round the corner with
     #: the gun wherever the way pointed it)
     wait: bool = False
+    #: on relief, breaks off (Evade: out of the enemy's sight, then searches) when no
+    #: shot of its own carries onto the enemy for ``combat.OUTGUNNED`` s and it is hit
+    #: meanwhile (False: drives on to a place whence a shot would carry, under fire)
+    outgunned: bool = False
     #: on relief, drives to where the hull's pitch carries a shot onto the enemy when it
     #: does not where it stands (``relief``; False: holds its fire and stares)
     relief: bool = True
@@ -83,7 +87,8 @@ DIFFICULTIES: dict[str, Difficulty] = {
                          dodge_reaction=0.45, engage=40.0, stand_off=45.0, cover=True),
     "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.3), vision_range=130.0,
                        hearing_radius=120.0, think_hz=20.0, engine_radius=40.0, lead=1.0, fire_tolerance=0.5,
-                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, wait=True),
+                       dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, wait=True,
+                       outgunned=True),
 }
 
 

@@ -214,6 +214,10 @@ def views_for(world: "World", grid: NavGrid) -> Views:
     return v
 
 
+#: the exploration's weight of a block never seen (one not seen for ``forget`` s: 1)
+NEVER_SEEN = 3.0
+
+
 class Coverage:
     """When each block was last in the agent's sight: the dynamic half of the sight
     memory, and the exploration it drives.
@@ -265,9 +269,17 @@ class Coverage:
         c = self.views.cell_at(x, z, y)
         return t - self.seen[c] if c >= 0 else math.inf
 
+    def worth(self, t: float) -> np.ndarray:
+        """Each block's worth to go and look at: its staleness, and ``NEVER_SEEN`` for a
+        block never looked at.  Everything is looked at once before the rounds begin
+        again: in 120 s duels in the maze, with staleness alone, a fifth of the blocks
+        were never looked at (a camper in one of them never found) while the big
+        stretches seen in the first minute drew the agent back in the second."""
+        return np.where(np.isinf(self.seen), NEVER_SEEN, self.staleness(t))
+
     def gain(self, cell: int, t: float) -> float:
-        """The staleness in sight of ``cell``."""
-        return float(self.sees[cell] @ self.staleness(t))
+        """The worth (``worth``) in sight of ``cell``."""
+        return float(self.sees[cell] @ self.worth(t))
 
     def goal(self, x: float, z: float, t: float, weight: np.ndarray | None = None,
              least: float = 1.0, d0: float = 60.0, y: float | None = None) -> tuple[int, float] | None:
@@ -281,7 +293,7 @@ class Coverage:
         c = v.cell_at(x, z, y)
         if c < 0:
             return None
-        s = self.staleness(t)
+        s = self.worth(t)
         if weight is not None:
             s = s * weight
         gain = self.sees @ s
