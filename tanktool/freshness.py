@@ -28,8 +28,9 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .errors import ArenaError
+from .grid_files import is_grid_file
 
-#: the navigation files: build-navgrid rebuilds them
+#: the navigation files: build-navgrid rebuilds them (and the smaller vehicles' navgrid.<vehicle>.npz)
 GRID_FILES = ("navgrid.npz", "quadtree.npz")
 #: the other files a match reads: import-arena makes them
 MODEL_FILES = ("walls.txt", "model.glb")
@@ -43,11 +44,12 @@ def problems(folder: Path, doc: dict[str, Any]) -> dict[str, str]:
     # a bundle import-arena made: its [source] and the [walkable] surface it found
     imported = isinstance(doc.get("source"), dict) and isinstance(doc.get("walkable"), dict)
     out: dict[str, str] = {}
-    for name in MODEL_FILES + GRID_FILES:
+    for name in MODEL_FILES + GRID_FILES + _vehicle_files(folder, doc):
         path = folder / name
         if name not in derived:
             # a hand-made bundle (walls.txt only) has no grid to miss; an imported one must
-            if imported and name in ("navgrid.npz", "walls.txt") and not path.is_file():
+            if imported and (name == "walls.txt" or is_grid_file(name) and name != "quadtree.npz") \
+                    and not path.is_file():
                 out[name] = "missing"
             continue
         if not path.is_file():
@@ -55,6 +57,13 @@ def problems(folder: Path, doc: dict[str, Any]) -> dict[str, str]:
         elif sha256_file(path) != derived[name]:
             out[name] = "stale"
     return out
+
+
+def _vehicle_files(folder: Path, doc: dict[str, Any]) -> tuple[str, ...]:
+    """The smaller vehicles' grid files, navgrid.<vehicle>.npz of [grids.<vehicle>]."""
+    from .grid_files import vehicle_file, vehicle_grids
+
+    return tuple(str(vehicle_file(n)) for n in vehicle_grids(doc, folder / "arena.toml"))
 
 
 def _say_files(bad: dict[str, str]) -> str:
@@ -133,8 +142,8 @@ def ensure_fresh(folder: Path, say: Callable[[str], None] | None = None) -> str 
     if not bad:
         return None
     what = f"{folder}: {_say_files(bad)}"
-    grid_only = all(n in GRID_FILES for n in bad)
-    edited = [n for n, w in bad.items() if w == "stale" and n not in GRID_FILES]
+    grid_only = all(is_grid_file(n) for n in bad)
+    edited = [n for n, w in bad.items() if w == "stale" and not is_grid_file(n)]
     fix = f"tanktool build-navgrid {folder}" if grid_only else _import_command(folder, doc)
     if edited:
         raise ArenaError(f"{folder}: {' and '.join(edited)} changed since the import (not the sha256 arena.toml "

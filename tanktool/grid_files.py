@@ -10,7 +10,9 @@ files byte for byte.
 from __future__ import annotations
 
 import math
+import re
 import time
+import dataclasses
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -18,8 +20,48 @@ from typing import Any, Callable
 from .errors import ArenaError
 
 DEFAULTS = {"cell": 0.5, "clearance": 2.0, "quadtree_depth": 3}
-#: the files written here, in the bundle's folder
+#: the files written here, in the bundle's folder (and navgrid.<vehicle>.npz: vehicle_file)
 FILES = ("navgrid.npz", "quadtree.npz", "navgrid.png")
+#: a vehicle name that may be part of a file name
+_VEHICLE_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]{0,63}")
+
+
+def vehicle_file(name: str) -> str | None:
+    """The grid file of a smaller vehicle, ``navgrid.<name>.npz`` (None: a name that
+    cannot be part of a file name)."""
+    return f"navgrid.{name}.npz" if isinstance(name, str) and _VEHICLE_NAME.fullmatch(name) else None
+
+
+def is_grid_file(name: str) -> bool:
+    """navgrid.npz, quadtree.npz or a vehicle's navgrid.<name>.npz: build-navgrid remakes them."""
+    return name in ("navgrid.npz", "quadtree.npz") or (name.startswith("navgrid.") and name.endswith(".npz")
+                                                       and vehicle_file(name[8:-4]) == name)
+
+
+def vehicle_grids(doc: dict[str, Any], where: Any = "arena.toml") -> dict[str, tuple[float, Any]]:
+    """{vehicle: (clearance, (k, 4) spawns [x, z, heading, y])} of the manifest's
+    [grids.<vehicle>] tables (none in a bundle made before them); ArenaError naming
+    ``where`` for a malformed one."""
+    import numpy as np
+
+    grids = doc.get("grids", {})
+    if not isinstance(grids, dict):
+        raise ArenaError(f"{where}: [grids] must be a table of vehicles")
+    out: dict[str, tuple[float, Any]] = {}
+    for name, t in grids.items():
+        c = t.get("clearance") if isinstance(t, dict) else None
+        if vehicle_file(name) is None or isinstance(c, bool) or not isinstance(c, (int, float)) \
+                or not (math.isfinite(c) and c > 0):
+            raise ArenaError(f"{where}: [grids.{name}] needs a vehicle name of letters, digits, - and _ and a "
+                             f"clearance > 0")
+        try:
+            sp = np.asarray(t.get("spawns", []), dtype=np.float64).reshape(-1, 4)
+        except (TypeError, ValueError):
+            raise ArenaError(f"{where}: [grids.{name}] spawns must be a list of [x, z, heading, y]") from None
+        if not np.isfinite(sp).all() or len(sp) == 0:
+            raise ArenaError(f"{where}: [grids.{name}] spawns must be a list of finite [x, z, heading, y]")
+        out[str(name)] = (float(c), sp)
+    return out
 
 
 #: the vehicles whose sizes set the defaults; None: the bundled ones (tests point it elsewhere)
@@ -129,6 +171,8 @@ class BuiltGrid:
     quadtree_depth: int
     params: Any = None        # nav.walkable.WalkableParams, None for a bare walls file
     seconds: float = 0.0
+    #: the smaller vehicles' grids stage_grid_files built with it ({vehicle: BuiltGrid})
+    vehicles: dict[str, Any] = field(default_factory=dict)
 
 
 def _number(name: str, value: float | None, lo: float, lo_open: bool) -> None:
@@ -267,6 +311,13 @@ def render_picture(built: BuiltGrid, target: Target, fmt: str = "png", annotate:
                           spawns=target.spawns, annotate=annotate, region=region, title=target.name)
 
 
+def _surface_options(params: Any) -> dict[str, float]:
+    """build_grid's max_slope / climb / headroom of a grid's walkable surface."""
+    if params is None:
+        return {}
+    return {"max_slope": params.max_slope, "climb": params.climb, "headroom": params.headroom}
+
+
 def stage_grid_files(stage: Path, target: Target, built: BuiltGrid, picture: bytes | None) -> dict[str, Any]:
     """Write navgrid.npz, quadtree.npz (and navgrid.png when ``picture`` is given) into
     the folder ``stage`` and return ``target``'s manifest with its [navgrid],
@@ -278,13 +329,25 @@ def stage_grid_files(stage: Path, target: Target, built: BuiltGrid, picture: byt
     if picture is not None:
         atomic_write_bytes(stage / "navgrid.png", picture)
     doc = dict(target.toml)
+    derived = {k: v for k, v in doc.get("derived", {}).items() if not (is_grid_file(k) and k not in FILES)}
+    grids, own_hashes = {}, {}
+    for name, (clearance, spawns) in vehicle_grids(doc, target.manifest).items():
+        # the same surface and settings, the vehicle's clearance, reachable from its own spawns
+        own = build_grid(dataclasses.replace(target, spawns=spawns), cell=built.cell, clearance=clearance,
+                         quadtree_depth=built.quadtree_depth, **_surface_options(built.params))
+        built.vehicles[name] = own
+        file = str(vehicle_file(name))
+        atomic_write_bytes(stage / file, own.grid.to_bytes())
+        own_hashes[file] = sha256_file(stage / file)
+        grids[name] = {**doc["grids"][name], "file": file}
+    if grids:
+        doc["grids"] = grids
     doc["navgrid"] = {**doc.get("navgrid", {}), "cell": float(built.cell), "clearance": float(built.clearance),
                       "quadtree_depth": int(built.quadtree_depth)}
     if built.params is not None:  # the surface this grid was built from
         doc["walkable"] = built.params.as_toml()
-    derived = dict(doc.get("derived", {}))
     for name in FILES:
         if name != "navgrid.png" or picture is not None:
             derived[name] = sha256_file(stage / name)
-    doc["derived"] = derived
+    doc["derived"] = {**derived, **own_hashes}     # after the others: a rebuild writes the same manifest
     return doc

@@ -133,6 +133,7 @@ def import_arena(
     mesh = _one_mesh(model, scene, params.cell, max_cells)
     result = _analyse(model, mesh, params, fleet, height, tolerance, progress)
     fits = _remark_fit(model, result, fleet, remark)
+    others = _vehicle_grids(result, fleet, remark)
     src_up = up or default_up(fmt)
     nav["cell"] = float(params.cell)
     companions = _companion_files(model)
@@ -143,6 +144,8 @@ def import_arena(
         source = {"up": src_up, "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness)}
         doc = _manifest(tmp, model, companions, name, source, textures, height, tolerance, params, fits,
                         result, nav)
+        if others:   # one grid per smaller vehicle: grid_files builds navgrid.<vehicle>.npz from these
+            doc["grids"] = others
         write_toml(tmp / MANIFEST, doc)
         # the surface (~100 bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m) is not
         # needed past the pictures, and the grid below builds its own: let go before it
@@ -226,6 +229,21 @@ def _remark_fit(model: Path, result: Any, fleet: Any, remark: Callable[[str], No
         remark(f"{model}: room for only {len(spawns)} spawn point(s) where the largest bundled tank that fits "
                f"({fits.radius_of}) fits, at least {fits.length:.1f} m apart")
     return fits
+
+
+def _vehicle_grids(result: Any, fleet: Any, remark: Callable[[str], None]) -> dict[str, Any]:
+    """arena.toml's [grids.<vehicle>] (clearance, spawns) of the bundled vehicles smaller
+    than the one navgrid.npz is for (nav.arena_levels.smaller_vehicles)."""
+    from .grid_files import vehicle_file
+    from .nav.arena_levels import smaller_vehicles
+
+    out: dict[str, Any] = {}
+    for name, (radius, spawns) in smaller_vehicles(result, fleet).items():
+        if vehicle_file(name) is None:
+            remark(f"vehicle {name!r}: no grid of its own (its name cannot be part of a file name)")
+            continue
+        out[name] = {"clearance": _r(radius), "spawns": [[_r(x), _r(z), _r(h, 6), _r(y)] for x, z, h, y in spawns]}
+    return out
 
 
 def _stage_files(tmp: Path, model: Path, companions: list[Path], scene: Any, target: Path, name: str,

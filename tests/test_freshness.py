@@ -69,7 +69,9 @@ def test_an_import_without_its_grid_is_an_error_in_check(tmp_path: Path):
     assert not (out / "navgrid.npz").exists()
     r = run("check", out)
     assert r.exit_code == 1 and "'navgrid.npz' is missing" in r.output, r.output
-    assert freshness.problems(out, read_toml(out / "arena.toml")) == {"navgrid.npz": "missing"}
+    # and the light tank's own grid ([grids.light]: its clearance and spawns are recorded)
+    assert freshness.problems(out, read_toml(out / "arena.toml")) == {"navgrid.npz": "missing",
+                                                                      "navgrid.light.npz": "missing"}
     assert _play(out).exit_code == 0
     assert run("check", out).exit_code == 0
 

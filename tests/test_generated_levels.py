@@ -23,7 +23,7 @@ THIRD_PARTY = ROOT / "tests" / "data" / "arenas_obj"
 #: the rules on the walls themselves (spawn and grid rules are another matter)
 WALL_CODES = {"A101", "A102", "A103", "A104", "A105", "A201", "A202", "A203", "A204", "A205"}
 #: a few seconds each: always run
-QUICK = ["town", "junkyard", "living_room", "stacked_floors"]
+QUICK = ["town", "junkyard", "living_room", "stacked_floors", "narrow_ramp"]
 #: terrains, big grids and the levels other tests import already: a minute together
 SLOW = ["terraces", "big_terrain", "rolling_terrain", "hills", "bumpy_floor", "narrow_deck", "fort", "bridge",
         "two_storeys", "ramps_and_decks", "corridor", "islands", "fence_field"]

@@ -20,6 +20,8 @@ height-field grids, seeded, so a seed gives the same file:
   objects pasted twice, overlapping boxes, faces wound inside out, zero-thickness fences
   a hair apart, rooms of single faces seen from inside, furniture on legs
 * ``fence_field``: 1,500 fences and 400 pillars in a 200 m yard (thin walls' stress test)
+* ``narrow_ramp``: a deck reached by one ramp 9.2 m wide, which the light tank drives up
+  and the heavy one does not fit (one grid per vehicle: the deck is the light tank's only)
 * ``stacked_floors`` (a car park of two decks), ``terraces`` (terrain cut into steps by
   retaining walls, a footbridge), ``big_terrain`` (a 300 m smooth hillside)
 """
@@ -185,6 +187,16 @@ def narrow_deck(length: float = 60.0, width: float = 7.5) -> list:
     return [("deck", box(0, 0, length, width, 4.5, 5.0))]
 
 
+def narrow_ramp(seed: int = 0, width: float = 9.2) -> list:
+    """A 70 x 50 m walled yard; a 24 x 22 m deck 4 m up on a solid block, reached by one
+    20 m ramp ``width`` m wide (11 degrees): wide enough for the light tank's agents
+    (footprint radius 3.46 m + 0.5 m margin), too narrow for the heavy tank's footprint
+    (4.63 m from each side)."""
+    z0 = 25.0 - width / 2
+    return walled_yard(70, 50) + [("deck", box(40, 14, 64, 36, 0, 4.0)),
+                                  ("ramp", ramp(20, z0, 40, z0 + width, 0.0, 4.0, "+x"))]
+
+
 def town(seed: int = 4) -> list:
     """A 120 x 120 m walled town as exporters write them: streets between blocks of
     houses where the same house is pasted twice on the spot, an L-shaped house made
@@ -328,7 +340,7 @@ def level(name: str, **kw) -> trimesh.Trimesh:
 LEVELS = {
     "rolling_terrain": rolling_terrain, "ramps_and_decks": ramps_and_decks, "bridge": bridge,
     "bumpy_floor": bumpy_floor, "tiny_room": tiny_room, "two_storeys": two_storeys, "hills": hills, "fort": fort,
-    "corridor": corridor, "islands": islands, "narrow_deck": narrow_deck,
+    "corridor": corridor, "islands": islands, "narrow_deck": narrow_deck, "narrow_ramp": narrow_ramp,
     "town": town, "junkyard": junkyard, "fence_field": fence_field, "living_room": living_room,
     "stacked_floors": stacked_floors, "terraces": terraces, "big_terrain": big_terrain,
 }

@@ -26,7 +26,7 @@ from ..geometry.hull import min_width
 from .diagnostics import Diagnostic, diag, fmt_xz
 from .freespace import UNBOUNDED, FreeSpace, analyse
 from .level_rules import block_wall_rules, level_rules
-from .manifest import Manifest, file_rules, safe_file
+from .manifest import Manifest, file_rules, safe_file, vehicle_grid_files
 from .walls_rules import bare_walls_leaks, check_walls, leak_diagnostics
 from .walls_scan import scan_walls_file
 
@@ -132,7 +132,8 @@ def check_arena(bundle: Path, vehicles: list[VehicleSize], model_rules: bool = T
     # on its grid: without it a match would run as if the arena were flat (issue 25), so
     # a missing grid is an error, as in play (tanktool/freshness.py)
     imported = isinstance(man.table("source"), dict) and isinstance(man.table("walkable"), dict)
-    out += file_rules(man, bundle, ("walls.txt",) + (("navgrid.npz",) if imported else ()))
+    grids = vehicle_grid_files(man, out) if imported else ()     # one grid per smaller vehicle
+    out += file_rules(man, bundle, ("walls.txt",) + (("navgrid.npz",) + grids if imported else ()))
 
     spawns4, spawn_lines, info.ids = _spawns(man, out)
     spawns, spawn_y = spawns4[:, :3], spawns4[:, 3]

@@ -213,6 +213,21 @@ def file_rules(man: Manifest, bundle: Path, required_derived: tuple[str, ...]) -
 MAX_TEXTURE_BYTES = 128 << 20
 
 
+def vehicle_grid_files(man: Manifest, out: list[Diagnostic]) -> tuple[str, ...]:
+    """The grid files of the smaller vehicles, ``navgrid.<vehicle>.npz`` of [grids.<vehicle>]
+    (they must be there, hashed, like navgrid.npz); a B102 for a malformed [grids]."""
+    from ..errors import ArenaError
+    from ..grid_files import vehicle_file, vehicle_grids
+
+    if man.doc is None or "grids" not in man.doc:
+        return ()
+    try:
+        return tuple(str(vehicle_file(name)) for name in vehicle_grids(man.doc, man.path))
+    except ArenaError as e:
+        out.append(diag("B102", str(man.path), man.lines.table("grids"), str(e).split(": ", 1)[-1]))
+        return ()
+
+
 def texture_rules(man: Manifest, bundle: Path) -> list[Diagnostic]:
     """B205: every texture ``[model] textures`` lists is a file inside the bundle that
     is an image (by its name and its content), at most the glTF sanitiser's

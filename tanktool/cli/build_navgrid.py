@@ -104,6 +104,11 @@ def build_navgrid(arena: Path, cell: float | None, clearance: float | None, max_
     _write_files(target, built, picture, table, table_path, plot_path, grid_path, tree_path)
     _report(target, built)
     wrote = [str(grid_path), f"{tree_path} ({len(tree.leaves)} leaves, depth {tree.max_depth})", str(plot_path)]
+    for name, own in built.vehicles.items():     # one grid per smaller vehicle ([grids] of arena.toml)
+        g = own.grid
+        echo(f"  {name}: clearance {own.clearance:g} m, {int(g.valid.sum()):,} valid, "
+             f"{int((g.valid & g.reachable).sum()):,} reachable from its own spawns ({own.seconds * 1000:.0f} ms)")
+        wrote.append(str(target.out_dir / f"navgrid.{name}.npz"))
     if table_path is not None:
         wrote.append(str(table_path))
     if target.manifest is not None:

@@ -84,7 +84,7 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
 
     \b
     Writes arena.toml, the model, model.glb, walls.txt, preview.png, navgrid.npz,
-    quadtree.npz, navgrid.png:
+    quadtree.npz, navgrid.png, and navgrid.<vehicle>.npz for each smaller bundled vehicle:
       tanktool import-arena castle.3ds -o arenas/castle --height 1.2
       tanktool import-arena hills.obj --max-slope 30 --climb 0.5
       tanktool import-arena plan.dxf --wall-height 3 --wall-thickness 0.4
@@ -128,6 +128,11 @@ def import_arena(model: Path, out: Path | None, name: str | None, up: str | None
         valid = int(g.grid.valid.sum())
         echo(f"  navgrid: {g.grid.nz} x {g.grid.nx} nodes{f' on {g.grid.levels} levels' if g.grid.levels > 1 else ''} "
              f"at {g.cell:g} m, clearance {g.clearance:g} m ({g.clearance_source}): {valid:,} valid")
+        for name, own in g.vehicles.items():     # a grid of its own for each smaller vehicle
+            og = own.grid
+            echo(f"  navgrid.{name}.npz: clearance {own.clearance:g} m (footprint radius of vehicle '{name}'): "
+                 f"{int(og.valid.sum()):,} valid, {int((og.valid & og.reachable).sum()):,} reachable from its "
+                 f"{len(og.spawn_nodes)} spawns")
         echo(f"  holds at once: {_holds(result)}")
     echo(f"  wrote {result.path} in {result.seconds:.2f} s")
 

@@ -99,7 +99,7 @@ class Episode:
         info = arena.info
         names = [f"agent_{i}" for i in range(config.agents)] + [
             f"{m.name}_{k}" for k, m in enumerate(arena.makers)]
-        self.world = World(info.walls, [arena.spec] * n, info.spawns, seed=seed, bounds=info.bounds,
+        self.world = World(info.walls, [arena.spec] * n, info.spawns_for(arena.spec), seed=seed, bounds=info.bounds,
                            ground=info.ground, names=names)
         w = self.world
         # seeds drawn in tank order from the world's generator, as a match seeds its bots

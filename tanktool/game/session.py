@@ -132,7 +132,7 @@ class GameSession:
         if n < 1:
             raise TanktoolError("a match needs at least one tank")
         names = (["you"] if player else []) + [f"bot{i + 1}" for i in range(bots)]
-        self.world = World(self.info.walls, [self.spec] * n, self.info.spawns, seed=seed, names=names,
+        self.world = World(self.info.walls, [self.spec] * n, self.info.spawns_for(self.spec), seed=seed, names=names,
                            bounds=self.info.bounds, ground=getattr(self.info, "ground", None), rules=rules)
         self.player = 0 if player else None
         if drivers is not None:

@@ -318,6 +318,33 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
                        fleet, too_big)
 
 
+def smaller_vehicles(result: ArenaLevels, fleet: Fleet,
+                     count: int = SPAWN_COUNT) -> dict[str, tuple[float, np.ndarray]]:
+    """{vehicle: (footprint radius, spawn points [x, z, heading, y])} for each bundled
+    vehicle smaller than the one ``result``'s grid and spawns are for: where it fits,
+    on the largest part of its own grid -- surfaces only it reaches (a deck up a ramp
+    too narrow for the larger tank) included.  One with room for fewer than 2 spawn
+    points is left out (it plays on the larger vehicle's spawns)."""
+    big = result.fleet or fleet
+    out: dict[str, tuple[float, np.ndarray]] = {}
+    for name, radius, length in fleet.sizes:
+        if radius >= big.radius - 1e-9 or name in out:
+            continue
+        g = tank_grid(result.surface, result.walls, radius)
+        g.climb = result.params.climb
+        if not g.valid.any():
+            continue
+        fl = fleet.down_to(name, radius, length)
+        focus = focus_box(result.vertices, result.faces, fl.length) if result.vertices is not None else None
+        try:
+            sp = choose_spawns(result.walls, g, fl, result.walls.walls.bounds, count, focus)
+        except ArenaError:
+            continue
+        if len(sp) >= 2:
+            out[name] = (float(radius), sp)
+    return out
+
+
 class NoFitError(ArenaError):
     """No bundled tank fits the model; ``scale`` is the --scale at which the smallest
     fits most of its walkable surface (None: none found)."""

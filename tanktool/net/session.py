@@ -103,9 +103,9 @@ class NetMatch:
     def __post_init__(self) -> None:
         self._seat()
         names = [f"p{n}" for n in range(1, self.peer.slots + 1)]
-        self.world = World(self.arena.walls, [self.spec] * self.peer.slots, self.arena.spawns, seed=self.seed,
-                           names=names, bounds=self.arena.bounds, ground=getattr(self.arena, "ground", None),
-                           rules=NET_RULES)
+        spawns = self.arena.spawns_for(self.spec)      # its vehicle's own, where it has a grid of its own
+        self.world = World(self.arena.walls, [self.spec] * self.peer.slots, spawns, seed=self.seed, names=names,
+                           bounds=self.arena.bounds, ground=getattr(self.arena, "ground", None), rules=NET_RULES)
         for t in self.world.tanks:
             self._start(t)
         self.me = self.world.tanks[self.peer.number - 1]

@@ -106,10 +106,10 @@ def holds(info: Any, specs: list, limit: int = 64) -> list[tuple[str, int]]:
 
     out = []
     for spec in specs:
-        w = World(info.walls, [spec], info.spawns[:1] if len(info.spawns) else info.spawns, bounds=info.bounds,
-                  ground=info.ground)
+        own = info.spawns_for(spec)      # a smaller vehicle's own spawns, where it has a grid of its own
+        w = World(info.walls, [spec], own[:1] if len(own) else own, bounds=info.bounds, ground=info.ground)
         w.spawns, w.spawn_y = w.spawns[:0], w.spawn_y[:0]   # count from the arena's own spawn points
-        for row in np.asarray(info.spawns, dtype=np.float64).reshape(len(info.spawns), -1):
+        for row in np.asarray(own, dtype=np.float64).reshape(len(own), -1):
             w.spawns.append((float(row[0]), float(row[1]), float(row[2])))
             w.spawn_y.append(float(row[3]) if len(row) > 3 and math.isfinite(row[3]) else None)
         out.append((spec.name, min(capacity(w, spec.radius, spec.box[2] - spec.box[0], limit), limit)))
@@ -120,6 +120,6 @@ def slots(info: Any, spec: Any, limit: int) -> int:
     """How many tanks of ``spec`` a match on ``info`` (``match.ArenaInfo``) can seat, up
     to ``limit`` (a network session's player numbers): ``limit`` when the arena has that
     many spawn points, else what it holds at once (:func:`holds`)."""
-    if len(info.spawns) >= limit:
+    if len(info.spawns_for(spec)) >= limit:
         return limit
     return holds(info, [spec], limit)[0][1]

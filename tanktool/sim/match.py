@@ -43,6 +43,15 @@ class ArenaInfo:
     bounds: np.ndarray | None = None
     ground: Any = None            # sim.ground.Ground, or sim.flat_ground.FlatGround (None: flat at y = 0)
     vehicles: dict[str, Any] = field(default_factory=dict)   # the manifest's [vehicles]: what it was built for
+    #: {vehicle: (clearance, (k, 4) spawns)} of the smaller vehicles' own grids (arena.toml [grids])
+    grids: dict[str, Any] = field(default_factory=dict)
+
+    def spawns_for(self, spec: Any) -> np.ndarray:
+        """The spawn points of ``spec``'s vehicle (a TankSpec or a name): those of its own
+        grid (a smaller vehicle's: surfaces only it reaches, such as a deck up a narrow
+        ramp, included), else the arena's (where its largest vehicle fits)."""
+        own = self.grids.get(spec if isinstance(spec, str) else getattr(spec, "name", None))
+        return self.spawns if own is None else own[1]
 
 
 @dataclass
@@ -116,6 +125,7 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
     """Walls, spawn points and bounds of an arena bundle (name or folder)."""
     from ..arena import load_arena
 
+    from ..grid_files import vehicle_grids
     from .flat_ground import load_ground
 
     path = _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
@@ -123,8 +133,9 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
     spawns = np.asarray(bundle.spawns, dtype=np.float64)
     spawns = spawns.reshape(len(spawns), -1) if spawns.size else np.zeros((0, 3))
     vehicles = bundle.toml.get("vehicles")
+    grids = vehicle_grids(bundle.toml, Path(path) / "arena.toml")
     return ArenaInfo(str(bundle.name), bundle.walls, spawns, Path(path), np.asarray(bundle.bounds, float),
-                     load_ground(bundle), vehicles if isinstance(vehicles, dict) else {})
+                     load_ground(bundle), vehicles if isinstance(vehicles, dict) else {}, grids)
 
 
 #: a vehicle may be this much larger than the one an arena was built for [m] (rounding)
@@ -234,8 +245,9 @@ def run_match(arena: ArenaInfo, spec: TankSpec, bots: int = 4, seconds: float = 
     if not (seconds > 0 and math.isfinite(seconds)):
         raise TanktoolError(f"--seconds must be a positive number, got {seconds}")
     names = [f"bot{i + 1}" for i in range(bots)]
-    world = World(arena.walls, [spec] * bots, arena.spawns, seed=seed, dt=dt, integrator=integrator, names=names,
-                  bounds=arena.bounds, ground=arena.ground, rules=match_rules(rules, time_limit, score_limit))
+    world = World(arena.walls, [spec] * bots, arena.spawns_for(spec), seed=seed, dt=dt, integrator=integrator,
+                  names=names, bounds=arena.bounds, ground=arena.ground,
+                  rules=match_rules(rules, time_limit, score_limit))
     drivers = make_bots(world, bot, difficulty)
     if wrap_drivers is not None:
         drivers = wrap_drivers(world, drivers)

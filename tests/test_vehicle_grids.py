@@ -1,0 +1,119 @@
+"""Every vehicle gets its arena (issue 25): one grid per bundled vehicle size.
+
+``navgrid.npz`` stays the grid of the largest vehicle that fits; each smaller one gets
+``navgrid.<vehicle>.npz`` (its clearance, reachable from its own spawns, recorded in
+arena.toml ``[grids.<vehicle>]``), so a deck up a ramp too narrow for the heavy tank is
+the light tank's: its grid has it, its spawns may be there, its agents drive up.  The
+files are hashed: missing or stale, check says so and play rebuilds them."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from tanktool.cli.main import cli
+from tanktool.formats.bundle import read_toml
+from tanktool.freshness import ensure_fresh
+from tanktool.nav.navgrid import NavGrid
+from tanktool.sim.agents.driving import trim
+from tanktool.sim.agents.navigation import plan_path
+from tanktool.sim.match import load_match_arena, load_tank_spec, make_bots, run_match
+from tanktool.sim.world import World
+
+from bot_helpers import view_of
+from level_helpers import import_level
+
+DECK = (52.0, 25.0, 4.0)       # the deck's centre (x, z, y): 4 m up, reached by the 9.2 m ramp only
+
+
+@pytest.fixture(scope="module")
+def bundle(tmp_path_factory):
+    return import_level(tmp_path_factory.mktemp("grids"), "narrow_ramp")
+
+
+def _deck(grid: NavGrid) -> int:
+    """Reachable nodes of ``grid`` on the deck."""
+    return int((grid.valid & grid.reachable & (grid.heights() > 3.9)).sum())
+
+
+def test_each_smaller_vehicle_gets_its_own_grid_and_spawns(bundle):
+    doc = read_toml(bundle / "arena.toml")
+    assert doc["vehicles"]["largest"] == "heavy"
+    light = doc["grids"]["light"]
+    assert light["file"] == "navgrid.light.npz" and "navgrid.light.npz" in doc["derived"]
+    assert 0 < light["clearance"] < doc["navgrid"]["clearance"]       # the light tank's footprint radius
+    heavy_g, light_g = NavGrid.load(bundle / "navgrid.npz"), NavGrid.load(bundle / "navgrid.light.npz")
+    assert _deck(heavy_g) == 0 and heavy_g.reachable.sum() > 3000     # the heavy tank's yard only
+    assert _deck(light_g) > 1000                                        # the light tank's yard and deck
+    info = load_match_arena(bundle)
+    assert set(info.grids) == {"light"}
+    assert np.array_equal(info.spawns_for("heavy"), info.spawns)
+    assert len(info.spawns_for("light")) >= 2 and not np.array_equal(info.spawns_for("light")[:, :2],
+                                                                      info.spawns[:, :2])
+
+
+def test_import_says_how_many_tanks_of_each_vehicle_fit(tmp_path, bundle):
+    src = next(bundle.glob("*.obj"))
+    r = CliRunner().invoke(cli, ["import-arena", str(src), "-o", str(tmp_path / "again")])
+    assert r.exit_code == 0, r.output
+    assert "navgrid.light.npz: clearance 3.2" in r.output
+    assert "holds at once: heavy " in r.output and ", light " in r.output
+    for f in ("navgrid.npz", "navgrid.light.npz"):     # the same model gives the same grids
+        assert (tmp_path / "again" / f).read_bytes() == (bundle / f).read_bytes()
+
+
+def test_a_light_agent_drives_up_to_the_deck_a_heavy_one_has_no_way(bundle):
+    info = load_match_arena(bundle)
+    light, heavy = load_tank_spec("light"), load_tank_spec("heavy")
+    w = World(info.walls, [heavy], info.spawns_for(heavy), bounds=info.bounds, ground=info.ground)
+    drv = make_bots(w)[0]
+    t = w.tanks[0]
+    drv(w, t)
+    assert not plan_path(drv.bot.nav.grid, (t.x, t.z, t.y), DECK)        # no way up for the heavy tank
+    own = info.spawns_for(light)
+    yard = own[own[:, 3] < 0.5]                   # start in the yard, at the foot of the ramp's level
+    w = World(info.walls, [light], yard, bounds=info.bounds, ground=info.ground)
+    drv = make_bots(w)[0]
+    t = w.tanks[0]
+    drv(w, t)
+    assert t.y < 0.5
+    bot = drv.bot
+    bot.path = plan_path(bot.nav.grid, (t.x, t.z, t.y), DECK)
+    assert bot.path
+    for _ in range(120 * 90):
+        trim(bot.path, t.x, t.z)
+        if not bot.path:
+            break
+        w.step(None, [bot.follow(view_of(drv, w), bot.path, speed=1.0, lookahead=4.0)])
+    assert abs(t.y - 4.0) < 0.2 and t.x > 41.0, (t.x, t.z, t.y)
+
+
+def test_a_match_spawns_each_vehicle_on_its_own_spawns(bundle):
+    info = load_match_arena(bundle)
+    light = load_tank_spec("light")
+    w = run_match(info, light, bots=2, seconds=0.5, seed=1).world
+    own = {tuple(np.round(s[:2], 3)) for s in info.spawns_for(light)}
+    assert {tuple(np.round(s[:2], 3)) for s in w.spawns[:len(own)]} == own
+
+
+def test_a_missing_or_stale_vehicle_grid_is_an_error_and_play_rebuilds_it(tmp_path, bundle):
+    b = tmp_path / "b"
+    shutil.copytree(bundle, b)
+    want = (b / "navgrid.light.npz").read_bytes()
+    (b / "navgrid.light.npz").unlink()
+    r = CliRunner().invoke(cli, ["check", str(b)])
+    assert r.exit_code == 1 and "B202" in r.output and "navgrid.light.npz" in r.output, r.output
+    line = ensure_fresh(b)
+    assert line and "navgrid.light.npz missing: rebuilt (build-navgrid" in line
+    assert (b / "navgrid.light.npz").read_bytes() == want
+    (b / "navgrid.light.npz").write_bytes(want[:-1] + b"x")
+    r = CliRunner().invoke(cli, ["check", str(b)])
+    assert r.exit_code == 1 and "B203" in r.output, r.output
+    # a [grids] table gone wrong is one clear diagnostic, not a traceback
+    text = (b / "arena.toml").read_text().replace('clearance = 3.229', 'clearance = "wide"')
+    (b / "arena.toml").write_text(text)
+    r = CliRunner().invoke(cli, ["check", str(b)])
+    assert r.exit_code == 1 and "B102" in r.output and "[grids.light]" in r.output, r.output
