@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .errors import ArenaError
-from .grid_files import is_grid_file
+from .formats.vehicle_grids import is_grid_file
 
 #: the navigation files: build-navgrid rebuilds them (and the smaller vehicles' navgrid.<vehicle>.npz)
 GRID_FILES = ("navgrid.npz", "quadtree.npz")
@@ -61,7 +61,7 @@ def problems(folder: Path, doc: dict[str, Any]) -> dict[str, str]:
 
 def _vehicle_files(folder: Path, doc: dict[str, Any]) -> tuple[str, ...]:
     """The smaller vehicles' grid files, navgrid.<vehicle>.npz of [grids.<vehicle>]."""
-    from .grid_files import vehicle_file, vehicle_grids
+    from .formats.vehicle_grids import vehicle_file, vehicle_grids
 
     return tuple(str(vehicle_file(n)) for n in vehicle_grids(doc, folder / "arena.toml"))
 

@@ -234,7 +234,7 @@ def _remark_fit(model: Path, result: Any, fleet: Any, remark: Callable[[str], No
 def _vehicle_grids(result: Any, fleet: Any, remark: Callable[[str], None]) -> dict[str, Any]:
     """arena.toml's [grids.<vehicle>] (clearance, spawns) of the bundled vehicles smaller
     than the one navgrid.npz is for (nav.arena_levels.smaller_vehicles)."""
-    from .grid_files import vehicle_file
+    from .formats.vehicle_grids import vehicle_file
     from .nav.arena_levels import smaller_vehicles
 
     out: dict[str, Any] = {}

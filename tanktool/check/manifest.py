@@ -217,7 +217,7 @@ def vehicle_grid_files(man: Manifest, out: list[Diagnostic]) -> tuple[str, ...]:
     """The grid files of the smaller vehicles, ``navgrid.<vehicle>.npz`` of [grids.<vehicle>]
     (they must be there, hashed, like navgrid.npz); a B102 for a malformed [grids]."""
     from ..errors import ArenaError
-    from ..grid_files import vehicle_file, vehicle_grids
+    from ..formats.vehicle_grids import vehicle_file, vehicle_grids
 
     if man.doc is None or "grids" not in man.doc:
         return ()

@@ -125,7 +125,7 @@ def load_match_arena(ref: str | Path) -> ArenaInfo:
     """Walls, spawn points and bounds of an arena bundle (name or folder)."""
     from ..arena import load_arena
 
-    from ..grid_files import vehicle_grids
+    from ..formats.vehicle_grids import vehicle_grids
     from .flat_ground import load_ground
 
     path = _bundle_dir(ref, "arenas", DEFAULT_ARENAS)
