@@ -52,3 +52,24 @@ def test_a_levels_regions_are_labelled_alike_compiled_and_by_scipy(seed):
         b, nb = _region_labels(cells, same)
     assert na == nb > 1
     np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("name", ["bridge", "two_storeys", "rolling_terrain"])
+def test_same_level_links_from_the_table_are_the_per_direction_ones(name):
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))
+    import make_levels
+
+    from tanktool.nav.level_walls import _same_level_links, surface_link_level
+    from tanktool.nav.walkable import WalkableParams, surface_layers, walkable_surface
+
+    mesh = make_levels.level(name)
+    s = walkable_surface(np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.faces, dtype=np.int64),
+                         WalkableParams(0.3, 0.2, 45.0, 0.9, 2.0), 0.6)
+    exists, _, _, span_of = surface_layers(s, clearance=False)
+    lev = np.arange(exists.shape[0])[:, None, None]
+    want = np.stack([surface_link_level(s, span_of, d) == lev for d in range(4)], axis=-1) & exists[..., None]
+    np.testing.assert_array_equal(_same_level_links(s, span_of, exists), want)
+    assert want.any()

@@ -313,7 +313,7 @@ def _prepare(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_heig
     span_flat[m] = hf.flat[w_idx[span_of[m]]]
     span_rim[m] = ~hf.top_walkable[w_idx[span_of[m]]]
     lev = np.arange(L)[:, None, None]
-    same = np.stack([surface_link_level(surface, span_of, d) == lev for d in range(4)], axis=-1) & exists[..., None]
+    same = _same_level_links(surface, span_of, exists)
     return _Cut(surface, hf.origin[[0, 2]], hf.cs, hf.ch, exists, height, span_of, span_flat, span_rim, same, cuts,
                 modelled_floors(vertices, faces), tolerance, climb_m, edge_error, edge_max_len, smooth_margin)
 
@@ -484,6 +484,19 @@ def _crop(mask: np.ndarray, box, origin: np.ndarray, cell: float):
     if not sub.any():
         return None
     return sub, np.array([origin[0] + j0 * cell, origin[1] + i0 * cell])
+
+
+def _same_level_links(surface: Surface, span_of: np.ndarray, exists: np.ndarray) -> np.ndarray:
+    """(L, nz, nx, 4): the node's span links in direction d to a span on the node's own
+    level.  Each span's four linked levels are looked up once as a small table (int8
+    while the levels fit, -1 for none) and gathered per node in one pass: four gathers
+    of int64 span links per node took a third of the walls' time on a 2 km terrain."""
+    L = exists.shape[0]
+    small = np.int8 if L < 127 else np.int32
+    lv = np.append(surface.level, -1).astype(small)
+    linked = lv[surface.link]  # (n, 4); a missing link (-1) reads the appended -1
+    lev = np.arange(L, dtype=small)[:, None, None, None]
+    return (linked[np.maximum(span_of, 0)] == lev) & exists[..., None]
 
 
 def surface_link_level(surface: Surface, span_of: np.ndarray, d: int) -> np.ndarray:

@@ -242,6 +242,9 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
     c = col[idx]
     first = np.ones(len(c), dtype=bool)
     first[1:] = c[1:] != c[:-1]
+    if first.all():  # one kept span a column (a terrain): all on level 0, nothing to move
+        level[idx] = 0
+        return level
     start = np.flatnonzero(first)
     level[idx] = np.arange(len(c)) - np.repeat(start, np.diff(np.append(start, len(c))))
     if link is None or level.max() == 0:
