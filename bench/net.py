@@ -130,13 +130,23 @@ def start_session(tmp: Path, peers: int, tag: str,
     return procs, reports, addresses
 
 
+def box_digest() -> bytes:
+    """The match digest of the sessions started here (box, its default vehicle): a
+    joiner on anything else is refused."""
+    from tanktool.net.digest import match_digest
+    from tanktool.sim.match import choose_vehicle, load_match_arena, load_tank_spec
+
+    info = load_match_arena("box")
+    return match_digest(info, load_tank_spec(choose_vehicle(info, None, lambda line: None)))
+
+
 def join_until_working(address: tuple[str, int], since: float, timeout: float = 15.0,
                        password: str | None = None) -> tuple[float, int]:
     """Seconds from ``since`` until a join through ``address`` gets a number, and the host."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         try:
-            p = Peer.join(address, "newcomer", password, timeout=1.0)
+            p = Peer.join(address, "newcomer", password, timeout=1.0, digest=box_digest())
         except NetError as e:
             if os.environ.get("BENCH_NET_DEBUG"):
                 print(f"  {time.monotonic() - since:.3f} s: {e}", file=sys.stderr)
