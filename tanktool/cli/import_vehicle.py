@@ -162,39 +162,15 @@ def sanity_warnings(model: Path, vertices: np.ndarray, mass: float, forward: str
     return out
 
 
-def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = None, scale: float = 1.0,
-                         hull_points_n: int = 16, levels: int = 3, branching: int = 4,
-                         mass: float | None = None, force: bool = False,
-                         drive: dict[str, Any] | None = None, forward: str = "+x") -> ImportResult:
-    """Read ``model`` and write the vehicle bundle ``out`` atomically.
-
-    ``forward`` is the model file's axis that points to the vehicle's front; it is
-    turned to +x.  ``drive`` replaces the computed [drive] defaults (``make vehicles``
-    keeps the hand-edited figures of a bundled vehicle this way).  What looks wrong
-    but is written anyway is in the result's ``warnings``.
-    """
+def _vehicle_mesh(model: Path, up: str, scale: float, forward: str) -> tuple[Any, Any, np.ndarray]:
+    """The model in the vehicle frame: (scene, its meshes as one, the offset applied),
+    refused when flat from above or absurdly large."""
     import trimesh
 
-    from ..formats.bundle import atomic_write_bytes, atomic_write_text, dumps_toml, sha256_file
-    from ..formats.bundle_swap import check_replaceable, staged_dir
-    from ..formats.materials import export_glb
-    from ..formats.models import default_up, detect_format, load_scene
-    from ..formats.vehicle_bundle import write_hull
-    from ..geometry.mass import drive_defaults, sig, to_scale
-    from ..geometry.spheres import write_spheres
-    from ..plots.vehicle import plot_vehicle
+    from ..formats.models import load_scene
 
-    t0 = time.perf_counter()
-    model = Path(model)
-    check_options(hull_points_n, levels, branching, mass, name)
-    out = Path(out)
-    check_replaceable(out, force, "vehicle.toml")  # only a vehicle bundle tanktool wrote is replaced
-    if out.resolve() == model.resolve().parent:
-        raise VehicleError(f"{out}: the output folder must not be the folder of the model being imported")
-    fmt = detect_format(model)
-    up_used = up or default_up(fmt)
-    turn = forward_rotation(forward, up_used)
-    scene = load_scene(model, up=up_used, scale=scale)
+    turn = forward_rotation(forward, up)
+    scene = load_scene(model, up=up, scale=scale)
     if not np.array_equal(turn, np.eye(4)):
         scene.apply_transform(turn)
     meshes = [m for m in scene.dump() if isinstance(m, trimesh.Trimesh) and len(m.faces)]
@@ -207,7 +183,38 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
     offset = vehicle_frame_offset(np.asarray(mesh.vertices))
     scene.apply_translation(offset)
     mesh.apply_translation(offset)
+    return scene, mesh, offset
 
+
+def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = None, scale: float = 1.0,
+                         hull_points_n: int = 16, levels: int = 3, branching: int = 4,
+                         mass: float | None = None, force: bool = False,
+                         drive: dict[str, Any] | None = None, forward: str = "+x") -> ImportResult:
+    """Read ``model`` and write the vehicle bundle ``out`` atomically.
+
+    ``forward`` is the model file's axis that points to the vehicle's front; it is
+    turned to +x.  ``drive`` replaces the computed [drive] defaults (``make vehicles``
+    keeps the hand-edited figures of a bundled vehicle this way).  What looks wrong
+    but is written anyway is in the result's ``warnings``.
+    """
+    from ..formats.bundle import atomic_write_bytes, atomic_write_text, dumps_toml
+    from ..formats.bundle_swap import check_replaceable, staged_dir
+    from ..formats.materials import export_glb
+    from ..formats.models import default_up, detect_format
+    from ..formats.vehicle_bundle import write_hull
+    from ..geometry.mass import drive_defaults
+    from ..geometry.spheres import write_spheres
+    from ..plots.vehicle import plot_vehicle
+
+    t0 = time.perf_counter()
+    model = Path(model)
+    check_options(hull_points_n, levels, branching, mass, name)
+    out = Path(out)
+    check_replaceable(out, force, "vehicle.toml")  # only a vehicle bundle tanktool wrote is replaced
+    if out.resolve() == model.resolve().parent:
+        raise VehicleError(f"{out}: the output folder must not be the folder of the model being imported")
+    up_used = up or default_up(detect_format(model))
+    scene, mesh, offset = _vehicle_mesh(model, up_used, scale, forward)
     hull, fp, tree, mp = derive(mesh, hull_points_n, levels, branching, mass)
     if not MASS_RANGE[0] <= mp.mass <= MASS_RANGE[1]:
         raise VehicleError(f"{model}: its volume ({mp.volume:.3g} m^3, {mp.method}) gives a mass of "
@@ -220,41 +227,55 @@ def build_vehicle_bundle(model: Path, out: Path, name: str, up: str | None = Non
     header = f"{name}: made by tanktool {__version__} import-vehicle from {model.name}"
 
     with staged_dir(out, force=force, manifest="vehicle.toml") as tmp:
-        source_name = model.name
-        shutil.copyfile(model, tmp / source_name)
+        shutil.copyfile(model, tmp / model.name)
         glb, textures = export_glb(model, scene, tmp, extra=[out], warn=warnings.append)   # textures copied in
         atomic_write_bytes(tmp / "model.glb", glb)
         write_hull(tmp / "hull.txt", hull, header)
         write_spheres(tmp / "spheres.txt", tree, header)
         plot_vehicle(tmp / "preview.png", mesh, hull, tree,
                      title=f"{name}: {len(hull)} hull points, {len(tree)} spheres, {mp.mass / 1000:.1f} t")
-        radius = float(np.max(np.hypot(hull[:, 0], hull[:, 2])))
-        size = float(np.ptp(np.asarray(mesh.vertices), axis=0).max())
-        # significant digits, not fixed decimals: a 5 cm model keeps its figures too
-        doc = {
-            "name": name,
-            "tool_version": __version__,
-            "footprint_radius": sig(radius),
-            "source": {"file": source_name, "sha256": sha256_file(tmp / source_name), "up": up_used,
-                       "forward": forward, "scale": float(scale),
-                       "vehicle_frame_offset": [to_scale(x, size) for x in offset]},
-            "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
-            "mass": {"mass": sig(mp.mass), "inertia": sig(mp.inertia),
-                     "centre_of_mass": [to_scale(x, size) for x in mp.centre_of_mass],
-                     "method": mp.method, "volume": sig(mp.volume),
-                     "mass_given": mass is not None},
-            "drive": params,
-            "hull": {"file": "hull.txt", "points": int(len(hull)), "requested": hull_points_n,
-                     "footprint_area": sig(fp.area), "convex_area": sig(fp.convex_area)},
-            "spheres": {"file": "spheres.txt", "levels": int(tree.levels), "branching": branching,
-                        "count": int(len(tree)), "leaves": int(len(tree.leaves())),
-                        "requested_levels": levels},
-            "derived": {f: sha256_file(tmp / f) for f in ("model.glb", "hull.txt", "spheres.txt", "preview.png")},
-        }
+        doc = _manifest(tmp, name, model.name, (up_used, forward, scale, offset), mesh, textures, mp, mass,
+                        params, (hull, fp, hull_points_n), (tree, branching, levels))
         atomic_write_text(tmp / "vehicle.toml", DRIVE_COMMENT + dumps_toml(doc))
     return ImportResult(out, name, len(hull), fp.area, fp.convex_area, len(tree), len(tree.leaves()),
                         int(tree.levels), float(tree.radii[0]), mp.mass, mp.inertia, mp.method,
                         time.perf_counter() - t0, warnings)
+
+
+def _manifest(tmp: Path, name: str, source_name: str, frame: tuple, mesh: Any, textures: list, mp: Any,
+              mass: float | None, params: dict, hull_info: tuple, tree_info: tuple) -> dict[str, Any]:
+    """vehicle.toml of the bundle staged in ``tmp`` (its files written): ``frame`` is
+    (up, forward, scale, offset), ``hull_info`` (hull, footprint, points asked for),
+    ``tree_info`` (sphere tree, branching, levels asked for)."""
+    from ..formats.bundle import sha256_file
+    from ..geometry.mass import sig, to_scale
+
+    up_used, forward, scale, offset = frame
+    hull, fp, hull_points_n = hull_info
+    tree, branching, levels = tree_info
+    radius = float(np.max(np.hypot(hull[:, 0], hull[:, 2])))
+    size = float(np.ptp(np.asarray(mesh.vertices), axis=0).max())
+    # significant digits, not fixed decimals: a 5 cm model keeps its figures too
+    return {
+        "name": name,
+        "tool_version": __version__,
+        "footprint_radius": sig(radius),
+        "source": {"file": source_name, "sha256": sha256_file(tmp / source_name), "up": up_used,
+                   "forward": forward, "scale": float(scale),
+                   "vehicle_frame_offset": [to_scale(x, size) for x in offset]},
+        "model": {"file": "model.glb", **({"textures": textures} if textures else {})},
+        "mass": {"mass": sig(mp.mass), "inertia": sig(mp.inertia),
+                 "centre_of_mass": [to_scale(x, size) for x in mp.centre_of_mass],
+                 "method": mp.method, "volume": sig(mp.volume),
+                 "mass_given": mass is not None},
+        "drive": params,
+        "hull": {"file": "hull.txt", "points": int(len(hull)), "requested": hull_points_n,
+                 "footprint_area": sig(fp.area), "convex_area": sig(fp.convex_area)},
+        "spheres": {"file": "spheres.txt", "levels": int(tree.levels), "branching": branching,
+                    "count": int(len(tree)), "leaves": int(len(tree.leaves())),
+                    "requested_levels": levels},
+        "derived": {f: sha256_file(tmp / f) for f in ("model.glb", "hull.txt", "spheres.txt", "preview.png")},
+    }
 
 
 DRIVE_COMMENT = """\
