@@ -9,9 +9,9 @@
  * Python's own headers.
  *
  *   link_spans(col, floor, ceil, start, nz, nx, headroom, climb, out)
- *       col, floor, ceil, start: int64; out: int64 (n, 4), filled in place
+ *       col, floor, ceil, start: int64; out: int32 (n, 4), filled in place (n < 2**31)
  *   chamfer(link, dist, limit)
- *       link: int64 (n, 4); dist: int32 (n,), the starting values, relaxed in place
+ *       link: int32 (n, 4); dist: int32 (n,), the starting values, relaxed in place
  *   raster(tri, abc, nz, nx, ch, max_steps, row_lo, row_hi, steep) -> (col, tri, smin, smax) as int64 bytes
  *       (the cells of rows row_lo .. row_hi - 1 only); steep: the triangles' exact sections
  *       (heightfield._cells_exact) instead of their planes (_cells_plane; abc unused)
@@ -20,7 +20,7 @@
  *   filters(col, smin, smax, walk, nz, nx, headroom, climb, w3, lifted, ledge, steep, low)
  *       int64 spans, bool walk; the five bool outputs of span_filters.filter_masks
  *   components(link, label)
- *       link: int64 (n, 4); label: int64 (n,) written: the smallest span of each component
+ *       link: int32 (n, 4); label: int64 (n,) written: the smallest span of each component
  *   merge_spans(key, thr, col, smin, smax, walk, flat, top_walk) -> count
  *       key: sorted int64 packed pieces; outputs int64 / bool arrays as long as key
  *   grid_labels(valid, link, L, nz, nx, out) -> k   (_kernels_grid.c)
@@ -43,11 +43,15 @@ static PyObject *link_spans(PyObject *self, PyObject *args) {
     Py_ssize_t n = col.len / 8;
     PyObject *ret = NULL;
     if (!need(&floor_, n, 8, "floor") || !need(&ceil_, n, 8, "ceil") || !need(&start, nz * nx + 1, 8, "start") ||
-        !need(&out, 4 * n, 8, "out"))
+        !need(&out, 4 * n, 4, "out"))
         goto done;
+    if (n >= INT32_MAX) {
+        PyErr_SetString(PyExc_ValueError, "link_spans: 2**31 spans or more (int32 links)");
+        goto done;
+    }
     {
         const i64 *c = col.buf, *f = floor_.buf, *ce = ceil_.buf, *st = start.buf;
-        i64 *o = out.buf;
+        int32_t *o = out.buf;
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t s = 0; s < n; ++s) {
             const i64 i = c[s] / nx, j = c[s] % nx;
@@ -65,7 +69,7 @@ static PyObject *link_spans(PyObject *self, PyObject *args) {
                         }
                     }
                 }
-                o[4 * s + d] = found;
+                o[4 * s + d] = (int32_t)found;
             }
         }
         Py_END_ALLOW_THREADS
@@ -88,8 +92,8 @@ static inline int32_t at(const int32_t *dist, i64 a) { return a < 0 ? 0 : dist[a
 
 /* one relaxation of span s: straight steps cost 2, diagonal ones (a straight link,
  * then the next direction's link from there, either way round) 3 */
-static inline int32_t relax(const i64 *L, const int32_t *dist, Py_ssize_t s, int32_t v) {
-    const i64 *l = L + 4 * s;
+static inline int32_t relax(const int32_t *L, const int32_t *dist, Py_ssize_t s, int32_t v) {
+    const int32_t *l = L + 4 * s;
     for (int d = 0; d < 4; ++d) {
         const int e = (d + 1) & 3;
         const i64 a = l[d], b = l[e];
@@ -109,9 +113,9 @@ static PyObject *chamfer(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "y*w*i", &link, &dist, &limit)) return NULL;
     Py_ssize_t n = dist.len / 4;
     PyObject *ret = NULL;
-    if (!need(&link, 4 * n, 8, "link")) goto done;
+    if (!need(&link, 4 * n, 4, "link")) goto done;
     {
-        const i64 *L = link.buf;
+        const int32_t *L = link.buf;
         int32_t *D = dist.buf;
         Py_BEGIN_ALLOW_THREADS
         /* sweeps forward and back (spans come in scan order, so each sweep carries a
@@ -158,9 +162,9 @@ static PyObject *components(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "y*w*", &link, &label)) return NULL;
     const Py_ssize_t n = label.len / 8;
     PyObject *ret = NULL;
-    if (!need(&link, 4 * n, 8, "link")) goto done;
+    if (!need(&link, 4 * n, 4, "link")) goto done;
     {
-        const i64 *L = link.buf;
+        const int32_t *L = link.buf;
         i64 *P = label.buf;
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t s = 0; s < n; ++s) P[s] = s;
@@ -365,7 +369,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 3
+#define TANKTOOL_KERNELS_ABI 4
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

@@ -87,7 +87,7 @@ class Surface:
     """Open spans (one per walkable span) of a heightfield, sorted by (column, floor).
 
     col : (n,) column ``i * nx + j``;  floor / ceil : (n,) in cell-height steps
-    link : (n, 4) index of the linked span in each direction (DIRS), -1 for none
+    link : (n, 4) index of the linked span in each direction (DIRS), -1 for none (int32, link_dtype)
     clearance : (n,) metres to the nearest edge (capped at ``max_clearance``)
     region : (n,) component label;  main : (n,) in the played region
     level : (n,) the span's level among the main region's spans (-1 outside it)
@@ -127,6 +127,12 @@ class Surface:
         return np.divmod(self.col, self.hf.shape[1])
 
 
+def link_dtype(n: int) -> type:
+    """The dtype of the links of ``n`` spans: int32 (16 bytes a span where int64 took
+    32: the largest array of a surface) unless the indices need more."""
+    return np.int32 if n < 2**31 - 1 else np.int64
+
+
 def link_spans(col: np.ndarray, floor: np.ndarray, ceil: np.ndarray, shape: tuple[int, int],
                headroom: int, climb: int) -> np.ndarray:
     """(n, 4) links between open spans (see the module docstring); steps in cells.
@@ -137,9 +143,9 @@ def link_spans(col: np.ndarray, floor: np.ndarray, ceil: np.ndarray, shape: tupl
     nz, nx = shape
     n = len(col)
     start = column_starts(col, nz * nx)
-    link = np.full((n, 4), -1, dtype=np.int64)
+    link = np.full((n, 4), -1, dtype=link_dtype(n))
     kern = active()
-    if kern is not None:
+    if kern is not None and link.dtype == np.int32:
         kern.link_spans(i64(col), i64(floor), i64(ceil), start, nz, nx, int(headroom), int(climb), link)
         return link
     count = np.diff(start)
@@ -177,8 +183,8 @@ def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
     if n == 0:
         return dist
     kern = active()
-    if kern is not None:  # sweeps to the same fixed point (tanktool/_kernels.c)
-        kern.chamfer(i64(link), dist, int(limit))
+    if kern is not None and link.dtype == np.int32:  # sweeps to the same fixed point (tanktool/_kernels.c)
+        kern.chamfer(np.ascontiguousarray(link), dist, int(limit))
         return dist
     # index n is a sentinel at distance 0: a missing link leads off the edge
     safe = [np.ascontiguousarray(np.where(link[:, d] < 0, n, link[:, d])) for d in range(4)]
@@ -213,9 +219,9 @@ def components(link: np.ndarray) -> np.ndarray:
     if n == 0:
         return np.arange(0, dtype=np.int64)
     kern = active()
-    if kern is not None:  # union-find, the smaller index the root: the same labels
+    if kern is not None and link.dtype == np.int32:  # union-find, the smaller index the root: the same labels
         label = np.empty(n, dtype=np.int64)
-        kern.components(i64(link), label)
+        kern.components(np.ascontiguousarray(link), label)
         return label
     ok = link >= 0
     dst = link[ok]                                   # row by row: the rows come sorted
