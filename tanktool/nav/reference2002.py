@@ -7,7 +7,7 @@ import numpy as np
 
 from ..formats.walls_txt import WallList
 from ..geometry.segments import point_segment_dist2
-from .navgrid import _oriented, node_coords, on_wall_tolerance
+from .free_space import _oriented, node_coords, on_wall_tolerance
 
 
 def reference_node(walls: WallList, A: np.ndarray, B: np.ndarray, origin: np.ndarray, p: np.ndarray) -> bool:
