@@ -214,6 +214,31 @@ def _representatives(points: np.ndarray, most: int) -> tuple[np.ndarray, np.ndar
 _REPS = 2048  # decisions are made on at most about this many representative points
 
 
+def _first_split(U: np.ndarray, fixed: np.ndarray, reps: np.ndarray, proj: np.ndarray, opts: list[_Option],
+                 branching: int, seed: int, lookahead: int) -> tuple[list[int], list[list[_Option]]]:
+    """The root's split, chosen with lookahead: the ``lookahead`` candidates claiming
+    least of the samples ``U`` (``fixed``: claimed already) are each scored by the
+    best level below them.  Returns ([the candidate chosen], the options chosen below
+    it: the next level, planned)."""
+    for o in opts:
+        o.mask = _cover(U, o.centers, o.radii)
+    best = None
+    for j in np.argsort([np.count_nonzero(o.mask) for o in opts], kind="stable")[:lookahead]:
+        below = [_options(reps, proj, g, branching, seed + 1 + t) for t, g in enumerate(opts[j].pieces)]
+        keep = fixed.copy()
+        for o2, c, r in zip(below, opts[j].centers, opts[j].radii):
+            if not o2:
+                keep |= _cover(U, c[None], np.array([r]))
+        choice_below, total = _choose(U, below, keep)
+        if best is None or total < best[0]:
+            best = (total, int(j), below, choice_below)
+    planned = [[opts2[c2]] if c2 >= 0 else [] for opts2, c2 in zip(best[2], best[3])]
+    for opts2 in planned:
+        for o in opts2:
+            o.mask = None
+    return [best[1]], planned
+
+
 def build_sphere_tree(points: np.ndarray, levels: int = 3, branching: int = 4, seed: int = 0,
                       lookahead: int = 4, samples: int = 8192) -> SphereTree:
     """Top-down sphere tree over ``points`` (vertices plus surface samples).
@@ -261,25 +286,7 @@ def build_sphere_tree(points: np.ndarray, levels: int = 3, branching: int = 4, s
                 c, r = quick_sphere(reps[idx], proj[idx])
                 fixed |= _cover(U, c[None], np.array([r]))
         if len(frontier) == 1 and depth < levels and len(options_per[0]) > 1:
-            # the first split: score the best few by the level below them
-            opts = options_per[0]
-            for o in opts:
-                o.mask = _cover(U, o.centers, o.radii)
-            best = None
-            for j in np.argsort([np.count_nonzero(o.mask) for o in opts], kind="stable")[:lookahead]:
-                below = [_options(reps, proj, g, branching, seed + 1 + t) for t, g in enumerate(opts[j].pieces)]
-                keep = fixed.copy()
-                for o2, c, r in zip(below, opts[j].centers, opts[j].radii):
-                    if not o2:
-                        keep |= _cover(U, c[None], np.array([r]))
-                choice_below, total = _choose(U, below, keep)
-                if best is None or total < best[0]:
-                    best = (total, int(j), below, choice_below)
-            choice = [best[1]]
-            planned = [[opts2[c2]] if c2 >= 0 else [] for opts2, c2 in zip(best[2], best[3])]
-            for opts2 in planned:
-                for o in opts2:
-                    o.mask = None
+            choice, planned = _first_split(U, fixed, reps, proj, options_per[0], branching, seed, lookahead)
         else:
             choice, _ = _choose(U, options_per, fixed)
         nxt = []
