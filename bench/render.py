@@ -12,7 +12,8 @@ For every bundled arena a match of 8 computer agents is warmed up for 60 frames,
   turns, ``--frames`` frames at a time for ``--rounds`` rounds, while the match goes on
   (2 steps of 1/120 s between frames, not timed), so each sees the same load; the
   **ratio** preset fps / reference fps (median of the rounds) is the figure to compare
-  across machines:
+  across machines (each preset's renderer has its own headless context, made current
+  for its frames: with one current for all, the others drew almost nothing):
   llvmpipe renders on every core, so on a shared machine the absolute fps follow the
   other jobs, the ratio much less.  Beside them the CPU time the frame took on every
   thread of the process (llvmpipe's rasteriser threads included: ``cpu ms/frame``),
