@@ -259,12 +259,37 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
     t["walls"] = time.perf_counter() - t0
     step("walls")
     t0 = time.perf_counter()
-    # the largest vehicle that fits: the grid and spawns are made for it (an arena too
-    # narrow for the heavy tank still plays with the light one; play refuses the others)
+    found, why, problem, tries = _largest_fit(surface, lw, params, fleet, spawn_count, vertices, faces)
+    t["grid"] = time.perf_counter() - t0
+    step("grid")
+    if found is None:
+        raise _refusal(surface, lw, tries, problem, (vertices, faces, params))
+    grid, spawns, fleet = found
+    too_big = [(n, why.get(n, "fits nowhere")) for n, r, _ in tries if r > fleet.radius]
+    t["spawns"] = 0.0
+    step("spawns")
+    t0 = time.perf_counter()
+    levels = _level_infos(surface, lw)
+    report = left_out(surface, vertices, faces, params, fleet.radius)
+    flat = len(lw.regions) == 1 and lw.regions[0].y_hi - lw.regions[0].y_lo <= params.cell_height + 1e-9
+    floor_y = _floor_y(lw, surface)
+    t["report"] = time.perf_counter() - t0
+    step("report")
+    return ArenaLevels(surface, params, lw, grid, spawns, levels, report, floor_y, flat, vertices, faces, t,
+                       fleet, too_big)
+
+
+def _largest_fit(surface: Surface, lw: LevelWalls, params: WalkableParams, fleet: Fleet, spawn_count: int,
+                 vertices: np.ndarray, faces: np.ndarray) -> tuple[tuple | None, dict[str, str], str | tuple, list]:
+    """The largest vehicle that fits: the grid and spawns are made for it (an arena too
+    narrow for the heavy tank still plays with the light one; play refuses the others).
+    Returns ((grid, spawns, fleet) or None, vehicle -> why the arena is not for it,
+    the first problem met (a message, or (vehicle, radius) that fits nowhere), the
+    vehicles tried (name, radius, length))."""
     tries = [(n, r, ln) for n, r, ln in fleet.sizes] or [(fleet.radius_of, fleet.radius, fleet.length)]
     found = None  # (grid, spawns, fleet) of the largest vehicle that fits
     problem: str | tuple = ""
-    why: dict[str, str] = {}  # vehicle -> why the arena is not for it
+    why: dict[str, str] = {}
     for k, (name, radius, length) in enumerate(tries):
         if k and radius >= tries[k - 1][1]:
             continue
@@ -286,22 +311,23 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
         if len(found[1]) >= 2:  # room for a duel; else a smaller vehicle may have more
             break
         why[name] = f"has room for only {len(sp)} spawn point"
-    t["grid"] = time.perf_counter() - t0
-    step("grid")
-    if found is None:
-        if len(tries) == 1:
-            if isinstance(problem, tuple):
-                raise _no_fit(surface, lw, *problem, (vertices, faces, params))
-            raise ArenaError(problem)
-        name, radius, _ = tries[-1]
-        nofit = _no_fit(surface, lw, name, radius, (vertices, faces, params))
-        raise NoFitError(f"no place where any bundled tank fits (the largest bundled tank, {tries[0][0]}, nor "
-                         f"the smallest): {nofit}", nofit.scale)
-    grid, spawns, fleet = found
-    too_big = [(n, why.get(n, "fits nowhere")) for n, r, _ in tries if r > fleet.radius]
-    t["spawns"] = 0.0
-    step("spawns")
-    t0 = time.perf_counter()
+    return found, why, problem, tries
+
+
+def _refusal(surface: Surface, lw: LevelWalls, tries: list, problem: str | tuple, model: tuple) -> ArenaError:
+    """Why no vehicle of ``tries`` fits (``problem``: the first one met, see :func:`_largest_fit`)."""
+    if len(tries) == 1:
+        if isinstance(problem, tuple):
+            return _no_fit(surface, lw, *problem, model)
+        return ArenaError(problem)
+    name, radius, _ = tries[-1]
+    nofit = _no_fit(surface, lw, name, radius, model)
+    return NoFitError(f"no place where any bundled tank fits (the largest bundled tank, {tries[0][0]}, nor "
+                      f"the smallest): {nofit}", nofit.scale)
+
+
+def _level_infos(surface: Surface, lw: LevelWalls) -> list[LevelInfo]:
+    """Each level's area, heights and number of regions."""
     levels = []
     cell2 = surface.hf.cs ** 2
     for lv in range(surface.levels):
@@ -309,13 +335,7 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
         ys = surface.y[m]
         levels.append(LevelInfo(lv, float(m.sum() * cell2), float(ys.min()), float(ys.max()),
                                 sum(1 for r in lw.regions if r.level == lv)))
-    report = left_out(surface, vertices, faces, params, fleet.radius)
-    flat = len(lw.regions) == 1 and lw.regions[0].y_hi - lw.regions[0].y_lo <= params.cell_height + 1e-9
-    floor_y = _floor_y(lw, surface)
-    t["report"] = time.perf_counter() - t0
-    step("report")
-    return ArenaLevels(surface, params, lw, grid, spawns, levels, report, floor_y, flat, vertices, faces, t,
-                       fleet, too_big)
+    return levels
 
 
 def smaller_vehicles(result: ArenaLevels, fleet: Fleet,
