@@ -273,3 +273,42 @@ def test_a_member_cut_off_alone_comes_back_and_draws_nobody_away():
     net.run(12.0)
     assert_one_session(net)
     assert host.core.is_host and len(live(net)) == 5 and not kinds(host, "stepdown") and kinds(carol, "stepdown")
+
+
+# ---------------------------------------------------------------- determinism, finding 8
+def _story(seed: int) -> list:
+    net = SimCluster(seed=seed, **BAD)
+    host = net.host("alice")
+    a, b = net.join("bob", host), net.join("carol", host)
+    net.run(1.0)
+    net.kill(b)
+    net.pause(host)
+    net.run(5.0)
+    net.resume(host)
+    net.run(5.0)
+    return [(n.name, round(t, 6), e.kind, e.number, e.reason) for n in net.nodes.values() for t, e in n.events]
+
+
+def test_the_same_seed_tells_the_same_story():
+    one, two = _story(12), _story(12)
+    assert one == two and any(kind == "stepdown" for _, _, kind, _, _ in one)
+    assert _story(13) != one
+
+
+def test_a_members_flood_leaves_the_honest_states_at_the_host():
+    """A member sends 20,000 valid states a second from its own address: dropped before
+    decoding at the host, whose honest member's 30 a second still all count."""
+    net = SimCluster(seed=14, delay=0.05)        # no loss or jitter: every honest state counts
+    host = net.host("alice")
+    honest, flooder = net.join("bob", host), net.join("mallory", host)
+    net.run(1.0)
+    before = host.core.states_from[honest.core.number]
+    for _ in range(300):                                         # 3 s
+        for _ in range(200):
+            flooder.core.seq += 1
+            data = P.encode(P.State(3, flooder.core.session_time(), 20.0, 20.0, 0, 0, 0, 0, 100.0, True),
+                            3, flooder.core.seq, net.now)
+            net.inject(flooder.address, host, data)
+        net.run(0.01)
+    taken = (host.core.states_from[honest.core.number] - before) / 3.0
+    assert taken >= 29.5 and host.core.dropped["flood"] > 50000

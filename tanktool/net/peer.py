@@ -14,6 +14,7 @@ A connection is flushed as the kernel takes it; one whose unsent data passes
 
 from __future__ import annotations
 
+import errno
 import selectors
 import socket
 import time
@@ -382,7 +383,7 @@ class Peer:
         sock.setblocking(False)
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         err = sock.connect_ex(a.addr)
-        if err not in (0, 115, 36, 11, 35, 10035):      # EINPROGRESS / EWOULDBLOCK (Linux, BSD, Windows)
+        if err not in (0, errno.EINPROGRESS, errno.EWOULDBLOCK, errno.EAGAIN):
             sock.close()
             self.core.disconnected(a.link, "connect failed", self.clock())
             return

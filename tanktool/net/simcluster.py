@@ -202,7 +202,7 @@ class SimCluster:
                 node.join_error, node.join_to = outcome.text, None
         core.tick(now)
         if core.number and now >= node.next_state and not core.closed:
-            node.next_state = now + 1.0 / self.state_hz
+            node.next_state = max(node.next_state + 1.0 / self.state_hz, now - 1.0 / self.state_hz)
             for n in core.speaks_for():
                 core.send_state(self.states(node, n, core.session_time()), now)
         self._perform(node)
