@@ -220,10 +220,21 @@ def walls_case(name: str, code: str, segs, dirs, mutate=None, aux=(-1.0, -1.0, R
     return case
 
 
-def make_cases() -> None:
-    segs, dirs = base_walls()
+#: a corner room behind a 2 m door: the 2.4 m wide tank cannot get in (no spawn is there)
+DOOR_PART = [[[28, 40], [28, 30]], [[28, 30], [38, 30]]]
 
-    # --- walls.txt syntax
+
+def make_cases() -> None:
+    """Every case of the rules on walls.txt, arenas, bundle files and vehicles."""
+    segs, dirs = base_walls()
+    _walls_cases(segs, dirs)
+    _arena_cases(segs, dirs)
+    _bundle_cases()
+    _vehicle_cases(segs, dirs)
+
+
+def _walls_cases(segs, dirs) -> None:
+    """A101-A105 (walls.txt syntax) and A201-A205 (wall geometry), bare walls files."""
     def replace_wall(text, seg, new):
         (x1, z1), (x2, z2) = seg
         out = []
@@ -264,7 +275,9 @@ def make_cases() -> None:
     c = walls_case("flipped_normal", "A205", segs, flipped)
     expect(c, "A205", "walls.txt", "walls.txt", [wall_line(c / "walls.txt", segs[1])])
 
-    # --- free space and spawn points (arena bundles)
+
+def _arena_cases(segs, dirs) -> None:
+    """A301-A308: free space and spawn points (arena bundles)."""
     leaky = [[[0, 0], [18, 0]], [[22, 0], [40, 0]]] + segs[1:]
     c = BROKEN / "A301_leak"
     write_arena(c / "arenas" / "leaky", leaky, [dirs[0]] + dirs)
@@ -292,8 +305,7 @@ def make_cases() -> None:
     c = spawn_case("A305", "few_spawns", SPAWNS[:7])
     expect(c, "A305", "arenas/few_spawns", "arenas/few_spawns/arena.toml",
            [line_of(c / "arenas/few_spawns/arena.toml", "spawns = ")])
-    # a corner room behind a 2 m door: the 2.4 m wide tank cannot get in (no spawn is there)
-    part = [[[28, 40], [28, 30]], [[28, 30], [38, 30]]]
+    part = DOOR_PART
     c = spawn_case("A306", "narrow_door", SPAWNS, vehicle=True, segs_=segs + part, dirs_=dirs + [1, 1])
     w = c / "arenas/narrow_door/walls.txt"
     expect(c, "A306", "arenas/narrow_door", "arenas/narrow_door/walls.txt",
@@ -306,7 +318,9 @@ def make_cases() -> None:
     write_arena(c / "arenas" / "bumpy", bump=True)
     expect(c, "A308", "arenas/bumpy", "arenas/bumpy/arena.toml", [line_of(c / "arenas/bumpy/arena.toml", "floor_y")])
 
-    # --- bundle files
+
+def _bundle_cases() -> None:
+    """B101-B301: the files of a bundle, and what play cannot load."""
     c = BROKEN / "B101_bad_toml"
     write_arena(c / "arenas" / "a")
     t = c / "arenas/a/arena.toml"
@@ -342,7 +356,9 @@ def make_cases() -> None:
     write_arena(c / "arenas" / "a", toml_edit=lambda d: d.update(walls=1))
     expect(c, "B301", "arenas/a", "arenas/a/arena.toml", [line_of(c / "arenas/a/arena.toml", "walls = 1")])
 
-    # --- vehicles
+
+def _vehicle_cases(segs, dirs) -> None:
+    """V101-V401: vehicle bundles."""
     def vcase(code, name, **kw):
         c = BROKEN / f"{code}_{name}"
         write_vehicle(c / "vehicles" / "tank", **kw)
@@ -402,7 +418,7 @@ def make_cases() -> None:
     expect(c, "V303", "vehicles/tank", "vehicles/tank/vehicle.toml", [line_of(v / "vehicle.toml", "top_speed")])
     c = BROKEN / "V401_does_not_fit"
     write_vehicle(c / "vehicles" / "tank")
-    write_arena(c / "arenas" / "narrow_door", segs + part, dirs + [1, 1])
+    write_arena(c / "arenas" / "narrow_door", segs + DOOR_PART, dirs + [1, 1])
     expect(c, "V401", "vehicles/tank", "vehicles/tank/vehicle.toml",
            [line_of(c / "vehicles/tank/vehicle.toml", "footprint_radius")])
 
