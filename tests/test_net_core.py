@@ -38,6 +38,21 @@ def kinds(node: SimNode, kind: str) -> list:
 
 
 # ---------------------------------------------------------------- the core by hand
+def test_the_core_does_no_io():
+    """The protocol's modules import no socket, selector, clock or thread: events and the
+    time come in, actions go out (the transport, net/peer.py, does the I/O)."""
+    import ast
+    import importlib
+
+    for name in ("core", "links", "handshake", "joining", "datagrams", "terms", "guard", "judge", "simnet",
+                 "simcluster"):
+        path = importlib.import_module(f"tanktool.net.{name}").__file__
+        tree = ast.parse(open(path, encoding="utf-8").read())
+        imported = {a.name.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names}
+        imported |= {n.module.split(".")[0] for n in ast.walk(tree) if isinstance(n, ast.ImportFrom) and n.module}
+        assert not imported & {"socket", "selectors", "time", "threading", "asyncio", "select"}, (name, imported)
+
+
 def test_the_core_by_hand_admits_a_joiner():
     """The example of docs/network.md: no socket, no clock; bytes and times in, actions out."""
     host = Core("alice", nonce_source=lambda k: bytes(k))
