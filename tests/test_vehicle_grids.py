@@ -15,7 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 from tanktool.cli.main import cli
-from tanktool.formats.bundle import read_toml
+from tanktool.formats.bundle import dumps_toml, read_toml
 from tanktool.freshness import ensure_fresh
 from tanktool.nav.navgrid import NavGrid
 from tanktool.sim.agents.driving import trim
@@ -117,3 +117,14 @@ def test_a_missing_or_stale_vehicle_grid_is_an_error_and_play_rebuilds_it(tmp_pa
     (b / "arena.toml").write_text(text)
     r = CliRunner().invoke(cli, ["check", str(b)])
     assert r.exit_code == 1 and "B102" in r.output and "[grids.light]" in r.output, r.output
+
+
+def test_check_judges_each_vehicle_grid_with_its_own_spawns(tmp_path, bundle):
+    b = tmp_path / "b"
+    shutil.copytree(bundle, b)
+    doc = read_toml(b / "arena.toml")
+    doc["grids"]["light"]["spawns"][0] = [0.2, 0.2, 0.0, 0.0]    # in the yard's wall corner: no node there
+    (b / "arena.toml").write_text(dumps_toml(doc))
+    r = CliRunner().invoke(cli, ["check", str(b)])
+    assert r.exit_code == 1 and "A314 error: light's spawn 0 at (0.20, 0.20) is on no node of navgrid.light.npz " \
+        "where its tank fits (clearance 3.229 m)" in r.output, r.output
