@@ -266,55 +266,72 @@ def main(argv: list[str] | None = None) -> int:
     for lv in levels:
         if lv not in DIFFICULTIES:
             ap.error(f"--levels: {lv!r} is not one of {', '.join(DIFFICULTIES)}")
-    rows = []
-    base_sight: dict[str, float] = {}
     t_start = time.perf_counter()
-    for arena in arenas:
-        runs = range(args.sight_runs)
-        base_sight[arena.name] = statistics.median(first_sight(arena, spec, k, None, args.cap) for k in runs)
-        for lv in levels:
-            res = [duel(arena, spec, k, lv, args.seconds) for k in range(args.matches)]
-            wins = sum(r["kills"][0] > r["kills"][1] for r in res)
-            losses = sum(r["kills"][0] < r["kills"][1] for r in res)
-            minutes = args.matches * args.seconds / 60.0
-            sights = [first_sight(arena, spec, k, lv, args.cap) for k in runs]
-            bound = None
-            if args.bound and lv == "normal":
-                cheat = [duel(arena, spec, k, lv, args.seconds, Omniscient) for k in range(args.matches)]
-                bound = sum(r["kills"][0] > r["kills"][1] for r in cheat) / args.matches
-            rows.append({
-                "arena": arena.name, "level": lv, "matches": args.matches,
-                "wins": wins, "losses": losses, "draws": args.matches - wins - losses,
-                "win_rate": wins / args.matches,
-                "win_rate_decided": wins / (wins + losses) if wins + losses else None,
-                "kills": sum(r["kills"][0] for r in res), "baseline_kills": sum(r["kills"][1] for r in res),
-                "bumps_per_min": sum(r["bumps"][0] for r in res) / minutes,
-                "baseline_bumps_per_min": sum(r["bumps"][1] for r in res) / minutes,
-                "stuck": statistics.fmean(r["stuck"][0] for r in res),
-                "baseline_stuck": statistics.fmean(r["stuck"][1] for r in res),
-                "first_sight_median_s": statistics.median(sights),
-                "first_sight_not_found": sum(s >= args.cap for s in sights),
-                "baseline_first_sight_median_s": base_sight[arena.name],
-                "bound_win_rate": bound,
-            })
-            if not args.json:
-                print(f"  {arena.name} {lv}: done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
+    rows = [row for arena in arenas for row in _arena_rows(arena, spec, levels, args, t_start)]
     cpu_rows = [{"arena": a.name, "agent_ms_per_step_8": 1e3 * cpu(a, spec, "agent", args.cpu_steps),
                  "baseline_ms_per_step_8": 1e3 * cpu(a, spec, "scripted", args.cpu_steps)} for a in arenas]
-    dodge_rows = []
-    if args.dodge_seconds > 0:
-        for mode in DODGE_MODES:
-            for dist in (float(v) for v in args.distances.split(",") if v):
-                n, hits = dodge_share(spec, dist, mode, args.dodge_seconds)
-                dodge_rows.append({"target": mode, "distance": dist, "on_target_shots": n, "hits": hits,
-                                   "avoided": (n - hits) / n if n else None})
+    dodge_rows = _dodge_rows(spec, args) if args.dodge_seconds > 0 else []
     out = {"vehicle": spec.name, "seconds_per_duel": args.seconds, "sight_runs": args.sight_runs,
            "sight_cap_s": args.cap, "baseline": "sim.driver.ScriptedDriver", "rows": rows, "cpu": cpu_rows,
            "rules": DEFAULT_RULES.to_dict(), "dodge": dodge_rows,
            "wall_clock_s": round(time.perf_counter() - t_start, 1)}
     if args.json:
         print(json.dumps(out))
-        return 0
+    else:
+        _print_tables(out, spec, args)
+    return 0
+
+
+def _arena_rows(arena, spec, levels: list[str], args, t_start: float) -> list[dict]:
+    """One row per difficulty on ``arena``: duels against the baseline, first sight,
+    and (normal) the bound of an agent told where the enemy is."""
+    rows = []
+    runs = range(args.sight_runs)
+    base_sight = statistics.median(first_sight(arena, spec, k, None, args.cap) for k in runs)
+    for lv in levels:
+        res = [duel(arena, spec, k, lv, args.seconds) for k in range(args.matches)]
+        wins = sum(r["kills"][0] > r["kills"][1] for r in res)
+        losses = sum(r["kills"][0] < r["kills"][1] for r in res)
+        minutes = args.matches * args.seconds / 60.0
+        sights = [first_sight(arena, spec, k, lv, args.cap) for k in runs]
+        bound = None
+        if args.bound and lv == "normal":
+            cheat = [duel(arena, spec, k, lv, args.seconds, Omniscient) for k in range(args.matches)]
+            bound = sum(r["kills"][0] > r["kills"][1] for r in cheat) / args.matches
+        rows.append({
+            "arena": arena.name, "level": lv, "matches": args.matches,
+            "wins": wins, "losses": losses, "draws": args.matches - wins - losses,
+            "win_rate": wins / args.matches,
+            "win_rate_decided": wins / (wins + losses) if wins + losses else None,
+            "kills": sum(r["kills"][0] for r in res), "baseline_kills": sum(r["kills"][1] for r in res),
+            "bumps_per_min": sum(r["bumps"][0] for r in res) / minutes,
+            "baseline_bumps_per_min": sum(r["bumps"][1] for r in res) / minutes,
+            "stuck": statistics.fmean(r["stuck"][0] for r in res),
+            "baseline_stuck": statistics.fmean(r["stuck"][1] for r in res),
+            "first_sight_median_s": statistics.median(sights),
+            "first_sight_not_found": sum(s >= args.cap for s in sights),
+            "baseline_first_sight_median_s": base_sight,
+            "bound_win_rate": bound,
+        })
+        if not args.json:
+            print(f"  {arena.name} {lv}: done ({time.perf_counter() - t_start:.0f} s)", file=sys.stderr)
+    return rows
+
+
+def _dodge_rows(spec, args) -> list[dict]:
+    """On-target shots and hits at each distance on each kind of target."""
+    rows = []
+    for mode in DODGE_MODES:
+        for dist in (float(v) for v in args.distances.split(",") if v):
+            n, hits = dodge_share(spec, dist, mode, args.dodge_seconds)
+            rows.append({"target": mode, "distance": dist, "on_target_shots": n, "hits": hits,
+                         "avoided": (n - hits) / n if n else None})
+    return rows
+
+
+def _print_tables(out: dict, spec, args) -> None:
+    """The duels, CPU and dodging tables of ``out`` for a reader."""
+    rows, cpu_rows, dodge_rows = out["rows"], out["cpu"], out["dodge"]
     print(f"agent vs baseline (ScriptedDriver), {spec.name} tanks, 1-on-1 duels of {args.seconds:g} s, "
           f"{args.matches} per row; first sight: median of {args.sight_runs} runs, cap {args.cap:g} s")
     head = (f"{'arena':<10} {'level':<7} {'W-L-D':>11} {'win%':>5} {'win% dec':>8} {'kills':>9} "
@@ -352,7 +369,6 @@ def main(argv: list[str] | None = None) -> int:
     print("bound: win % of an agent told where the enemy is (the same duels, normal)")
     print("goals at normal: win rate >= 80 %, < 1 bump/min, stuck < 2 %; agents for 8 tanks < 1 ms per step")
     print(f"wall clock {out['wall_clock_s']:.0f} s")
-    return 0
 
 
 if __name__ == "__main__":
