@@ -327,3 +327,21 @@ def test_a_members_flood_leaves_the_honest_states_at_the_host():
         net.run(0.01)
     taken = (host.core.states_from[honest.core.number] - before) / 3.0
     assert taken >= 29.5 and host.core.dropped["flood"] > 50000
+
+
+# ---------------------------------------------------------------- finding 7
+def test_look_alike_names_are_refused_and_a_refusal_is_shown_escaped():
+    net = SimCluster(seed=15)
+    host = net.host("alice")
+    bob = net.join("bob", host)
+    fake = net.join("\u0430lice", host)                        # Cyrillic a
+    assert not fake.core.number and "looks like alice" in fake.join_error
+    assert sorted(host.core.table) == [1, 2] and bob.core.number == 2
+    # a host whose refusal carries escape sequences: the joiner's message shows them escaped
+    joiner = Core("carol")
+    link = joiner.joining(("10.0.0.9", 5000), 5000, 5000, now=0.0)
+    joiner.received(link, P.encode(P.Challenge(bytes(P.NONCE_SIZE), False, 1, 1, 1), 1, 1, 0.0), now=0.1)
+    assert [type(a) for a in joiner.take_actions()] == [Send]          # the JOIN
+    joiner.received(link, P.encode(P.Refuse(P.RefuseCode.FULL, "\x1b[2Jgone"), 1, 2, 0.2), now=0.2)
+    assert joiner.join_outcome.kind == "error"
+    assert joiner.join_outcome.text == "join refused by 10.0.0.9:5000: \\x1b[2Jgone"
