@@ -239,6 +239,8 @@ def _vehicle_grids(result: Any, fleet: Any, remark: Callable[[str], None]) -> di
 
     out: dict[str, Any] = {}
     for name, (radius, spawns) in smaller_vehicles(result, fleet).items():
+        if result.flat:   # the 2002 case keeps its spawns for every vehicle: flat arenas play as they did
+            spawns = result.spawns
         if vehicle_file(name) is None:
             remark(f"vehicle {name!r}: no grid of its own (its name cannot be part of a file name)")
             continue
