@@ -402,14 +402,18 @@ class Peer:
         if len(conn.out) > MAX_OUTBUF:
             self._gone(conn, "too slow")
             return
-        want = selectors.EVENT_READ | (selectors.EVENT_WRITE if conn.out else 0)
+        if conn.close_at is not None and not conn.out:
+            self._finish(conn)
+            return
+        # closing: only the flush is waited for (what it still says is never read, so a
+        # readable socket must not wake every select until its deadline)
+        want = selectors.EVENT_WRITE if conn.close_at is not None else \
+            selectors.EVENT_READ | (selectors.EVENT_WRITE if conn.out else 0)
         try:
             if self.sel.get_key(conn.sock).events != want:
                 self.sel.modify(conn.sock, want, conn)
         except (KeyError, ValueError):
             pass
-        if conn.close_at is not None and not conn.out:
-            self._finish(conn)
 
     def _gone(self, conn: _Conn, reason: str) -> None:
         """A connection failed: closed here, and the core told."""
