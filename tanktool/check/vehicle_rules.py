@@ -17,6 +17,7 @@ from typing import Iterator
 
 import numpy as np
 
+from ..formats.bundle import data_lines
 from ..formats.vehicle_bundle import DRIVE_KEYS, HULL_MAX, HULL_MIN
 from ..geometry.hull import convex_hull_2d, points_in_prism
 from ..geometry.spheres import SphereTree
@@ -38,11 +39,7 @@ SURFACE_SEED = 2002
 def _data_lines(path: Path) -> Iterator[tuple[int, str, list[str]]]:
     """(line number, text without its comment, fields) of each line of ``path`` that
     holds data (undecodable bytes read as U+FFFD, so such a line is a bad one)."""
-    text = path.read_bytes().decode("utf-8", errors="replace")
-    for no, raw in enumerate(text.splitlines(), 1):
-        line = raw.split("#", 1)[0].strip()
-        if line:
-            yield no, line, line.split()
+    yield from data_lines(path.read_bytes().decode("utf-8", errors="replace"))
 
 
 def scan_hull(path: Path) -> tuple[np.ndarray, list[Diagnostic]]:

@@ -31,7 +31,7 @@ import shutil
 import stat
 import sys
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -118,6 +118,15 @@ def read_input_text(path: str | os.PathLike, expected: str = "a text file", limi
     except UnicodeDecodeError as e:
         line = data[: e.start].count(b"\n") + 1
         raise FormatError(f"{path}:{line}: not UTF-8 text (byte offset {e.start})") from None
+
+
+def data_lines(text: str) -> Iterator[tuple[int, str, list[str]]]:
+    """(line number, the line without its ``#`` comment, its fields) of every line of a
+    small text format (hull.txt, spheres.txt) that holds data."""
+    for lineno, raw in enumerate(text.splitlines(), 1):
+        line = raw.split("#", 1)[0].strip()
+        if line:
+            yield lineno, line, line.split()
 
 
 def parse_toml(data: bytes, label: str) -> dict[str, Any]:

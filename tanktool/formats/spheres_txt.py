@@ -113,16 +113,12 @@ def write_spheres(path: str | os.PathLike, tree: SphereTree, header: str = "") -
 
 def read_spheres(path: str | os.PathLike) -> SphereTree:
     """Read ``spheres.txt``; any defect is a FormatError naming the file and line."""
-    from .bundle import read_input_text
+    from .bundle import data_lines, read_input_text
 
     path = Path(path)
     text = read_input_text(path, "a spheres.txt file")
     rows: list[tuple[int, int, int, float, float, float, float]] = []
-    for lineno, raw in enumerate(text.splitlines(), 1):
-        line = raw.split("#", 1)[0].strip()
-        if not line:
-            continue
-        parts = line.split()
+    for lineno, line, parts in data_lines(text):
         where = f"{path}:{lineno}"
         if len(parts) != 7:
             raise FormatError(f"{where}: expected 7 fields 'id parent level cx cy cz r', got {len(parts)}")

@@ -21,7 +21,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import FormatError, VehicleError
-from .bundle import atomic_write_text, bundle_file, clean_stale, read_input, read_input_text, read_toml
+from .bundle import (atomic_write_text, bundle_file, clean_stale, data_lines, read_input, read_input_text,
+                     read_toml)
 from .limits import MAX_SMALL_TEXT_BYTES
 from .spheres_txt import SphereTree, read_spheres
 
@@ -67,11 +68,7 @@ def read_hull(path: str | os.PathLike) -> np.ndarray:
     path = Path(path)
     text = read_input_text(path, "a hull.txt file", limit=MAX_SMALL_TEXT_BYTES)
     rows: list[tuple[float, float, float]] = []
-    for lineno, raw in enumerate(text.splitlines(), 1):
-        line = raw.split("#", 1)[0].strip()
-        if not line:
-            continue
-        parts = line.split()
+    for lineno, line, parts in data_lines(text):
         if len(parts) != 3:
             raise FormatError(f"{path}:{lineno}: expected 3 numbers 'x y z', got {len(parts)} fields")
         try:
