@@ -345,3 +345,27 @@ def test_look_alike_names_are_refused_and_a_refusal_is_shown_escaped():
     joiner.received(link, P.encode(P.Refuse(P.RefuseCode.FULL, "\x1b[2Jgone"), 1, 2, 0.2), now=0.2)
     assert joiner.join_outcome.kind == "error"
     assert joiner.join_outcome.text == "join refused by 10.0.0.9:5000: \\x1b[2Jgone"
+
+
+def test_rejoining_after_a_partition_forgets_the_old_sessions_departures():
+    """While cut off, the host's side admits two players who then leave: (6, 6) and
+    (7, 7) departed there.  The other side gives the same pairs to the rejoining host
+    and its member: each must still see the other (not 'you left the session')."""
+    net = SimCluster(seed=16, **BAD)
+    host = net.host("alice")
+    nodes = [host] + [net.join(name, host) for name in ("bob", "carol", "dave", "erin")]
+    x1, x2 = net.node("x1"), net.node("x2")
+    net.run(1.0)
+    side_a = [host.ip, nodes[1].ip, x1.ip, x2.ip]
+    net.udp.partition(net.now, net.now + 10.0, side_a, [n.ip for n in nodes[2:]])
+    net.run(5.0)
+    net.start_join(x1, host)
+    net.run(1.0)
+    net.start_join(x2, host)
+    net.run(1.0)
+    assert (x1.core.number, x2.core.number) == (6, 7) and [x1.core.table[6].epoch, x2.core.table[7].epoch] == [6, 7]
+    net.leave(x1)
+    net.leave(x2)
+    net.run(16.0)
+    assert_one_session(net)
+    assert len(live(net)) == 5 and {host.core.number, nodes[1].core.number} == {6, 7}

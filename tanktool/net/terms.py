@@ -162,3 +162,7 @@ class TermsMixin:
         self.first_round = False
         self.step_down_to = None
         self.used_numbers, self.freed, self.max_epoch = set(), [], 0   # type: ignore[attr-defined]
+        # who left our old session says nothing about the new one (whose numbers and
+        # epochs may repeat ours: both sides of a partition gave them)
+        self.departed.clear()                                         # type: ignore[attr-defined]
+        self.addr_buckets.clear()                                     # type: ignore[attr-defined]
