@@ -77,3 +77,51 @@ done:
     PyBuffer_Release(&out);
     return ret;
 }
+
+/* walkable.grid_from_surface's links: for every node with a span (span_of >= 0), the
+ * level of the span its span links to in each direction when that span is a node of
+ * the grid (its level >= 0 and the node exists), else -1; one pass, no temporaries.
+ *   grid_links(span_of int32 (N), link int32 (n, 4), level int64 (n), col int64 (n),
+ *              exists bool (N), per, out int8 (N, 4)) */
+PyObject *tanktool_grid_links(PyObject *self, PyObject *args) {
+    Py_buffer span_of, link, level, col, exists, out;
+    long long per;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*y*Lw*", &span_of, &link, &level, &col, &exists, &per, &out)) return NULL;
+    const Py_ssize_t N = span_of.len / 4, n = level.len / 8;
+    PyObject *ret = NULL;
+    if (!need(&link, 4 * n, 4, "link") || !need(&col, n, 8, "col") || !need(&exists, N, 1, "exists") ||
+        !need(&out, 4 * N, 1, "out"))
+        goto done;
+    {
+        const int32_t *S = span_of.buf, *K = link.buf;
+        const i64 *LV = level.buf, *C = col.buf;
+        const uint8_t *E = exists.buf;
+        int8_t *O = out.buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t a = 0; a < N; ++a) {
+            const int32_t s = S[a];
+            for (int d = 0; d < 4; ++d) {
+                int8_t v = -1;
+                if (s >= 0 && s < n) {
+                    const int32_t t = K[4 * (i64)s + d];
+                    if (t >= 0 && t < n && LV[t] >= 0) {
+                        const i64 b = LV[t] * per + C[t];
+                        if (b >= 0 && b < N && E[b]) v = (int8_t)LV[t];
+                    }
+                }
+                O[4 * a + d] = v;
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&span_of);
+    PyBuffer_Release(&link);
+    PyBuffer_Release(&level);
+    PyBuffer_Release(&col);
+    PyBuffer_Release(&exists);
+    PyBuffer_Release(&out);
+    return ret;
+}

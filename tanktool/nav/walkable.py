@@ -179,7 +179,7 @@ def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
     matters, and the relaxation needs about limit / 2 rounds.
     """
     n = len(link)
-    dist = np.where((link < 0).any(axis=1), 1, limit).astype(np.int32)
+    dist = np.where((link < 0).any(axis=1), np.int32(1), np.int32(limit))  # int32 from the start
     if n == 0:
         return dist
     kern = active()
@@ -367,7 +367,8 @@ def build_surface(hf: Heightfield, headroom: float, climb: float, max_clearance:
     link = link_spans(col, floor, ceil, hf.shape, head, clim)
     limit = int(math.ceil(2 * max_clearance / hf.cs)) + 2
     dist = chamfer_clearance(link, limit)
-    clearance = np.where(dist >= limit, np.inf, dist * hf.cs / 2)
+    clearance = dist * (hf.cs / 2)  # the same values as dist * cs / 2 (halving is exact), one array
+    clearance[dist >= limit] = np.inf
     region = components(link) if len(col) else np.zeros(0, dtype=np.int64)
     main = _main_region(hf, col, floor, region, seeds)
     level = stack_levels(col, main, link)
@@ -426,6 +427,33 @@ def surface_layers(surface: Surface, clearance: bool = True) -> tuple[np.ndarray
     return exists.reshape(shape), height.reshape(shape), clear, span.reshape(shape)
 
 
+def _grid_links(surface: Surface, exists: np.ndarray, span: np.ndarray) -> np.ndarray:
+    """(L * nz * nx, 4) int8: the level each node's span links to in each direction
+    when that span is a node too, else -1 (flat indices throughout)."""
+    L, nz, nx = exists.shape
+    per = nz * nx
+    link = np.full((L * per, 4), -1, dtype=np.int8)
+    kern = active()
+    if kern is not None and span.dtype == np.int32 and surface.link.dtype == np.int32:
+        # one pass, where numpy's takes ~40 bytes a node of temporaries per direction
+        kern.grid_links(np.ascontiguousarray(span), np.ascontiguousarray(surface.link), i64(surface.level),
+                        i64(surface.col), np.ascontiguousarray(exists), per, link)
+        return link
+    node = np.flatnonzero(exists)
+    sp = span.ravel()[node]
+    vflat = exists.ravel()
+    lv_of = np.append(surface.level, -1)  # span -1 (no link) -> level -1
+    col_of = np.append(surface.col, 0)
+    for d in range(4):
+        t = surface.link[sp, d]
+        tl = lv_of[t]
+        target = tl * per + col_of[t]
+        ok = tl >= 0
+        ok[ok] = vflat[target[ok]]
+        link[node[ok], d] = tl[ok]
+    return link
+
+
 def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray, seeds: np.ndarray | None = None,
                       too_close: np.ndarray | None = None):
     """The layered navigation grid of a surface (cell = the heightfield's cell).
@@ -448,21 +476,8 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
     # each node's span, and the node its link reaches: flat indices throughout.  Links
     # and heights are kept for every node of the surface, valid (a tank fits) or not:
     # the simulation drives on all of it; runs, reachability and paths use valid nodes.
-    per = nz * nx
-    node = np.flatnonzero(exists)
-    sp = span.ravel()[node]
-    vflat = exists.ravel()
-    link = np.full((L * per, 4), -1, dtype=np.int8)
-    lv_of = np.append(surface.level, -1)  # span -1 (no link) -> level -1
-    col_of = np.append(surface.col, 0)
-    for d in range(4):
-        t = surface.link[sp, d]
-        tl = lv_of[t]
-        target = tl * per + col_of[t]
-        ok = tl >= 0
-        ok[ok] = vflat[target[ok]]
-        link[node[ok], d] = tl[ok]
-    link = link.reshape(L, nz, nx, 4)
+    link = _grid_links(surface, exists, span).reshape(L, nz, nx, 4)
+    del span
     ri, rt, ci, ct = layered_runs(valid, link)
     cell = surface.hf.cs
     seeds_n: list = []
