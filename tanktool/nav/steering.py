@@ -164,3 +164,68 @@ def heading_of_move(src: Node, dst: Node, heading: str) -> str:
         if s == rest:
             return h
     return heading
+
+
+# ------------------------------------------------------------------ on levels
+Node3 = tuple[int, int, int]
+#: a grid heading's link direction (navgrid.STEPS order: +x, +z, -x, -z)
+_DIR = {h: d for d, h in enumerate(STEPS)}
+
+
+def step3(grid: NavGrid, node: Node3, heading: str) -> Node3 | None:
+    """The valid node one step ``heading`` from ``node`` along its link (the level the
+    link reaches: up a ramp, onto a deck), None where the link is blocked."""
+    lv, i, j = node
+    di, dj = STEPS[heading]
+    ni, nj = i + di, j + dj
+    if not (0 <= ni < grid.nz and 0 <= nj < grid.nx):
+        return None
+    to = int(grid.links()[lv, i, j, _DIR[heading]])
+    return (to, ni, nj) if to >= 0 and grid.valid[to, ni, nj] else None
+
+
+def nodes_ahead3(grid: NavGrid, node: Node3, heading: str) -> int:
+    """Free nodes after ``node`` on its level before a wall or an edge, travelling ``heading``."""
+    if not grid.valid[node]:
+        return 0
+    return run_ahead(grid.row_index[node], grid.col_index[node], grid.row_total[node], grid.col_total[node],
+                     heading)
+
+
+def _diagonal(grid: NavGrid, node: Node3, first: str, second: str) -> Node3 | None:
+    """The node a step ``first`` then ``second`` away along links (either way round)."""
+    for a, b in ((first, second), (second, first)):
+        mid = step3(grid, node, a)
+        end = step3(grid, mid, b) if mid is not None else None
+        if end is not None:
+            return end
+    return None
+
+
+def children3(grid: NavGrid, node: Node3, heading: str) -> list[Child]:
+    """:func:`children` on a layered grid (nodes ``(level, i, j)``): the ahead-left, ahead
+    and ahead-right nodes reached along the links from ``node``, so the decision never
+    leaves the tank's level but where a ramp or a step links it to another."""
+    h = _check(heading)
+    out = []
+    for name, side in (("left", turn_left(h)), ("ahead", None), ("right", turn_right(h))):
+        c = step3(grid, node, h) if side is None else _diagonal(grid, node, h, side)
+        if c is not None:
+            travel = side or h
+            out.append(Child(name, c, travel, nodes_ahead3(grid, c, travel)))  # type: ignore[arg-type]
+    return out
+
+
+def turn_in_place3(grid: NavGrid, node: Node3, heading: str) -> Node3 | None:
+    """:func:`choose_next`'s turn when nothing ahead is valid, on a layered grid: the
+    linked side neighbour with more room (right on ties), else the one behind."""
+    h = _check(heading)
+    side = {}
+    for name, t in (("right", turn_right(h)), ("left", turn_left(h))):
+        n = step3(grid, node, t)
+        if n is not None:
+            side[name] = (n, nodes_ahead3(grid, n, t))
+    if side:
+        name = max(side, key=lambda k: (side[k][1], k == "right"))
+        return side[name][0]
+    return step3(grid, node, turn_right(turn_right(h)))

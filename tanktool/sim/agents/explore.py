@@ -25,12 +25,11 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
-from ...nav.navgrid import nearest_valid_node
 from ...nav.steering import heading_from_angle
 from ..commands import Command
 from .driving import trim
 from .machine import State
-from .navigation import SearchPlan
+from .navigation import SearchPlan, wander_start
 from .perception import wrap
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -112,7 +111,7 @@ class Wander(State["Agent"]):
             route.clear()                      # pushed off the route: start again here
             agent.walker = None
         if agent.walker is None:
-            n = nearest_valid_node(grid.valid[0], grid.node_of(x, z), 6)
+            n = wander_start(grid, x, z, me.y)     # (level, i, j) on a ground's layered grid
             if n is None:
                 return agent.back_off()
             agent.walker = (n, heading_from_angle(me.heading))
@@ -123,7 +122,7 @@ class Wander(State["Agent"]):
             if nxt is None:
                 break
             agent.walker = nxt
-            point = grid.centre(*nxt[0])
+            point = grid.centre(*nxt[0][-2:])
             if point in route:     # a pocket the heuristic only turns about in
                 break
             route.append(point)

@@ -17,9 +17,10 @@ so the agent grid is made from the surface itself:
 * **reachable**: the valid nodes joined by links to a spawn.
 
 The result is a layered ``NavGrid`` (``(L, nz, nx)`` arrays, ``height``, ``link``):
-``nav.path.astar_layered`` plans on it across ramps, steps and decks.  The agents'
-2-D views of the map (where it has been, the quadrants it searches, the Wander
-heuristic) read its projection: a column is valid when any of its levels is.
+``nav.path.astar_layered`` plans on it across ramps, steps and decks, and the Wander
+heuristic walks it along its links (``navigation.Wanderer``).  The agents' 2-D views of
+the map (where it has been, the quadrants' leaves) read its projection: a column is
+valid when any of its levels is.
 """
 
 from __future__ import annotations

@@ -38,7 +38,7 @@ import numpy as np
 from ...nav.navgrid import (NavGrid, Node, STEPS, grid_from_mask, grid_shape, nearest_valid_node, nearest_valid_node3,
                             reachable_from, too_close)
 from ...nav.path import find_path
-from ...nav.steering import children, decide, heading_of_move
+from ...nav.steering import children, children3, decide, heading_of_move
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..world import World
@@ -153,12 +153,16 @@ class Memory:
 class Wanderer:
     """The paper's decision among the three nodes ahead, with novelty and jitter.
 
-    ``memory`` None and ``jitter`` 0 give ``nav.steering.choose_next``'s choice.
+    ``memory`` None and ``jitter`` 0 give ``nav.steering.choose_next``'s choice.  On a
+    ground (an agent grid with ``.layers``) it walks the layered grid itself: nodes are
+    ``(level, i, j)`` and each step follows the links (:func:`wander_start` gives the
+    first), so a tank under a deck is never sent into a column only the deck has.
     """
 
     def __init__(self, grid: NavGrid, memory: Memory | None = None, rng: random.Random | None = None,
                  jitter: float = 0.2, cap: int = 12, look: int = 16, forget: float = 60.0,
                  floor: float = 0.08, straight: float = 1.5) -> None:
+        self.layers = getattr(grid, "layers", None)
         self.grid = grid
         self.memory = memory
         self.rng = rng
@@ -177,12 +181,12 @@ class Wanderer:
             return 1.0
         k = min(ahead, self.look)
         di, dj = STEPS[heading]
-        x, z = self.grid.centre(node[0] + di * k, node[1] + dj * k)
+        x, z = self.grid.centre(node[-2] + di * k, node[-1] + dj * k)
         return self.floor + min(self.memory.since(x, z, t) / self.forget, 1.0)
 
     def choose(self, node: Node, heading: str, t: float = 0.0) -> tuple[Node, str] | None:
         """The next node and the heading after moving there; None when boxed in."""
-        kids = children(self.grid, node, heading)
+        kids = children(self.grid, node, heading) if self.layers is None else children3(self.layers, node, heading)
         if not kids:
             return self._turn_in_place(node, heading)
         if self.memory is None and self.jitter == 0.0:
@@ -207,12 +211,34 @@ class Wanderer:
         return None  # unreachable
 
     def _turn_in_place(self, node: Node, heading: str) -> tuple[Node, str] | None:
-        from ...nav.steering import choose_next
+        from ...nav.steering import choose_next, turn_in_place3
 
-        nxt = choose_next(self.grid, node, heading)
+        nxt = choose_next(self.grid, node, heading) if self.layers is None else \
+            turn_in_place3(self.layers, node, heading)
         if nxt is None:
             return None
-        return nxt, heading_of_move(node, nxt, heading)
+        return nxt, heading_of_move(node[-2:], nxt[-2:], heading)
+
+
+def wander_start(grid: NavGrid, x: float, z: float, y: float | None, steps: int = 6) -> tuple | None:
+    """The wanderer's first node near (x, z): on the 2002 grid the nearest valid node
+    (i, j); on a ground's agent grid the layered node (level, i, j) nearest the tank's
+    height ``y`` -- its own level, not a deck above it."""
+    layers = grid.layers
+    if layers is None:
+        return nearest_valid_node(grid.valid[0], grid.node_of(x, z), steps)
+    if y is None:
+        return nearest_valid_node3(layers.valid, layers.height, layers.node_of(x, z), y, steps)
+    col, best = layers.node_of(x, z), None
+    for lv in range(layers.levels):      # a level within a metre of the tank first, then the nearest node
+        n = nearest_valid_node(layers.valid[lv], col, steps)
+        if n is None:
+            continue
+        dy = abs(float(layers.height[lv, n[0], n[1]]) - y)
+        key = (not dy <= 1.0, (n[0] - col[0]) ** 2 + (n[1] - col[1]) ** 2, dy)
+        if best is None or key < best[0]:
+            best = (key, (lv, n[0], n[1]))
+    return None if best is None else best[1]
 
 
 # ------------------------------------------------------------------ search
