@@ -25,6 +25,7 @@
  *       key: sorted int64 packed pieces; outputs int64 / bool arrays as long as key
  *   grid_labels(valid, link, L, nz, nx, out) -> k   (_kernels_grid.c)
  *   grid_links(span_of, link, level, col, exists, per, out)   (_kernels_grid.c)
+ *   grid_runs(valid, link, L, nz, nx, row_index, row_total, col_index, col_total)   (_kernels_grid.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -364,6 +365,7 @@ static PyMethodDef methods[] = {
     {"merge_spans", merge_spans, METH_VARARGS, "the merged spans of sorted packed keys"},
     {"grid_labels", tanktool_grid_labels, METH_VARARGS, "component labels of the grid's valid nodes (_kernels_grid.c)"},
     {"grid_links", tanktool_grid_links, METH_VARARGS, "the layered grid's links from the surface's (_kernels_grid.c)"},
+    {"grid_runs", tanktool_grid_runs, METH_VARARGS, "the layered grid's row and column runs (_kernels_grid.c)"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -371,7 +373,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 5
+#define TANKTOOL_KERNELS_ABI 6
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

@@ -28,5 +28,6 @@ PyObject *tanktool_raster(PyObject *self, PyObject *args);
 /* the grid (_kernels_grid.c) */
 PyObject *tanktool_grid_labels(PyObject *self, PyObject *args);
 PyObject *tanktool_grid_links(PyObject *self, PyObject *args);
+PyObject *tanktool_grid_runs(PyObject *self, PyObject *args);
 
 #endif

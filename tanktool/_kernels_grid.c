@@ -125,3 +125,68 @@ done:
     PyBuffer_Release(&out);
     return ret;
 }
+
+/* one line of nodes (a row along +x, d = 0, or a column along +z, d = 1, of one level
+ * l): runs of valid nodes each linked to the next on the same level; a node's 1-based
+ * place in its run and the run's length (0 and 0 off the valid nodes) */
+static void runs_line(const uint8_t *V, const int8_t *K, i64 first, i64 step, i64 count, int d, int l,
+                      int32_t *index, int32_t *total) {
+    i64 j = 0;
+    while (j < count) {
+        const i64 a = first + j * step;
+        if (!V[a]) {
+            index[a] = 0;
+            total[a] = 0;
+            ++j;
+            continue;
+        }
+        const i64 start = j;
+        while (j + 1 < count && K[4 * (first + j * step) + d] == l && V[first + (j + 1) * step]) ++j;
+        const int32_t len = (int32_t)(j - start + 1);
+        for (i64 k = start; k <= j; ++k) {
+            index[first + k * step] = (int32_t)(k - start + 1);
+            total[first + k * step] = len;
+        }
+        ++j;
+    }
+}
+
+/* navgrid.layered_runs: grid_runs(valid bool (L, nz, nx), link int8 (L, nz, nx, 4), L, nz,
+ * nx, row_index, row_total, col_index, col_total int32 (L, nz, nx)) */
+PyObject *tanktool_grid_runs(PyObject *self, PyObject *args) {
+    Py_buffer valid, link, ri, rt, ci, ct;
+    long long L, nz, nx;
+    if (!PyArg_ParseTuple(args, "y*y*LLLw*w*w*w*", &valid, &link, &L, &nz, &nx, &ri, &rt, &ci, &ct)) return NULL;
+    const Py_ssize_t n = (Py_ssize_t)(L * nz * nx);
+    PyObject *ret = NULL;
+    if (!need(&valid, n, 1, "valid") || !need(&link, 4 * n, 1, "link") || !need(&ri, n, 4, "row_index") ||
+        !need(&rt, n, 4, "row_total") || !need(&ci, n, 4, "col_index") || !need(&ct, n, 4, "col_total"))
+        goto done;
+    if (L > 127) {
+        PyErr_SetString(PyExc_ValueError, "grid_runs: more than 127 levels (int8 links)");
+        goto done;
+    }
+    {
+        const uint8_t *V = valid.buf;
+        const int8_t *K = link.buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (i64 l = 0; l < L; ++l) {
+            const i64 base = l * nz * nx;
+            for (i64 i = 0; i < nz; ++i)
+                runs_line(V, K, base + i * nx, 1, nx, 0, (int)l, ri.buf, rt.buf);
+            for (i64 j = 0; j < nx; ++j)
+                runs_line(V, K, base + j, nx, nz, 1, (int)l, ci.buf, ct.buf);
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&valid);
+    PyBuffer_Release(&link);
+    PyBuffer_Release(&ri);
+    PyBuffer_Release(&rt);
+    PyBuffer_Release(&ci);
+    PyBuffer_Release(&ct);
+    return ret;
+}

@@ -14,12 +14,15 @@ def test_runs_in_blocks_of_rows_are_the_runs_of_the_whole_grid(seed, monkeypatch
     L, nz, nx = int(rng.integers(1, 4)), int(rng.integers(5, 60)), int(rng.integers(5, 70))
     valid = rng.random((L, nz, nx)) < 0.75
     link = rng.integers(-1, L, size=(L, nz, nx, 4)).astype(np.int8)
-    whole = navgrid.layered_runs(valid, link)
-    for block in (1, 7, nx + 3, 3 * nx):  # one row a block, a row per block, several rows, uneven ends
-        monkeypatch.setattr(navgrid, "RUN_BLOCK", block)
-        for a, b in zip(navgrid.layered_runs(valid, link), whole):
-            assert a.dtype == b.dtype
-            np.testing.assert_array_equal(a, b)
+    from tanktool.geometry.kernels import use_kernels
+
+    with use_kernels(False):  # the numpy code's blocks (the compiled runs go a line at a time)
+        whole = navgrid.layered_runs(valid, link)
+        for block in (1, 7, nx + 3, 3 * nx):  # one row a block, a row per block, several rows, uneven ends
+            monkeypatch.setattr(navgrid, "RUN_BLOCK", block)
+            for a, b in zip(navgrid.layered_runs(valid, link), whole):
+                assert a.dtype == b.dtype
+                np.testing.assert_array_equal(a, b)
     assert whole[1].max() > 1  # runs longer than one node were found
 
 
@@ -73,3 +76,22 @@ def test_same_level_links_from_the_table_are_the_per_direction_ones(name):
     want = np.stack([surface_link_level(s, span_of, d) == lev for d in range(4)], axis=-1) & exists[..., None]
     np.testing.assert_array_equal(_same_level_links(s, span_of, exists), want)
     assert want.any()
+
+
+@pytest.mark.skipif(not __import__("tanktool.geometry.kernels", fromlist=["x"]).available(),
+                    reason="the compiled kernels are not built")
+@pytest.mark.parametrize("seed", range(4))
+def test_compiled_runs_are_numpys(seed):
+    from tanktool.geometry.kernels import use_kernels
+
+    rng = np.random.default_rng(300 + seed)
+    L, nz, nx = int(rng.integers(1, 4)), int(rng.integers(1, 60)), int(rng.integers(1, 70))
+    valid = rng.random((L, nz, nx)) < 0.8
+    link = rng.integers(-1, L, size=(L, nz, nx, 4)).astype(np.int8)
+    with use_kernels(True):
+        a = navgrid.layered_runs(valid, link)
+    with use_kernels(False):
+        b = navgrid.layered_runs(valid, link)
+    for x, y in zip(a, b):
+        assert x.dtype == y.dtype == np.int32
+        np.testing.assert_array_equal(x, y)

@@ -318,7 +318,14 @@ def layered_runs(valid: np.ndarray, link: np.ndarray) -> tuple[np.ndarray, ...]:
     """(row_index, row_total, col_index, col_total) of a layered grid, per level: a row
     run goes along +x over valid nodes of one level each linked to the next on the same
     level; a column run likewise along +z."""
-    L = valid.shape[0]
+    from ..geometry.kernels import active
+
+    L, nz, nx = valid.shape
+    kern = active()
+    if kern is not None and link.dtype == np.int8 and L <= 127:  # one pass a line, no temporaries
+        out = [np.empty(valid.shape, dtype=np.int32) for _ in range(4)]
+        kern.grid_runs(np.ascontiguousarray(valid, dtype=bool), np.ascontiguousarray(link), L, nz, nx, *out)
+        return out[0], out[1], out[2], out[3]
     lev = np.arange(L)[:, None, None]
     out = []
     for axis, d in ((2, 0), (1, 1)):  # rows along +x (step 0), columns along +z (step 1)
