@@ -120,6 +120,20 @@ def model_box() -> list[tuple[str, str, trimesh.Trimesh]]:
     return out
 
 
+def _runs(flags: list[bool]) -> list[tuple[int, int]]:
+    """(start, stop) of each run of True in ``flags``: one wall per run of wall pieces."""
+    out, k = [], 0
+    while k < len(flags):
+        if flags[k]:
+            k0 = k
+            while k < len(flags) and flags[k]:
+                k += 1
+            out.append((k0, k))
+        else:
+            k += 1
+    return out
+
+
 def model_maze(cells: int = 8, cell: float = 13.0, t: float = 1.0, seed: int = 2002) -> list[tuple[str, str, trimesh.Trimesh]]:
     rng = random.Random(seed)
     # walls between cells: h[i][j] the wall south of cell (i, j); v[i][j] west of it
@@ -158,29 +172,15 @@ def model_maze(cells: int = 8, cell: float = 13.0, t: float = 1.0, seed: int = 2
     out = [("floor", "floor", box(-t / 2, -t / 2, size + t / 2, size + t / 2, -SLAB, 0))]
     k = 0
     for i in range(cells + 1):  # runs of horizontal walls
-        j = 0
-        while j < cells:
-            if h[i][j]:
-                j0 = j
-                while j < cells and h[i][j]:
-                    j += 1
-                z = i * cell
-                out.append((f"h{k}", "wall", box(j0 * cell - t / 2, z - t / 2, j * cell + t / 2, z + t / 2, 0, WALL_H)))
-                k += 1
-            else:
-                j += 1
+        z = i * cell
+        for j0, j in _runs(h[i]):
+            out.append((f"h{k}", "wall", box(j0 * cell - t / 2, z - t / 2, j * cell + t / 2, z + t / 2, 0, WALL_H)))
+            k += 1
     for j in range(cells + 1):  # runs of vertical walls
-        i = 0
-        while i < cells:
-            if v[i][j]:
-                i0 = i
-                while i < cells and v[i][j]:
-                    i += 1
-                x = j * cell
-                out.append((f"v{k}", "wall", box(x - t / 2, i0 * cell - t / 2, x + t / 2, i * cell + t / 2, 0, WALL_H)))
-                k += 1
-            else:
-                i += 1
+        x = j * cell
+        for i0, i in _runs([v[i][j] for i in range(cells)]):
+            out.append((f"v{k}", "wall", box(x - t / 2, i0 * cell - t / 2, x + t / 2, i * cell + t / 2, 0, WALL_H)))
+            k += 1
     return out
 
 
