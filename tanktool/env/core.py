@@ -77,8 +77,9 @@ class Arena:
         self.spec = load_tank_spec(choose_vehicle(self.info, config.vehicle))
         self.makers = [load_bot(s) for s in config.opponents]
         n = config.agents + len(config.opponents)
-        if n > len(self.info.spawns):
-            raise TanktoolError(f"arena {self.info.name} has {len(self.info.spawns)} spawn points: "
+        own = self.info.spawns_for(self.spec)      # the vehicle's own, where it has a grid of its own
+        if n > len(own):
+            raise TanktoolError(f"arena {self.info.name} has {len(own)} spawn points for {self.spec.name}: "
                                 f"{config.agents} agents and {len(config.opponents)} opponents do not fit")
 
 
