@@ -128,3 +128,24 @@ def test_check_judges_each_vehicle_grid_with_its_own_spawns(tmp_path, bundle):
     r = CliRunner().invoke(cli, ["check", str(b)])
     assert r.exit_code == 1 and "A314 error: light's spawn 0 at (0.20, 0.20) is on no node of navgrid.light.npz " \
         "where its tank fits (clearance 3.229 m)" in r.output, r.output
+
+
+def test_the_judge_takes_a_vehicles_own_spawns(bundle):
+    """net/judge.py judges a (re)spawn against the spawn places of the world's vehicle: a
+    light tank may come back at the light tank's own spawn points, which the heavy
+    tank's world does not have."""
+    import math
+
+    from tanktool.net.judge import Judge
+    from tanktool.net.session import NET_RULES
+
+    info = load_match_arena(bundle)
+    worlds = {v: World(info.walls, [load_tank_spec(v)] * 2, info.spawns_for(v), bounds=info.bounds,
+                       ground=info.ground, rules=NET_RULES) for v in ("light", "heavy")}
+    heavy_places = Judge(worlds["heavy"]).spawn_places()
+    own = [(float(x), float(z)) for x, z in info.spawns_for("light")[:, :2]
+           if min(math.hypot(x - hx, z - hz) for hx, hz in heavy_places) > 5.0]
+    assert own                                            # places only the light tank spawns at
+    for x, z in own:
+        assert Judge(worlds["light"]).near_spawn(x, z)
+        assert not Judge(worlds["heavy"]).near_spawn(x, z)
