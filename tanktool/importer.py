@@ -132,8 +132,8 @@ def import_arena(
         progress("read")
     mesh = _one_mesh(model, scene, params.cell, max_cells)
     result = _analyse(model, mesh, params, fleet, height, tolerance, progress)
-    fits = _remark_fit(model, result, fleet, remark)
     others = _vehicle_grids(result, fleet, remark)
+    fits = _remark_fit(model, result, fleet, remark, others)
     src_up = up or default_up(fmt)
     nav["cell"] = float(params.cell)
     companions = _companion_files(model)
@@ -215,7 +215,8 @@ def _analyse(model: Path, mesh: Any, params: Any, fleet: Any, height: float, tol
         raise err from None
 
 
-def _remark_fit(model: Path, result: Any, fleet: Any, remark: Callable[[str], None]) -> Any:
+def _remark_fit(model: Path, result: Any, fleet: Any, remark: Callable[[str], None],
+                others: dict[str, Any] | None = None) -> Any:
     """Remark on repaired walls, vehicles too big and too few spawns; the fleet the arena is for."""
     for line in result.walls.repairs.remarks():   # repaired walls, and what check would still find
         remark(f"{model}: {line}")
@@ -226,8 +227,9 @@ def _remark_fit(model: Path, result: Any, fleet: Any, remark: Callable[[str], No
                f"grid are for {fits.radius_of} (footprint radius {fits.radius:.2f} m), and play refuses the "
                f"larger vehicles here")
     if len(spawns) < MIN_SPAWNS:
+        own = "".join(f"; {n} has {len(t['spawns'])} of its own" for n, t in (others or {}).items())
         remark(f"{model}: room for only {len(spawns)} spawn point(s) where the largest bundled tank that fits "
-               f"({fits.radius_of}) fits, at least {fits.length:.1f} m apart")
+               f"({fits.radius_of}) fits, at least {fits.length:.1f} m apart{own}")
     return fits
 
 

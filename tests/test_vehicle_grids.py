@@ -149,3 +149,19 @@ def test_the_judge_takes_a_vehicles_own_spawns(bundle):
     for x, z in own:
         assert Judge(worlds["light"]).near_spawn(x, z)
         assert not Judge(worlds["heavy"]).near_spawn(x, z)
+
+
+def test_too_few_spawns_for_the_largest_vehicle_names_the_smaller_ones_own(tmp_path):
+    from types import SimpleNamespace
+
+    from tanktool.fleet import Fleet
+    from tanktool.importer import _remark_fit
+
+    said: list[str] = []
+    result = SimpleNamespace(walls=SimpleNamespace(repairs=SimpleNamespace(remarks=lambda: [])),
+                             spawns=np.zeros((2, 4)), fleet=Fleet(4.6, 8.4, 2.3, "heavy", "heavy", "heavy"),
+                             too_big=[])
+    _remark_fit(tmp_path / "m.obj", result, result.fleet, said.append,
+                {"light": {"clearance": 3.2, "spawns": [[0.0, 0.0, 0.0, 0.0]] * 7}})
+    assert said == [f"{tmp_path / 'm.obj'}: room for only 2 spawn point(s) where the largest bundled tank that "
+                    f"fits (heavy) fits, at least 8.4 m apart; light has 7 of its own"]
