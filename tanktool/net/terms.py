@@ -10,15 +10,16 @@ others elected a new one, or one side of a partition.  So it **probes**: it dial
 addresses of the players it lost, once every ``PROBE_EVERY`` for ``PROBE_TIME``, then
 every ``PROBE_SLOW`` until ``PROBE_LONG`` (a partition may last), and reads their
 CHALLENGE.  When one of them stands in the session that goes on — more players (a
-majority, as Raft elects), or as many under a higher term — it **steps down**: a host first tells its members where that
+majority, as Raft elects), or as many under a higher term, or as many under the same
+term with a lower host number — it **steps down**: a host first tells its members where that
 session is (a NOT_HOST refusal on their links, so they follow it), its computer
 opponents are dropped (the new host adopted them: no duplicates), joiners are
 redirected to that session, and ``Peer.rejoin`` joins it as a member (a new number).
 So when a partition heals, every peer ends in the session of the highest (players,
-term).  A peer left alone refuses joins with "try again" until its first round of
+term, lower host).  A peer left alone refuses joins with "try again" until its first round of
 probes has been answered, so that a joiner dialling a stale host's address is not taken
-into a split session.  (Two sides that each changed hosts the same number of times and
-kept as many players stay apart: a tie has no winner.)  A member dropped by the
+into a split session.  (Two sides with as many players, the same term and hosts of the
+same number stay apart: that tie has no winner.)  A member dropped by the
 others (silence) that made itself host of its own session comes back the same way: the
 larger session does not step down to it.  No I/O: part of :class:`~tanktool.net.core.Core` (a probe is a
 ``Connect`` action; the answer comes back as any link's bytes).
@@ -39,8 +40,9 @@ PROBE_SLOW = 5.0
 PROBE_LONG = 60.0
 #: a probe's connection gives up after this long [s]
 PROBE_TIMEOUT = 1.0
-#: why a player left that says nothing about the session going on elsewhere
-CLEAN = ("exit", "dropped by the host", "replaced")
+#: why a player left that says nothing about the session going on elsewhere ("dropped
+#: by the host" does: the host may have lost it to a partition, as we did not)
+CLEAN = ("exit", "replaced")
 
 
 class TermsMixin:
@@ -127,9 +129,11 @@ class TermsMixin:
         if not isinstance(body, P.Challenge) or self.step_down_to is not None:
             return
         # the session that goes on is the one with more players (a majority, as Raft
-        # elects); between as many, the higher term.  A member dropped by silence that
-        # made itself host of its own one-player session (term + 1) draws nobody to it
-        if (body.players, body.term) > (len(self._others()) + 1, self.term):
+        # elects); between as many, the higher term; then the lower host number (both
+        # sides see the same two numbers: two peers left alone do not stay apart).  A
+        # member dropped by silence that made itself host of its own one-player session
+        # (term + 1) draws nobody to it
+        if (body.players, body.term, -body.host) > (len(self._others()) + 1, self.term, -self.host_number):
             if self.is_host:                     # type: ignore[attr-defined]
                 # our members follow us there, rather than electing one of them
                 redirect = self._pack(P.Refuse(P.RefuseCode.NOT_HOST, f"{link.addr[0]}:{link.addr[1]}"))  # type: ignore[attr-defined]
@@ -157,8 +161,8 @@ class TermsMixin:
         self.last_state_seq.clear()                                   # type: ignore[attr-defined]
         self.window.anchors.clear()                                   # type: ignore[attr-defined]
         self.number = self.host_number = 0                            # type: ignore[attr-defined]
-        self.lost.clear()
-        self.probe_until = self.probe_fast_until = -1.0
+        # the players we lost stay on the list: the session we join may be the smaller
+        # side of a partition, and they the larger one
         self.first_round = False
         self.step_down_to = None
         self.used_numbers, self.freed, self.max_epoch = set(), [], 0   # type: ignore[attr-defined]
