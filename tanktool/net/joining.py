@@ -26,6 +26,8 @@ class JoiningMixin:
         challenge is on its way), or None when there is no room (close it)."""
         self.now = now
         self.dropped.source = addr[0]      # TCP: by address (each connection has its own port)
+        if self.closed:                    # left or kicked: no session to offer anyone
+            return None
         if not self._make_room(addr[0]):
             self.dropped["too_many_pending"] += 1
             return None

@@ -132,7 +132,10 @@ class TermsMixin:
         # elects); between as many, the higher term; then the lower host number (both
         # sides see the same two numbers: two peers left alone do not stay apart).  A
         # member dropped by silence that made itself host of its own one-player session
-        # (term + 1) draws nobody to it
+        # (term + 1) draws nobody to it.  Our own term and host number is our own session
+        # seen by a peer that has not caught up (a kicked player's last view): not another
+        if (body.term, body.host) == (self.term, self.host_number):
+            return
         if (body.players, body.term, -body.host) > (len(self._others()) + 1, self.term, -self.host_number):
             if self.is_host:                     # type: ignore[attr-defined]
                 # our members follow us there, rather than electing one of them
