@@ -164,14 +164,19 @@ def settings(target: Target, cell: float | None, quadtree_depth: int | None) -> 
 def build_grid(target: Target, cell: float | None = None, clearance: float | None = None,
                max_slope: float | None = None, climb: float | None = None, headroom: float | None = None,
                quadtree_depth: int | None = None, warn: Callable[[str], None] | None = None,
-               progress: Callable[[int], None] | None = None, fleet: Any = None) -> BuiltGrid:
+               progress: Callable[[int], None] | None = None, fleet: Any = None,
+               base: Any = None) -> BuiltGrid:
     """The navigation grid and wall quadtree of ``target``: on a bundle with its model,
     the layered grid of the model's walkable surface; on a bare walls file, the flat
     2002 grid.  Options left None come from the manifest, then the defaults.
 
     ``fleet`` (import-arena's ``fleet.Fleet``, the vehicles the arena was made for)
     gives the default clearance, its largest footprint radius, when its largest
-    vehicle is not the one build-navgrid would take from the vehicles on disk."""
+    vehicle is not the one build-navgrid would take from the vehicles on disk.
+
+    On a bundle with its model and [grids] tables, the smaller vehicles' grids are
+    built too (``BuiltGrid.vehicles``), of the same walkable surface reseeded
+    (``base``: (params, surface) of the larger grid) where each built it again."""
     import numpy as np
 
     from .nav.navgrid import build_navgrid as build, free_space, grid_shape
@@ -209,32 +214,46 @@ def build_grid(target: Target, cell: float | None = None, clearance: float | Non
 
     t0 = time.perf_counter()
     if params is not None:
-        grid, free = _layered(target, params, clearance, bounds, shape)
+        reuse = base[1] if base is not None and base[0] == params else None
+        grid, free, surface = _layered(target, params, clearance, bounds, shape, reuse)
     else:
+        surface = None
         grid = build(target.walls, cell, clearance, spawns=target.spawns, bounds=bounds, progress=progress)
         free = free_space(target.walls, grid.origin, cell, shape)
     tree = WallQuadtree.build(target.walls.segments, bounds, depth=quadtree_depth)
-    return BuiltGrid(grid, tree, free, cell, float(clearance), source, quadtree_depth, params,
-                     time.perf_counter() - t0)
+    built = BuiltGrid(grid, tree, free, cell, float(clearance), source, quadtree_depth, params)
+    if surface is not None and base is None:  # while the surface is alive; stage_grid_files writes them
+        for name, (c, spawns) in vehicle_grids(target.toml, target.manifest).items():
+            built.vehicles[name] = build_grid(dataclasses.replace(target, spawns=spawns), cell=cell, clearance=c,
+                                              quadtree_depth=quadtree_depth, base=(params, surface),
+                                              **_surface_options(params))
+    built.seconds = time.perf_counter() - t0
+    return built
 
 
-def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: tuple[int, int]) -> tuple[Any, Any]:
+def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: tuple[int, int],
+             base: Any = None) -> tuple[Any, Any, Any]:
     """The layered grid of a bundle: its model's walkable surface on the grid over the
-    bounds, valid where a node keeps ``clearance`` from the walls of its level.
-    Returns (grid, mask of nodes that exist, for the picture)."""
+    bounds, valid where a node keeps ``clearance`` from the walls of its level (``base``,
+    a surface of the same model and settings, reseeded when it lies on the same grid).
+    Returns (grid, mask of nodes that exist, for the picture, the surface)."""
     import numpy as np
 
     from .nav.arena_levels import walls_too_close
-    from .nav.walkable import grid_from_surface, surface_layers, walkable_surface
+    from .nav.walkable import grid_from_surface, reseed, surface_layers, walkable_surface
 
-    vertices, faces = _model_triangles(target.model)
     origin = np.asarray(bounds, dtype=np.float64)[0]
     seeds = None
     if target.spawns is not None:  # [x, z] and the spawn's height when the manifest has it
         sp = np.asarray(target.spawns, dtype=np.float64)
         seeds = sp[:, [0, 1, 3]] if sp.shape[1] >= 4 else sp[:, :2]
-    surface = walkable_surface(vertices, faces, params, clearance, origin_xz=origin, shape=shape,
-                               seeds=seeds)
+    if base is not None and tuple(base.shape) == tuple(shape) and np.array_equal(base.hf.origin[[0, 2]], origin):
+        surface = reseed(base, clearance, seeds)
+    else:
+        vertices, faces = _model_triangles(target.model)
+        surface = walkable_surface(vertices, faces, params, clearance, origin_xz=origin, shape=shape,
+                                   seeds=seeds)
+        del vertices, faces
     if not surface.main.any():
         raise ArenaError(f"{target.model}: no walkable surface (max slope {params.max_slope:g} deg, "
                          f"headroom {params.headroom:g} m)")
@@ -242,7 +261,8 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
     tc = walls_too_close(target.walls, origin, params.cell, shape, levels, clearance)
     grid = grid_from_surface(surface, clearance, origin, seeds=target.spawns, too_close=tc)
     exists = surface_layers(surface, clearance=False)[0]
-    return grid, (exists[0] if grid.levels == 1 else None)
+    return grid, (exists[0] if grid.levels == 1 else None), surface
+
 
 
 def _model_triangles(model: Path) -> tuple[Any, Any]:
@@ -294,9 +314,11 @@ def stage_grid_files(stage: Path, target: Target, built: BuiltGrid, picture: byt
     grids, own_hashes = {}, {}
     for name, (clearance, spawns) in vehicle_grids(doc, target.manifest).items():
         # the same surface and settings, the vehicle's clearance, reachable from its own spawns
-        own = build_grid(dataclasses.replace(target, spawns=spawns), cell=built.cell, clearance=clearance,
-                         quadtree_depth=built.quadtree_depth, **_surface_options(built.params))
-        built.vehicles[name] = own
+        own = built.vehicles.get(name)
+        if own is None or own.clearance != clearance:   # a bare walls file's (build_grid made a bundle's)
+            own = build_grid(dataclasses.replace(target, spawns=spawns), cell=built.cell, clearance=clearance,
+                             quadtree_depth=built.quadtree_depth, **_surface_options(built.params))
+            built.vehicles[name] = own
         file = str(vehicle_file(name))
         atomic_write_bytes(stage / file, own.grid.to_bytes())
         own_hashes[file] = sha256_file(stage / file)

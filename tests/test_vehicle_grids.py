@@ -55,6 +55,21 @@ def test_each_smaller_vehicle_gets_its_own_grid_and_spawns(bundle):
                                                                       info.spawns[:, :2])
 
 
+def test_a_smaller_vehicles_grid_of_the_shared_surface_is_its_grid_built_alone(bundle):
+    import dataclasses
+
+    from tanktool.formats.vehicle_grids import vehicle_grids
+    from tanktool.grid_files import build_grid, open_target
+
+    target = open_target(bundle)
+    built = build_grid(target)          # the light tank's grid reseeds the heavy one's surface
+    (clearance, spawns), = vehicle_grids(target.toml).values()
+    own = {k: v for k, v in target.toml.items() if k != "grids"}
+    alone = build_grid(dataclasses.replace(target, spawns=spawns, toml=own), clearance=clearance)
+    assert built.vehicles["light"].grid.to_bytes() == alone.grid.to_bytes()
+    assert (bundle / "navgrid.light.npz").read_bytes() == alone.grid.to_bytes()
+
+
 def test_import_says_how_many_tanks_of_each_vehicle_fit(tmp_path, bundle):
     src = next(bundle.glob("*.obj"))
     r = CliRunner().invoke(cli, ["import-arena", str(src), "-o", str(tmp_path / "again")])

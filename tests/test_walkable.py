@@ -313,3 +313,21 @@ def test_import_and_build_navgrid_on_a_two_level_model(tmp_path):
     assert g.levels == 2 and (g.valid & g.reachable).any()
     res = CliRunner().invoke(cli, ["check", str(out)])
     assert "0 errors" in res.output, res.output
+
+
+@pytest.mark.parametrize("name", ["bridge", "two_storeys", "islands"])
+def test_a_reseeded_surface_is_the_surface_built_again_with_that_clearance_and_seeds(name):
+    from tanktool.nav.walkable import reseed
+
+    V, F = mesh_of(name)
+    big = walkable_surface(V, F, PARAMS, 3.0)
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    rng = np.random.default_rng(0)
+    seeds = np.column_stack([rng.uniform(lo[0], hi[0], 3), rng.uniform(lo[2], hi[2], 3), [0.0, 5.0, np.nan]])
+    for clearance, sd in ((1.2, seeds), (3.0, seeds[:, :2]), (4.5, None), (0.25, seeds[:1])):
+        want = walkable_surface(V, F, PARAMS, clearance, seeds=sd)
+        got = reseed(big, clearance, sd)
+        assert got.max_clearance == want.max_clearance
+        for k in ("col", "floor", "ceil", "link", "clearance", "region", "main", "level", "y"):
+            a, b = getattr(got, k), getattr(want, k)
+            assert a.dtype == b.dtype and np.array_equal(a, b), k
