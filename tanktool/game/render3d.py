@@ -144,6 +144,8 @@ class Renderer3D:
             if t.spec.name not in self.tank_models:
                 self.tank_models[t.spec.name] = self._vehicle_model(t.spec)
         self.textures: dict[int, Any] = {}
+        self._white = ctx.texture((1, 1), 3, bytes((255, 255, 255)))
+        self._corners: dict[str, np.ndarray] = {}
         self._split: Model | None = None
         self.quality = quality or PRESETS["medium"]
         self.view = np.identity(4)
@@ -222,14 +224,14 @@ class Renderer3D:
 
         self.quality = q
         ctx = self.ctx
-        def scene(per_pixel: bool) -> Any:
-            d = dict(SHADOWS=q.shadow_size > 0, PER_PIXEL=per_pixel)
+        def scene(per_pixel: bool, arena: bool) -> Any:
+            d = dict(SHADOWS=q.shadow_size > 0, PER_PIXEL=per_pixel, ARENA=arena)
             return ctx.program(vertex_shader=shaders.source(shaders.SCENE_VERTEX, **d),
                                fragment_shader=shaders.source(shaders.SCENE_FRAGMENT, **d))
 
-        self.prog = scene(True)                                    # tanks: always Phong per pixel
-        per_pixel = q.arena_light == "pixel"
-        self.arena_prog = self.prog if per_pixel else scene(False)
+        self.prog = scene(True, False)                             # tanks: always Phong per pixel
+        # the arena's own program: no tint (game/shaders.py), lit per vertex below high
+        self.arena_prog = scene(q.arena_light == "pixel", True)
         # no triangle so big that the light's attenuation or the fog change across it
         self.arena_shape = self._split_arena()
         self.arena = self._gpu(self.arena_shape, self.arena_prog)
@@ -249,7 +251,15 @@ class Renderer3D:
         by_kind: dict[str, list[np.ndarray]] = {}
         for t in self.session.world.tanks:
             by_kind.setdefault(t.spec.name, []).append(self._tank_model_matrix(t, alpha))
-        self.shadows.draw_tanks([(self.tanks_far[name], models) for name, models in by_kind.items()])
+        self.shadows.draw_tanks([(self.tanks_far[name], models, self._tank_corners(name))
+                                 for name, models in by_kind.items()])
+
+    def _tank_corners(self, name: str) -> np.ndarray:
+        """The (8, 3) corners of a vehicle model's bounding box (where its shadow is drawn from)."""
+        if name not in self._corners:
+            (x0, y0, z0), (x1, y1, z1) = self.tank_models[name].bounds().tolist()
+            self._corners[name] = np.array([[x, y, z] for x in (x0, x1) for y in (y0, y1) for z in (z0, z1)])
+        return self._corners[name]
 
     # ------------------------------------------------------------------ camera
     def toggle_camera(self) -> str:
@@ -380,8 +390,8 @@ class Renderer3D:
                 self.ctx.enable(moderngl.CULL_FACE)
             else:
                 self.ctx.disable(moderngl.CULL_FACE)
-            if b.texture is not None:
-                b.texture.use(0)
+            # the arena's program always samples its texture: white for vertex colours alone
+            (b.texture or self._white).use(0)
             set_uniform(prog, "use_texture", 1.0 if b.texture is not None else 0.0)
             set_uniform(prog, "tex_luma", b.luma)
             b.vao.render()

@@ -7,8 +7,8 @@ that is not there costs nothing.
 * **scene**: the paper's point light (D3DLIGHT8: position, range, attenuation
   1/(a0 + a1·d + a2·d²)) with Phong shading per pixel (Blinn's half vector), ambient,
   the material's texture, a team tint that keeps the texture's detail, the shadow map
-  (hardware 2×2 PCF through ``sampler2DShadow``): one map of the arena drawn once, one
-  of the tanks drawn every frame; and distance fog
+  (hardware 2×2 PCF through ``sampler2DShadow``): one map, the arena's depth drawn once
+  with this frame's tanks drawn into it; and distance fog
   towards the horizon's colour;
 * **depth**: the shadow pass, positions only;
 * **sky**: a grid over the window at the far plane, drawn after the scene so that only
@@ -39,37 +39,44 @@ in vec3 in_pos;
 in vec3 in_normal;
 in vec3 in_colour;
 in vec2 in_uv;
-out vec3 v_colour;
 out vec2 v_uv;
-out float v_visible;          // the fog's visibility
 #if PER_PIXEL
+out vec3 v_colour;
+out float v_visible;          // the fog's visibility
 out vec3 v_normal;
 out vec3 v_to_light;          // affine in the position: interpolated exactly, normalised per pixel
 out vec3 v_to_eye;
 out float v_att;
 #else
-out vec3 v_direct;            // the point light's diffuse light at this vertex
+uniform vec3 ambient;
+out vec3 v_ambient;           // colour x ambient light x fog visibility
+out vec3 v_direct;            // colour x the point light's diffuse light x fog visibility
+out float v_fog;              // 1 - visibility: the share of the fog's colour
 #endif
 #if SHADOWS
 out vec4 v_light;
 #endif
 void main() {
     vec4 world = model * vec4(in_pos, 1.0);
-    v_colour = in_colour;
     v_uv = in_uv;
     vec3 to_light = light_pos - world.xyz;
     float d = length(to_light);
     float att = d > light_range ? 0.0 : 1.0 / (attenuation.x + attenuation.y * d + attenuation.z * d * d);
     vec3 to_eye = eye - world.xyz;
-    v_visible = 1.0 / (1.0 + fog_k * dot(to_eye, to_eye));
+    float visible = 1.0 / (1.0 + fog_k * dot(to_eye, to_eye));
 #if PER_PIXEL
+    v_colour = in_colour;
+    v_visible = visible;
     v_normal = mat3(model) * in_normal;
     v_to_light = to_light;
     v_to_eye = to_eye;
     v_att = att;
 #else
     vec3 n = normalize(mat3(model) * in_normal);
-    v_direct = light_colour * (max(dot(n, to_light / d), 0.0) * att);
+    vec3 direct = light_colour * (max(dot(n, to_light / d), 0.0) * att);
+    v_ambient = in_colour * ambient * visible;
+    v_direct = in_colour * direct * visible;
+    v_fog = 1.0 - visible;
 #endif
 #if SHADOWS
     v_light = light_vp * world;
@@ -85,67 +92,86 @@ void main() {
 # come from the vertices (the arena's big triangles are split for them, game/meshes.py).
 # PER_PIXEL 0 lights each vertex (as Direct3D 8's fixed pipeline lit the paper's arena)
 # and leaves the pixel its texture and its shadow: the arena at the low and medium
-# presets.
+# presets.  There everything that does not change across a triangle -- colour, ambient,
+# light, fog -- is folded into three values per vertex, and the pixel does one texture
+# and one shadow lookup and two multiply-adds.
+#
+# ARENA 1 leaves out the tanks' team tint, emission and the "has a texture" switch (an
+# untextured batch is given a white texture): llvmpipe runs both sides of an `if` with
+# masks, so code a pixel never needs still costs it (a sixth of an arena pixel's time).
+#
+# One shadow map: the arena's depth from the light, drawn once, with this frame's tanks
+# drawn into it (game/shadows.py): one lookup per pixel, not one per map.
 SCENE_FRAGMENT = """
+uniform vec3 fog_colour;
+uniform sampler2D tex;
+#if SHADOWS
+uniform sampler2DShadow shadow_map;
+in vec4 v_light;
+#endif
+in vec2 v_uv;
+out vec4 frag;
+
+float shadowed() {
+#if SHADOWS
+    return textureProj(shadow_map, v_light);
+#else
+    return 1.0;
+#endif
+}
+
+#if PER_PIXEL
 uniform vec3 ambient;
+uniform vec3 light_colour;
+in vec3 v_colour;
+in float v_visible;
+in vec3 v_normal;
+in vec3 v_to_light;
+in vec3 v_to_eye;
+in float v_att;
+#if !ARENA
 uniform vec3 tint;
 uniform float tint_amount;
 uniform float tex_luma;       // the texture's mean luminance: a tint keeps its detail
 uniform float use_texture;
 uniform vec3 emissive;
 uniform float alpha;
-uniform vec3 fog_colour;
-uniform sampler2D tex;
-#if PER_PIXEL
-uniform vec3 light_colour;
-in vec3 v_normal;
-in vec3 v_to_light;
-in vec3 v_to_eye;
-in float v_att;
-#else
-in vec3 v_direct;
 #endif
-#if SHADOWS
-uniform sampler2DShadow shadow_static;    // the arena, drawn once
-uniform sampler2DShadow shadow_tanks;     // the tanks, every frame
-in vec4 v_light;
-#endif
-in vec3 v_colour;
-in vec2 v_uv;
-in float v_visible;
-out vec4 frag;
-
-float shadowed() {
-#if SHADOWS
-    float s = textureProj(shadow_static, v_light);
-    if (s > 0.0) s *= textureProj(shadow_tanks, v_light);
-    return s;
-#else
-    return 1.0;
-#endif
-}
 
 void main() {
+#if ARENA
+    vec3 base = v_colour * texture(tex, v_uv).rgb;
+#else
     vec3 base = v_colour;
     if (use_texture > 0.5) base *= texture(tex, v_uv).rgb;
     if (tint_amount > 0.0) {               // tanks: the team colour, keeping the texture's light and dark
         float luma = dot(base, vec3(0.2126, 0.7152, 0.0722));
         base = mix(base, tint * clamp(luma / tex_luma, 0.35, 1.6), tint_amount);
     }
-#if PER_PIXEL
+#endif
     vec3 n = normalize(v_normal);
     vec3 l = normalize(v_to_light);
     float diffuse = max(dot(n, l), 0.0);
     float spec = max(dot(n, normalize(l + normalize(v_to_eye))), 0.0);
     spec *= spec; spec *= spec; spec *= spec; spec *= spec; spec *= spec;      // ^32
-    float lit = v_att;
-    if (diffuse > 0.0) lit *= shadowed();
-    vec3 colour = base * (ambient + light_colour * (diffuse * lit)) + (0.25 * spec * lit) * light_colour + emissive;
+    float lit = v_att * shadowed();
+    vec3 colour = base * (ambient + light_colour * (diffuse * lit)) + (0.25 * spec * lit) * light_colour;
+#if ARENA
+    frag = vec4(mix(fog_colour, colour, v_visible), 1.0);
 #else
-    vec3 colour = base * (ambient + v_direct * (v_direct.g > 0.0 ? shadowed() : 1.0)) + emissive;
+    frag = vec4(mix(fog_colour, colour + emissive, v_visible), alpha);
 #endif
-    frag = vec4(mix(fog_colour, colour, v_visible), alpha);
 }
+#else
+in vec3 v_ambient;
+in vec3 v_direct;
+in float v_fog;
+
+void main() {
+    vec3 t = texture(tex, v_uv).rgb;
+    frag = vec4(t * (v_ambient + v_direct * shadowed()) + fog_colour * v_fog, 1.0);
+}
+#endif
 """
 
 DEPTH_VERTEX = """
@@ -291,5 +317,7 @@ void main() { frag = texture(hud, uv); }
 
 def source(body: str, **defines: int) -> str:
     """A shader of ``body`` with ``#version 330 core`` and ``#define NAME value`` lines."""
+    # every switch a shader tests with #if is defined (0 unless given): GLSL has no default
+    defines = {"SHADOWS": 0, "PER_PIXEL": 1, "ARENA": 0, "CLOUDS": 0, **defines}
     head = "#version 330 core\n" + "".join(f"#define {k} {int(v)}\n" for k, v in sorted(defines.items()))
     return head + body
