@@ -413,14 +413,22 @@ def _main_region(hf: Heightfield, col, floor, region, seeds) -> np.ndarray:
         s = np.asarray(seeds, dtype=np.float64).reshape(len(seeds), -1)
         sj = np.clip(np.floor((s[:, 0] - hf.origin[0]) / hf.cs), 0, nx - 1).astype(np.int64)
         si = np.clip(np.floor((s[:, 1] - hf.origin[2]) / hf.cs), 0, nz - 1).astype(np.int64)
-        i, j = np.divmod(col, nx)
-        y = hf.origin[1] + floor * hf.ch
+        ij = None
         picked = []
         for k, (a, b) in enumerate(zip(si, sj)):
-            d = (i - a) ** 2 + (j - b) ** 2
-            near = np.flatnonzero(d == d.min())
+            # the seed's own column when it has spans (col is sorted): the nearest at
+            # distance 0, found without a pass over every span (~0.1 s a seed on 1 km)
+            lo, hi = np.searchsorted(col, [a * nx + b, a * nx + b + 1])
+            if hi > lo:
+                near = np.arange(lo, hi)
+            else:
+                if ij is None:
+                    ij = np.divmod(col, nx)
+                d = (ij[0] - a) ** 2 + (ij[1] - b) ** 2
+                near = np.flatnonzero(d == d.min())
             if s.shape[1] >= 3 and np.isfinite(s[k, -1]):
-                pick = near[int(np.argmin(np.abs(y[near] - s[k, -1])))]
+                y = hf.origin[1] + floor[near] * hf.ch
+                pick = near[int(np.argmin(np.abs(y - s[k, -1])))]
             else:
                 pick = near[int(np.argmax(sizes[region[near]]))]
             picked.append(region[pick])
