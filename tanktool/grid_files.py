@@ -252,7 +252,7 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
     else:
         vertices, faces = _model_triangles(target.model)
         surface = walkable_surface(vertices, faces, params, clearance, origin_xz=origin, shape=shape,
-                                   seeds=seeds)
+                                   seeds=seeds, lean=True)   # its grid reads the walls' distance (too_close)
         del vertices, faces
     if not surface.main.any():
         raise ArenaError(f"{target.model}: no walkable surface (max slope {params.max_slope:g} deg, "

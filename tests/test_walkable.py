@@ -331,3 +331,23 @@ def test_a_reseeded_surface_is_the_surface_built_again_with_that_clearance_and_s
         for k in ("col", "floor", "ceil", "link", "clearance", "region", "main", "level", "y"):
             a, b = getattr(got, k), getattr(want, k)
             assert a.dtype == b.dtype and np.array_equal(a, b), k
+
+
+@pytest.mark.parametrize("name", ["bridge", "islands"])
+def test_a_lean_surface_makes_the_same_grid_and_reseeds_alike(name):
+    from tanktool.nav.arena_levels import walls_too_close
+    from tanktool.nav.walkable import reseed
+
+    V, F = mesh_of(name)
+    full = walkable_surface(V, F, PARAMS, 3.0)
+    lean = walkable_surface(V, F, PARAMS, 3.0, lean=True)
+    assert lean.clearance is None and len(lean.hf.col) == 0 and len(lean.ceil) == 0
+    walls = analyse_arena(V, F, PARAMS, TANK).walls.walls
+    origin = full.hf.origin[[0, 2]]
+    for c, a, b in ((3.0, full, lean), (1.5, reseed(full, 1.5), reseed(lean, 1.5))):
+        for k in ("col", "floor", "link", "region", "main", "level", "y"):
+            assert np.array_equal(getattr(a, k), getattr(b, k)), k
+        tc = walls_too_close(walls, origin, PARAMS.cell, full.shape, max(a.levels, 1), c)
+        ga = grid_from_surface(a, c, origin, too_close=tc)
+        gb = grid_from_surface(b, c, origin, too_close=tc)
+        assert ga.to_bytes() == gb.to_bytes()

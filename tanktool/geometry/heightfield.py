@@ -83,6 +83,16 @@ class Heightfield:
         """World y of each span's top."""
         return self.origin[1] + self.smax * self.ch
 
+    def geometry(self) -> "Heightfield":
+        """The grid alone (origin, cells, shape, counts) without its spans: what a
+        lean walkable surface keeps of it (walkable.walkable_surface(lean=True))."""
+        def none(a: np.ndarray) -> np.ndarray:
+            return np.zeros(0, dtype=a.dtype)  # not a[:0]: a view would keep the spans alive
+
+        return Heightfield(self.origin, self.cs, self.ch, self.shape, none(self.col), none(self.smin),
+                           none(self.smax), none(self.walkable), none(self.flat), none(self.top_walkable),
+                           dict(self.counts), none(self.low_headroom))
+
 
 #: a horizontal face: |n_y| at least this (within ~2.6 degrees)
 FLAT_NY = 0.999
