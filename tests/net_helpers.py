@@ -103,12 +103,13 @@ def peers():
     close_all(made)
 
 
-def session(peers, n: int, password: str | None = None) -> list[Peer]:
-    """A host and ``n - 1`` joiners, in ``peers``, the mesh formed."""
-    host = Peer.host((LOOPBACK, 0), "host", password)
+def session(peers, n: int, password: str | None = None, **kw) -> list[Peer]:
+    """A host and ``n - 1`` joiners, in ``peers``, the mesh formed (``kw``: Peer's,
+    e.g. ``silence``)."""
+    host = Peer.host((LOOPBACK, 0), "host", password, **kw)
     peers.append(host)
     for i in range(2, n + 1):
-        join(peers, host.tcp_address, f"peer{i}", password)
+        join(peers, host.tcp_address, f"peer{i}", password, **kw)
     return peers
 
 
