@@ -12,6 +12,8 @@
  *       col, floor, ceil, start: int64; out: int32 (n, 4), filled in place (n < 2**31)
  *   chamfer(link, dist, limit)
  *       link: int32 (n, 4); dist: int32 (n,), the starting values, relaxed in place
+ *   reach(link, dist)
+ *       as chamfer, straight steps of 2 only (surface_report._distance_from)
  *   raster(tri, abc, nz, nx, ch, max_steps, row_lo, row_hi, steep) -> (col, tri, smin, smax) as int64 bytes
  *       (the cells of rows row_lo .. row_hi - 1 only); steep: the triangles' exact sections
  *       (heightfield._cells_exact) instead of their planes (_cells_plane; abc unused)
@@ -145,6 +147,42 @@ done:
     return ret;
 }
 
+/* surface_report._distance_from: half cells from the nearest source (dist 0) along
+ * straight links only (2 a step), capped at the starting value of the other spans
+ * (the limit).  Sweeps forward and back until nothing changes: the numpy
+ * relaxation's fixed point, with one int32 a span where it took seven. */
+static PyObject *reach(PyObject *self, PyObject *args) {
+    Py_buffer link, dist;
+    if (!PyArg_ParseTuple(args, "y*w*", &link, &dist)) return NULL;
+    Py_ssize_t n = dist.len / 4;
+    PyObject *ret = NULL;
+    if (!need(&link, 4 * n, 4, "link")) goto done;
+    {
+        const int32_t *L = link.buf;
+        int32_t *D = dist.buf;
+        Py_BEGIN_ALLOW_THREADS
+        int changed = 1;
+        while (changed) {
+            changed = 0;
+            for (Py_ssize_t k = 0; k < 2 * n; ++k) {
+                const Py_ssize_t s = k < n ? k : 2 * n - 1 - k;
+                int32_t v = D[s];
+                for (int d = 0; d < 4; ++d) {
+                    const int32_t t = L[4 * s + d];
+                    if (t >= 0 && D[t] + 2 < v) v = D[t] + 2;
+                }
+                if (v < D[s]) { D[s] = v; changed = 1; }
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&link);
+    PyBuffer_Release(&dist);
+    return ret;
+}
 
 /* ------------------------------------------------------------------ components */
 
@@ -359,6 +397,7 @@ done:
 static PyMethodDef methods[] = {
     {"link_spans", link_spans, METH_VARARGS, "links between open spans (see nav/kernels.py)"},
     {"chamfer", chamfer, METH_VARARGS, "chamfer distance relaxed to its fixed point, in place"},
+    {"reach", reach, METH_VARARGS, "straight-step distance from the sources relaxed to its fixed point, in place"},
     {"raster", tanktool_raster, METH_VARARGS, "spans of triangles, as heightfield._cells_plane / _cells_exact"},
     {"filters", filters, METH_VARARGS, "Recast's three span filters, as span_filters.filter_masks"},
     {"components", components, METH_VARARGS, "component labels (smallest span index), in place"},
@@ -373,7 +412,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 6
+#define TANKTOOL_KERNELS_ABI 7
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

@@ -82,6 +82,15 @@ def test_random_span_graphs_give_the_same_links_and_distances(seed):
         with use_kernels(False):
             db = chamfer_clearance(la, limit)
         assert np.array_equal(da, db), limit
+    from tanktool.nav.surface_report import _distance_from
+
+    for limit, share in ((3, 0.5), (14, 0.2), (40, 0.02)):
+        sources = rng.random(len(la)) < share
+        with use_kernels(True):
+            ra = _distance_from(sources, la, limit)
+        with use_kernels(False):
+            rb = _distance_from(sources, la, limit)
+        assert np.array_equal(ra, rb) and (ra == limit).any() and ((ra > 0) & (ra < limit)).any(), limit
     with use_kernels(True):
         ca = components(la)
     with use_kernels(False):

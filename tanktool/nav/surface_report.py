@@ -166,7 +166,15 @@ def unreachable(surface: Surface, radius: float, vertices: np.ndarray | None = N
 def too_small(surface: Surface, radius: float) -> np.ndarray:
     """Parts of the played region no tank footprint of ``radius`` ever covers: farther
     than the radius (along the links) from every span where a tank fits, in patches of
-    at least MIN_SMALL_AREA radius-squared (a room's corners are not "too small")."""
+    at least MIN_SMALL_AREA radius-squared (a room's corners are not "too small").
+    Worked out once per surface and radius (the report and the picture both ask)."""
+    key = ("too_small", float(radius))
+    if key not in surface.derived:
+        surface.derived[key] = _too_small(surface, radius)
+    return surface.derived[key].copy()
+
+
+def _too_small(surface: Surface, radius: float) -> np.ndarray:
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -204,8 +212,14 @@ MIN_SMALL_AREA = 0.8
 
 def _distance_from(sources: np.ndarray, link: np.ndarray, limit: int) -> np.ndarray:
     """Chamfer-like distance (half cells, straight steps only) from the source spans."""
+    from ..geometry.kernels import active
+
     n = len(sources)
     dist = np.where(sources, 0, limit).astype(np.int32)
+    kern = active()
+    if kern is not None and link.dtype == np.int32 and n:  # the same fixed point, no int64 copies of the links
+        kern.reach(np.ascontiguousarray(link), dist)
+        return dist
     safe = [np.where(link[:, d] < 0, n, link[:, d]) for d in range(4)]
     ext = np.full(n + 1, limit, dtype=np.int32)
     for _ in range(limit // 2 + 2):

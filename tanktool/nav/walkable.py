@@ -106,6 +106,9 @@ class Surface:
     max_clearance: float
     stats: dict = field(default_factory=dict)
     height: np.ndarray | None = None
+    #: what is derived from the finished surface and asked for twice (the import's
+    #: report and its picture: surface_report.too_small by radius), kept with it
+    derived: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def shape(self) -> tuple[int, int]:
