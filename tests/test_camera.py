@@ -178,3 +178,27 @@ def test_the_first_person_eye_stays_under_a_roof_and_behind_a_wall():
         mesh = MeshIndex(np.array(tris, float), np.arange(len(tris), dtype=np.int64).reshape(-1, 3))
         assert mesh.first_hit((me.x, y + 0.6 * h, me.z), tuple(eye)) is None     # the hull's side of both
         assert target[0] > eye[0] + 5.0                                       # still looking ahead
+
+
+@pytest.mark.parametrize("arena", ["box", "fort", "hills", "maze", "paper2002"])
+def test_the_chase_camera_at_every_spawn_sees_the_tank_from_the_first_frame(arena):
+    """A match starts (and a tank respawns) with a fresh camera at a spawn point, often in
+    a corner or against a wall: its first frame and the next quarter second keep at least 80 %
+    of the hull in the frame, nothing of the arena between the eye and the tank."""
+    s = GameSession(arena, bots=1, seed=1, player=True)
+    me = s.world.tanks[0]
+    s.world.tanks[1].alive = False
+    mesh = arena_mesh(load_model(str(Path(s.info.path) / "model.glb")))
+    worst, hidden = 1.0, []
+    for i, (x, z, heading) in enumerate(s.world.spawns):
+        cam = Camera(mesh)
+        me.place(x, z, heading)
+        for _ in range(30):                               # a quarter second standing there
+            s.step()
+            me.place(x, z, heading)
+            eye, target = cam.pose(s, 1.0, "chase")
+            worst = min(worst, in_frame(s, eye, target))
+            if mesh.first_hit(tuple(eye), (me.x, me.y + 0.6 * me.spec.height, me.z)) is not None:
+                hidden.append(i)
+    assert worst >= 0.8, worst
+    assert not hidden, sorted(set(hidden))
