@@ -67,3 +67,37 @@ def test_every_preset_renders_and_shadows_darken_behind_a_crate():
     assert shadowed < 0.8 * lit
     for name, img in shots.items():
         assert img.std() > 10, name
+
+
+@pytest.mark.skipif(ctypes.util.find_library("EGL") is None, reason="libEGL is not installed")
+def test_a_tank_shadow_follows_the_tank_and_leaves_nothing_behind():
+    """The tanks are drawn into the arena's shadow map every frame (game/shadows.py): a
+    tank's shadow darkens the floor beside it, and once it has moved on the floor there
+    is drawn exactly as by a renderer that never saw it there."""
+    from tanktool.game.render3d import Renderer3D
+    from tanktool.game.session import GameSession
+
+    s = GameSession("box", bots=1, seed=0, player=True)        # one tank: the player's, standing
+    tank = s.world.tanks[0]
+    tank.place(15.0, 30.0, 0.0)             # the light is over (30, 30): its shadow falls towards -x
+    s.step()
+    r = Renderer3D(s, (320, 180), quality=PRESETS["medium"])
+    try:
+        r.camera = "overview"
+        first = r.render(hud=False).astype(int)
+        px, py, _ = r.project((15.0, 0.0, 30.0))
+        tank.place(45.0, 20.0, 0.0)
+        s.step()
+        moved = r.render(hud=False).astype(int)
+    finally:
+        r.release()
+    fresh = Renderer3D(s, (320, 180), quality=PRESETS["medium"])
+    try:
+        fresh.camera = "overview"
+        clean = fresh.render(hud=False).astype(int)
+    finally:
+        fresh.release()
+    # the shadow: floor darker with the tank there than once it has gone, next to it
+    darker = np.argwhere(first.sum(axis=2) < 0.8 * moved.sum(axis=2))
+    assert np.sum(np.abs(darker - (py, px)).max(axis=1) < 25) >= 20
+    assert np.abs(moved - clean).max() <= 2                       # nothing left behind anywhere

@@ -185,6 +185,19 @@ out vec4 frag;
 void main() { frag = vec4(1.0); }
 """
 
+# Puts the arena's depth back into the shadow map where last frame's tanks were drawn:
+# quads over those texels copy it from a plain float texture of the arena's map (one draw
+# call; a texture upload per rectangle costs llvmpipe more than the pixels).
+RESTORE_VERTEX = """
+in vec2 in_pos;               // the map's clip space
+void main() { gl_Position = vec4(in_pos, 0.0, 1.0); }
+"""
+
+RESTORE_FRAGMENT = """
+uniform sampler2D arena_depth;
+void main() { gl_FragDepth = texelFetch(arena_depth, ivec2(gl_FragCoord.xy), 0).r; }
+"""
+
 # The sky is a grid over the window at the far plane: its colour (gradient, the light's
 # glow) is worked out per vertex and interpolated, so a pixel of sky costs nothing but
 # the optional cloud lookup; it is drawn after the scene, only where nothing else is.

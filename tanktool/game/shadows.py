@@ -16,6 +16,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from . import shaders
 from .matrices import _gl, frustum, look_at, set_uniform
 
 
@@ -51,19 +52,27 @@ class ShadowMaps:
     One map rather than the arena's and the tanks' apart: the scene's pixels then do one
     shadow lookup, not two (on llvmpipe a lookup is about a tenth of an arena pixel's
     time).  The tanks' depth is taken out again where it was drawn: the rectangles the
-    last frame's tanks covered are rewritten from a copy of the arena's map (a few
-    thousand texels, against a million to copy or redraw the whole map)."""
+    last frame's tanks covered are copied back from the arena's map (a few thousand
+    texels, against a million to copy or redraw the whole map)."""
 
     def __init__(self, ctx: Any, depth_prog: Any, light_pos: Sequence[float], scene_box: np.ndarray,
                  size: int, arena: list[Any]) -> None:
+        import moderngl
+
         self.ctx, self.depth_prog = ctx, depth_prog
         self.light_vp = light_matrix(light_pos, scene_box)
         self.size = size
         self.tex, self.fbo = self._target(size)
         self._draw(self.fbo, size, [(arena, [np.identity(4)])])
-        # the arena's depth alone, rows from the bottom as OpenGL keeps them
-        self._arena_depth = np.frombuffer(self.tex.read(), dtype="f4").reshape(size, size).copy()
-        self._dirty: list[tuple[int, int, int, int]] = []     # (x, y, w, h) the tanks were drawn over
+        # the arena's depth alone, as a plain float texture the restoring quads copy from
+        self.arena_depth = ctx.texture((size, size), 1, self.tex.read(), dtype="f4")
+        self.arena_depth.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self._restore_prog = ctx.program(vertex_shader=shaders.source(shaders.RESTORE_VERTEX),
+                                         fragment_shader=shaders.source(shaders.RESTORE_FRAGMENT))
+        self._restore_prog["arena_depth"].value = 3
+        self._quads = ctx.buffer(reserve=6 * 2 * 4 * 16, dynamic=True)
+        self._restore = ctx.vertex_array(self._restore_prog, [(self._quads, "2f", "in_pos")])
+        self._dirty = np.zeros((0, 4))                  # the map's rectangles the tanks were drawn over
 
     def _target(self, n: int) -> tuple[Any, Any]:
         """A depth texture of n x n sampled with comparison (hardware PCF) and its framebuffer."""
@@ -79,25 +88,44 @@ class ShadowMaps:
         """This frame's tanks into the map: each group's batches placed at each of its model
         matrices, ``(batches, models, corners)`` with ``corners`` the (8, 3) corners of the
         batches' bounding box in the model's frame (where the tank's depth can land)."""
-        for x, y, w, h in self._dirty:            # the arena's depth back where the last tanks were
-            self.tex.write(self._arena_depth[y:y + h, x:x + w].tobytes(), viewport=(x, y, w, h))
-        self._dirty = [r for _, models, corners in groups for m in models
-                       if (r := self._texels(m, corners)) is not None]
+        self.fbo.use()
+        self.ctx.viewport = (0, 0, self.size, self.size)
+        self._put_back(self._dirty)                  # the arena's depth where the last tanks were
+        boxes = [self._texels(np.asarray(models), corners) for _, models, corners in groups if len(models)]
+        self._dirty = np.concatenate(boxes) if boxes else np.zeros((0, 4))
         self._draw(self.fbo, self.size, [(b, models) for b, models, _ in groups], clear=False)
 
-    def _texels(self, model: np.ndarray, corners: np.ndarray) -> tuple[int, int, int, int] | None:
-        """The map's rectangle (x, y, w, h) under a box placed by ``model``, a texel of
-        margin for the filter; None when it is off the map."""
-        p = self.light_vp @ model @ np.c_[corners, np.ones(len(corners))].T
-        if np.any(p[3] <= 1e-9):
-            return (0, 0, self.size, self.size)            # reaching above the light: all of it
-        uv = (p[:2] / p[3] + 1.0) * 0.5 * self.size
-        x0, y0 = np.floor(uv.min(axis=1)).astype(int) - 2
-        x1, y1 = np.ceil(uv.max(axis=1)).astype(int) + 2
-        x0, y0, x1, y1 = max(x0, 0), max(y0, 0), min(x1, self.size), min(y1, self.size)
-        if x1 <= x0 or y1 <= y0:
-            return None
-        return int(x0), int(y0), int(x1 - x0), int(y1 - y0)
+    def _put_back(self, rects: np.ndarray) -> None:
+        """Copy the arena's depth into the map over ``rects`` ((n, 4) clip-space x0 y0 x1 y1)."""
+        import moderngl
+
+        if not len(rects):
+            return
+        x0, y0, x1, y1 = rects.T
+        quads = np.stack([x0, y0, x1, y0, x1, y1, x0, y0, x1, y1, x0, y1], axis=1).astype("f4").tobytes()
+        if len(quads) > self._quads.size:
+            self._quads.orphan(2 * len(quads))
+        self._quads.write(quads)
+        ctx = self.ctx
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "1"                          # always: written whatever is there
+        self.arena_depth.use(3)
+        self._restore.render(moderngl.TRIANGLES, vertices=6 * len(rects))
+        ctx.depth_func = "<"
+
+    def _texels(self, models: np.ndarray, corners: np.ndarray) -> np.ndarray:
+        """The map's rectangles (n, 4), as clip-space x0 y0 x1 y1, under a box (``corners``)
+        placed by each of ``models`` (n, 4, 4), with two texels of margin for the filter."""
+        pts = np.ones((4, len(corners)))
+        pts[:3] = corners.T
+        p = (self.light_vp @ models) @ pts                                # (n, 4, 8)
+        w = p[:, 3]
+        if (w <= 1e-9).any():                       # reaching above the light: all of the map
+            return np.tile([-1.0, -1.0, 1.0, 1.0], (len(models), 1))
+        x, y = p[:, 0] / w, p[:, 1] / w
+        pad = 4.0 / self.size
+        out = np.stack([x.min(axis=1) - pad, y.min(axis=1) - pad, x.max(axis=1) + pad, y.max(axis=1) + pad], axis=1)
+        return np.clip(out, -1.0, 1.0)
 
     def _draw(self, fbo: Any, n: int, groups: list[tuple[list[Any], list[np.ndarray]]], clear: bool = True) -> None:
         """Depth from the light of each group's batches placed at each of its model matrices."""
