@@ -219,7 +219,7 @@ void main() {
     float sun = max(dot(dir, sun_dir), 0.0);
     v_colour = mix(horizon, zenith, pow(up, 0.55)) + vec3(1.0, 0.92, 0.75) * 0.3 * pow(sun, 12.0);
     v_cloud_uv = dir.xz / (max(dir.y, 0.0) + 0.08) * 0.35 + vec2(time * 0.004, time * 0.0015);
-    v_cloud = smoothstep(0.02, 0.25, dir.y);
+    v_cloud = smoothstep(0.02, 0.25, dir.y);     // 0.02: sky.CLOUD_BASE (the rows under it skip the clouds)
     gl_Position = vec4(in_pos, 1.0, 1.0);
 }
 """

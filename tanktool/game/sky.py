@@ -24,12 +24,15 @@ SKY = (0.66, 0.75, 0.85)
 ZENITH = (0.30, 0.48, 0.78)
 #: the widest a particle may be on screen, as a share of the window's height
 PARTICLE_MAX_SCREEN = 0.2
+#: the height of a direction (its y, unit vector) under which the sky has no clouds
+#: (the smoothstep's lower edge in shaders.SKY_VERTEX)
+CLOUD_BASE = 0.02
 
 
 class Sky:
     """The sky pass: its program, grid and (with ``clouds``) cloud texture."""
 
-    def __init__(self, ctx: Any, clouds: bool, nx: int = 24, ny: int = 16) -> None:
+    def __init__(self, ctx: Any, clouds: bool, nx: int = 24, ny: int = 16, trilinear: bool = False) -> None:
         import moderngl
 
         self.ctx = ctx
@@ -41,7 +44,11 @@ class Sky:
             self.cloud_tex = ctx.texture(pix.shape[::-1], 1, pix.tobytes())
             self.cloud_tex.repeat_x = self.cloud_tex.repeat_y = True
             self.cloud_tex.build_mipmaps()
-            self.cloud_tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            # between mipmap levels too only with trilinear: blending two levels doubles what
+            # a pixel of sky costs llvmpipe (half the screen in the hills: 2.5 ms a frame),
+            # and on soft clouds the step between levels does not show
+            self.cloud_tex.filter = (moderngl.LINEAR_MIPMAP_LINEAR if trilinear else moderngl.LINEAR_MIPMAP_NEAREST,
+                                     moderngl.LINEAR)
         # rows of quads over the window, bottom row first (drawn from the horizon up)
         self.cols, self.rows = nx, ny
         xs, ys = np.linspace(-1, 1, nx + 1), np.linspace(-1, 1, ny + 1)
@@ -52,20 +59,31 @@ class Sky:
                 quads += [a, b, c, a, c, d]
         buf = ctx.buffer(np.array(quads, dtype="f4").tobytes())
         self.grid = ctx.vertex_array(self.prog, [(buf, "2f", "in_pos")])
+        # the rows under the clouds' base (only the gradient there) drawn without the
+        # cloud lookup: the shader would pay for it where its cover is 0
+        self.plain_prog = self.prog
+        self.plain_grid = self.grid
+        if clouds:
+            self.plain_prog = ctx.program(vertex_shader=shaders.source(shaders.SKY_VERTEX),
+                                          fragment_shader=shaders.source(shaders.SKY_FRAGMENT, CLOUDS=False))
+            self.plain_grid = ctx.vertex_array(self.plain_prog, [(buf, "2f", "in_pos")])
+        gx, gy = np.meshgrid(xs, ys)                    # (ny + 1, nx + 1): the grid's corners
+        self._corners = np.stack([gx, gy, np.ones_like(gx), np.ones_like(gx)], axis=-1).reshape(-1, 4)
 
     def draw(self, pv: np.ndarray, view: np.ndarray, eye: np.ndarray, sun_dir: Sequence[float], t: float) -> None:
         """The sky behind what is drawn, seen through ``pv`` from ``eye`` at time ``t``."""
         import moderngl
 
-        prog = self.prog
-        prog["inv_view_proj"].write(_gl(np.linalg.inv(pv)))
-        prog["horizon"].value = SKY
-        prog["zenith"].value = ZENITH
-        prog["sun_dir"].value = tuple(float(v) for v in sun_dir)
-        prog["eye"].value = tuple(float(v) for v in eye)
-        set_uniform(prog, "time", float(t))
+        inv = np.linalg.inv(pv)
+        for prog in (self.prog,) if self.plain_prog is self.prog else (self.prog, self.plain_prog):
+            prog["inv_view_proj"].write(_gl(inv))
+            prog["horizon"].value = SKY
+            prog["zenith"].value = ZENITH
+            prog["sun_dir"].value = tuple(float(v) for v in sun_dir)
+            prog["eye"].value = tuple(float(v) for v in eye)
+            set_uniform(prog, "time", float(t))
         if self.cloud_tex is not None:
-            prog["clouds"].value = 0
+            self.prog["clouds"].value = 0
             self.cloud_tex.use(0)
         # the sky is only above the horizon: below it the clear colour (the horizon's,
         # the fog's) shows where nothing was drawn, and the grid's lower rows are not drawn
@@ -80,13 +98,27 @@ class Sky:
                 if ndc_y > 1.0:
                     return                          # looking down: no sky in view
                 lowest = int(np.clip(math.floor((ndc_y + 1.0) / 2.0 * self.rows), 0, self.rows - 1))
+        cloudy = self._cloudy_from(inv, eye, lowest) if self.plain_prog is not self.prog else lowest
         ctx = self.ctx
         ctx.depth_func = "<="
         ctx.depth_mask = False
         per_row = 6 * self.cols
-        self.grid.render(moderngl.TRIANGLES, vertices=(self.rows - lowest) * per_row, first=lowest * per_row)
+        if cloudy > lowest:
+            self.plain_grid.render(moderngl.TRIANGLES, vertices=(cloudy - lowest) * per_row, first=lowest * per_row)
+        if cloudy < self.rows:
+            self.grid.render(moderngl.TRIANGLES, vertices=(self.rows - cloudy) * per_row, first=cloudy * per_row)
         ctx.depth_mask = True
         ctx.depth_func = "<"
+
+    def _cloudy_from(self, inv_pv: np.ndarray, eye: np.ndarray, lowest: int) -> int:
+        """The first grid row from ``lowest`` up with a corner over the clouds' base (the
+        sky shader's ``CLOUD_BASE``): the rows under it have no cloud to draw."""
+        far = self._corners @ inv_pv.T
+        d = far[:, :3] / far[:, 3:4] - eye
+        up = (d[:, 1] / np.linalg.norm(d, axis=1)).reshape(self.rows + 1, self.cols + 1).max(axis=1)
+        row_up = np.maximum(up[:-1], up[1:])             # a row spans two lines of corners
+        over = np.nonzero(row_up[lowest:] > CLOUD_BASE)[0]
+        return lowest + int(over[0]) if len(over) else self.rows
 
 
 class EffectsPass:
