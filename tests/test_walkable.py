@@ -351,3 +351,18 @@ def test_a_lean_surface_makes_the_same_grid_and_reseeds_alike(name):
         ga = grid_from_surface(a, c, origin, too_close=tc)
         gb = grid_from_surface(b, c, origin, too_close=tc)
         assert ga.to_bytes() == gb.to_bytes()
+
+
+def test_heights_and_layers_built_in_blocks_are_the_same(monkeypatch):
+    from tanktool.nav import walkable
+
+    V, F = mesh_of("bridge")
+    whole = walkable_surface(V, F, PARAMS, 2.0)
+    g_whole = grid_from_surface(whole, 2.0, whole.hf.origin[[0, 2]])
+    monkeypatch.setattr(walkable, "BLOCK", 7)   # many blocks, the last one short
+    blocks = walkable_surface(V, F, PARAMS, 2.0)
+    assert np.array_equal(blocks.height, whole.height)
+    g_blocks = grid_from_surface(blocks, 2.0, blocks.hf.origin[[0, 2]])
+    assert g_blocks.to_bytes() == g_whole.to_bytes()
+    for a, b in zip(walkable.surface_layers(blocks), walkable.surface_layers(whole)):
+        assert np.array_equal(a, b, equal_nan=True)
