@@ -47,8 +47,16 @@ SHAKE_REACH, SHAKE_S = 25.0, 0.4
 YAWS = (0.0, 0.7, -0.7, 1.4, -1.4, 2.1, -2.1)
 LIFTS = (0.0, 0.3, 0.6, 0.9)
 YAW_COST, LIFT_COST = 0.12, 0.15
+#: a view pulled in to this share of the full distance loses nothing for it: the plain
+#: chase view closer in, looking ahead over the hull, beats swinging up (at the spawn
+#: points by a wall the highest swing looked straight down on the hull from 17 m)
+ROOM_ENOUGH = 0.4
 #: the swings are searched at most this often [s] (a few dozen segment queries)
 SEARCH_S = 0.1
+#: swung all the way up (a wall right behind, as at many spawn points) the camera still
+#: looks this share of the way ahead: looking straight down at the hull, the view showed
+#: only ground, and beyond the wall behind the void outside the arena
+LOOK_LIFTED = 0.45
 
 
 def arena_mesh(model: Any) -> Any:
@@ -146,7 +154,7 @@ class Camera:
             for yaw in YAWS:
                 for lift in LIFTS:
                     room = plain if yaw == lift == 0.0 else free(yaw, lift)[0]
-                    score = room - YAW_COST * abs(yaw) - LIFT_COST * lift
+                    score = min(room / ROOM_ENOUGH, 1.0) - YAW_COST * abs(yaw) - LIFT_COST * lift
                     if score > best[0] + 0.02:
                         best = (score, yaw, lift)
             e.goal = best[1:]
@@ -162,11 +170,11 @@ class Camera:
         k = min(k, e.pull)
         e.pull = k
         eye = self._clear(pivot + k * (want - pivot))
-        # pulled in close or swung high, look at the tank itself rather than ahead of it
+        # pulled in close or swung high, look at the tank itself more than ahead of it
         heading = e.heading + e.yaw
         f = np.array([math.cos(heading), 0.0, math.sin(heading)])
         ahead = p + f * AHEAD * size + np.array([0.0, 1.0, 0.0])
-        w = k * k * max(1.0 - e.lift / LIFTS[-1], 0.0) ** 2 * max(math.cos(e.yaw), 0.0)
+        w = k * k * (LOOK_LIFTED + (1.0 - LOOK_LIFTED) * max(1.0 - e.lift / LIFTS[-1], 0.0) ** 2) * max(math.cos(e.yaw), 0.0)
         return eye, centre + w * (ahead - centre)
 
     def _free(self, pivot: np.ndarray, centre: np.ndarray, bounds: np.ndarray, want: np.ndarray) -> float:
