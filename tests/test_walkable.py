@@ -182,8 +182,30 @@ def test_a_bridge_over_a_passage_gives_two_levels_joined_across_them():
     assert path and path[0] == (lv_pass, *node) and path[-1] == (lv_deck, *node)
     ys = np.array([grid.height[n] for n in path])
     assert (np.abs(np.diff(ys)) <= PARAMS.climb + 1e-9).all()  # every step within the climb
-    # the run numbers are per level: a row run on the deck ends at the deck's end
-    assert grid.row_total[lv_deck][node] <= (46 - 34) / 0.5
+    # the run numbers are per level: a row run on the deck ends where its level ends, the
+    # deck and the plateaus' edges beside it (lifted to the deck's level as far as the
+    # largest clearance and a cell: stack_levels' lift), not across the whole yard
+    lift = (math.ceil(surface.max_clearance / 0.5) + 2) * 0.5
+    assert grid.row_total[lv_deck][node] <= (46 - 34 + 2 * lift) / 0.5
+    # and the passage under the deck has walls at the rock faces, not a run through them
+    assert grid.row_total[lv_pass][node] <= (46 - 34) / 0.5
+
+
+@pytest.mark.parametrize("name", ["stacked_floors", "two_storeys"])
+def test_a_ramp_up_to_a_deck_over_the_ground_reaches_the_deck(name):
+    # the ramp's top ends beside the ground under the deck (its own level, 4-5 m below):
+    # on one level that edge walled the ramp off from the deck for every tank; the top
+    # of the ramp now joins the deck's level, so a tank's grid reaches every deck
+    from tanktool.nav.arena_levels import grid_components, tank_grid
+
+    V, F = mesh_of(name)
+    r = analyse_arena(V, F, PARAMS, TANK)
+    assert len(r.levels) >= 2
+    g = tank_grid(r.surface, r.walls, TANK.radius)
+    labels, _ = grid_components(g)
+    big = np.bincount(labels[labels > 0]).argmax()
+    for lv in range(g.valid.shape[0]):
+        assert (labels[lv] == big).sum() > 1000, (name, lv)
 
 
 def test_a_deck_over_pillars_stays_one_level_and_the_ground_under_it_another():
