@@ -183,10 +183,11 @@ def test_a_bridge_over_a_passage_gives_two_levels_joined_across_them():
     ys = np.array([grid.height[n] for n in path])
     assert (np.abs(np.diff(ys)) <= PARAMS.climb + 1e-9).all()  # every step within the climb
     # the run numbers are per level: a row run on the deck ends where its level ends, the
-    # deck and the plateaus' edges beside it (lifted to the deck's level as far as the
-    # largest clearance and a cell: stack_levels' lift), not across the whole yard
-    lift = (math.ceil(surface.max_clearance / 0.5) + 2) * 0.5
-    assert grid.row_total[lv_deck][node] <= (46 - 34 + 2 * lift) / 0.5
+    # deck and the plateaus' edges beside it (lifted to the deck's level: nav/level_lift.py),
+    # not across the whole yard
+    from tanktool.nav.level_lift import LIFT
+
+    assert grid.row_total[lv_deck][node] <= (46 - 34 + 2 * (LIFT + 0.5)) / 0.5
     # and the passage under the deck has walls at the rock faces, not a run through them
     assert grid.row_total[lv_pass][node] <= (46 - 34) / 0.5
 

@@ -31,6 +31,7 @@ import numpy as np
 from ..errors import ArenaError
 from ..geometry.kernels import active, i64
 from ..geometry.heightfield import OPEN, Heightfield, build_heightfield, column_starts, neighbour_columns
+from .level_lift import lift_steps, lift_to_portals
 
 #: the four link directions as (di, dj) on the grid: +x, +z, -x, -z (navgrid.STEPS order)
 DIRS = ((0, 1), (1, 0), (0, -1), (-1, 0))
@@ -247,7 +248,7 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
     on when that level is free in its column (the deck over a pillar joins the deck
     over the passage instead of standing alone on level 0); last, with ``lift`` > 0,
     the top of a ramp onto a deck over walkable ground joins the deck's level
-    (:func:`_lift_to_portals`)."""
+    (:func:`tanktool.nav.level_lift.lift_to_portals`)."""
     level = np.full(len(col), -1, dtype=np.int64)
     idx = np.flatnonzero(keep)
     if len(idx) == 0:
@@ -301,69 +302,13 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
         active[ok] = True
     level = lv[:-1]
     if lift > 0:
-        _lift_to_portals(col, level, link, lift)
+        lift_to_portals(col, level, link, lift)
     # levels numbered from 0 without gaps, in order of height
     used = np.flatnonzero(np.bincount(level[idx]))  # small counts: no hashing sort
     remap = np.full(int(used.max()) + 1, -1)
     remap[used] = np.arange(len(used))
     level[idx] = remap[level[idx]]
     return level
-
-
-def _lift_to_portals(col: np.ndarray, level: np.ndarray, link: np.ndarray, steps: int) -> None:
-    """Move, in place, the spans near a *ledged portal* to the level across it.
-
-    A ramp coming up to a deck that stands on pillars over walkable ground ends beside
-    the ground under the deck: its top cells link to the deck (another level) across
-    an edge where a cell of their own level (the ground, 4 m below) lies unlinked.  On
-    one level, that edge is a wall for the ground and so for the ramp too: the ramp's
-    top would be cut off from the deck by a clearance's width, and no tank reaches the
-    deck (stacked_floors, two_storeys).  So the spans within ``steps`` links of such an
-    edge, along links on their own level, join the deck's level where it is free in
-    their column: the seam moves down the ramp, away from the ground's wall, to a
-    portal between the ramp's two levels."""
-    kept = np.flatnonzero(level >= 0)
-    if len(kept) == 0:
-        return
-    L = int(level.max()) + 1
-    keys = np.sort(col[kept] * L + level[kept])  # (column, level) pairs that hold a span
-
-    def held(c: np.ndarray, lv: np.ndarray) -> np.ndarray:
-        k = c * L + lv
-        at = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
-        return keys[at] == k
-
-    target = np.full(len(level), -1, dtype=np.int64)
-    away = np.full(len(level), -1, dtype=np.int64)  # the direction back down the ramp
-    for d in range(4):
-        nb = link[kept, d].astype(np.int64)
-        s, t = kept[nb >= 0], nb[nb >= 0]
-        cross = level[t] != level[s]
-        s, t = s[cross], t[cross]
-        # the neighbour column holds a span of s's own level that s does not link to
-        ledged = held(col[t], level[s]) & ~held(col[s], level[t])
-        target[s[ledged]] = level[t[ledged]]
-        away[s[ledged]] = (d + 2) % 4
-    # straight back from the edge (a band as wide as the edge, its seam a straight
-    # portal: a diagonal seam's simplified outline would read partly as a wall)
-    front = np.flatnonzero(target >= 0)
-    for _ in range(steps):
-        u = link[front, away[front]].astype(np.int64)
-        ok = u >= 0
-        f, u = front[ok], u[ok]
-        ok = (level[u] == level[f]) & (target[u] < 0) & ~held(col[u], target[f])
-        target[u[ok]], away[u[ok]] = target[f[ok]], away[f[ok]]
-        front = u[ok]
-        if len(front) == 0:
-            break
-    moved = np.flatnonzero(target >= 0)
-    if len(moved) == 0:
-        return
-    # two spans of one column sent to the same level (not met in practice): neither moves
-    k = col[moved] * L + target[moved]
-    _, inv, cnt = np.unique(k, return_inverse=True, return_counts=True)
-    moved = moved[cnt[inv] == 1]
-    level[moved] = target[moved]
 
 
 def _level_taken(c: np.ndarray, col_rank: np.ndarray, lv: np.ndarray, cand: np.ndarray, new: np.ndarray,
@@ -456,9 +401,7 @@ def build_surface(hf: Heightfield, headroom: float, climb: float, max_clearance:
     clearance = _clearance(link, max_clearance, hf.cs) if distance else None
     region = components(link) if len(col) else np.zeros(0, dtype=np.int64)
     main = _main_region(hf, col, floor, region, seeds)
-    # the top of a ramp onto a deck over the ground joins the deck's level as far as the
-    # largest clearance (and a cell): past it, the ground's wall does not reach the ramp
-    level = stack_levels(col, main, link, lift=int(math.ceil(max_clearance / hf.cs)) + 1)
+    level = stack_levels(col, main, link, lift=lift_steps(hf.cs))
     return Surface(hf, col, floor, ceil, link, clearance, region, main, level, float(max_clearance),
                    {"climb_steps": clim, "headroom_steps": head})
 
@@ -492,7 +435,7 @@ def reseed(surface: Surface, max_clearance: float, seeds: np.ndarray | None = No
     else:
         clearance = _clearance(surface.link, max_clearance, hf.cs)
     main = _main_region(hf, surface.col, surface.floor, surface.region, seeds)
-    level = stack_levels(surface.col, main, surface.link)
+    level = stack_levels(surface.col, main, surface.link, lift=lift_steps(hf.cs))
     return Surface(hf, surface.col, surface.floor, surface.ceil, surface.link, clearance, surface.region, main,
                    level, float(max_clearance), dict(surface.stats), surface.height)
 
