@@ -240,7 +240,7 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
     import numpy as np
 
     from .nav.arena_levels import walls_too_close
-    from .nav.walkable import grid_from_surface, reseed, surface_layers, walkable_surface
+    from .nav.walkable import grid_from_surface, level_nodes, reseed, walkable_surface
 
     origin = np.asarray(bounds, dtype=np.float64)[0]
     seeds = None
@@ -260,8 +260,7 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
     levels = max(surface.levels, 1)
     tc = walls_too_close(target.walls, origin, params.cell, shape, levels, clearance)
     grid = grid_from_surface(surface, clearance, origin, seeds=target.spawns, too_close=tc)
-    exists = surface_layers(surface, clearance=False)[0]
-    return grid, (exists[0] if grid.levels == 1 else None), surface
+    return grid, (level_nodes(surface) if grid.levels == 1 else None), surface
 
 
 

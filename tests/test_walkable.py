@@ -389,3 +389,6 @@ def test_heights_and_layers_built_in_blocks_are_the_same(monkeypatch):
     assert g_blocks.to_bytes() == g_whole.to_bytes()
     for a, b in zip(walkable.surface_layers(blocks), walkable.surface_layers(whole)):
         assert np.array_equal(a, b, equal_nan=True)
+    exists = walkable.surface_layers(whole)[0]
+    for level in range(len(exists)):
+        assert np.array_equal(walkable.level_nodes(blocks, level), exists[level])

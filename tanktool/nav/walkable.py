@@ -505,6 +505,16 @@ def surface_layers(surface: Surface, clearance: bool = True) -> tuple[np.ndarray
     return exists.reshape(shape), height.reshape(shape), clear, span.reshape(shape)
 
 
+def level_nodes(surface: Surface, level: int = 0) -> np.ndarray:
+    """``(nz, nx)`` mask of the nodes of one level: ``surface_layers(surface)[0][level]``
+    without the layers' heights and span indices (13 bytes a node of every level)."""
+    nz, nx = surface.shape
+    out = np.zeros(nz * nx, dtype=bool)
+    for a in range(0, len(surface.level), BLOCK):
+        out[surface.col[a:a + BLOCK][surface.level[a:a + BLOCK] == level]] = True
+    return out.reshape(nz, nx)
+
+
 def _grid_links(surface: Surface, exists: np.ndarray, span: np.ndarray) -> np.ndarray:
     """(L * nz * nx, 4) int8: the level each node's span links to in each direction
     when that span is a node too, else -1 (flat indices throughout)."""
