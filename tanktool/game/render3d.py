@@ -197,7 +197,8 @@ class Renderer3D:
 
     def _split_arena(self) -> Model:
         if self._split is None:
-            self._split = self.arena_model.tessellated(max(ARENA_EDGE, self.span / 10.0))
+            split = self.arena_model.tessellated(max(ARENA_EDGE, self.span / 10.0))
+            self._split = Model([Batch(occluders_first(b.vertices), b.image, b.closed) for b in split.batches])
         return self._split
 
     def _gpu(self, model: Model, prog: Any) -> list[GpuBatch]:
@@ -506,6 +507,22 @@ class Renderer3D:
     def release(self) -> None:
         if self.own_ctx:
             self.ctx.release()
+
+
+def occluders_first(vertices: np.ndarray) -> np.ndarray:
+    """A batch's triangles (rows of 3 vertices) reordered for a camera above the floor:
+    walls first, then what faces up from the highest down, the lowest floor last.  The
+    software rasteriser shades a pixel only when it is nearer than what is already drawn,
+    so a floor drawn before the wall or roof in front of it is shaded for nothing (a
+    third of the fort's arena pixels were)."""
+    if len(vertices) < 6:
+        return vertices
+    tri = vertices[:, :3].reshape(-1, 3, 3).astype(np.float64)
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    up = n[:, 1] / np.maximum(np.linalg.norm(n, axis=1), 1e-12)
+    wall = np.abs(up) < 0.7
+    order = np.lexsort((-tri[:, :, 1].max(axis=1), ~wall))        # walls, then by height, highest first
+    return vertices.reshape(-1, 3, vertices.shape[1])[order].reshape(vertices.shape)
 
 
 def standalone_context() -> Any:
