@@ -392,3 +392,28 @@ def test_heights_and_layers_built_in_blocks_are_the_same(monkeypatch):
     exists = walkable.surface_layers(whole)[0]
     for level in range(len(exists)):
         assert np.array_equal(walkable.level_nodes(blocks, level), exists[level])
+
+
+def test_flat_heights_in_blocks_of_faces_are_the_same(monkeypatch):
+    from tanktool.geometry import heightfield
+    from tanktool.geometry.heightfield import flat_heights
+
+    V, F = mesh_of("two_storeys")
+    whole = flat_heights(V, F)
+    assert len(whole[0]) >= 2
+    monkeypatch.setattr(heightfield, "FACE_BLOCK", 5)
+    for a, b in zip(flat_heights(V, F), whole):
+        assert np.array_equal(a, b)
+
+
+def test_the_walls_exact_cuts_in_blocks_of_faces_are_the_same(monkeypatch):
+    from tanktool.nav import level_walls as lw_mod
+
+    V, F = mesh_of("two_storeys")
+    whole = lw_mod.ExactCuts(V, F, 1.0, PARAMS.headroom, 0.01, 0.999, PARAMS.climb)
+    monkeypatch.setattr(lw_mod, "FACE_BLOCK", 7)
+    blocks = lw_mod.ExactCuts(V, F, 1.0, PARAMS.headroom, 0.01, 0.999, PARAMS.climb)
+    for k in ("up", "up_height", "low", "cut_faces"):
+        a, b = getattr(blocks, k), getattr(whole, k)
+        assert a.dtype == b.dtype and np.array_equal(a, b), k
+    assert len(whole.up) > 0

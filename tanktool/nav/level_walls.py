@@ -40,7 +40,7 @@ from ..geometry import contours, slivers
 from ..geometry import cross_section as xs
 from ..geometry import walls as cut
 from ..geometry.wall_pairs import Repairs, pair_tolerance, repair_walls
-from ..geometry.heightfield import FLAT_GAP, flat_heights
+from ..geometry.heightfield import FACE_BLOCK, FLAT_GAP, flat_heights
 from .inner_walls import inner_walls
 from .walkable import DIRS, Surface, surface_layers
 
@@ -136,18 +136,26 @@ class ExactCuts:
         top = headroom - 0.05
         self.steps = [cut_height] + ([(cut_height + top) / 2] if top - cut_height > 0.6 else []) + \
             ([top] if top > cut_height else [])
-        up, self.up_height, _, _ = cut._upward_faces(vertices, faces)
-        tri = vertices[faces[up]]
-        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        ny = n[:, 1] / np.maximum(np.linalg.norm(n, axis=1), 1e-300)
-        keep = ny >= min_ny
-        self.up = up[keep]
+        # a block of faces at a time (~190 bytes a face of temporaries, heightfield.flat_heights)
+        ups, heights, lows = [], [], []
+        for b in range(0, len(faces), FACE_BLOCK):
+            fb = faces[b:b + FACE_BLOCK]
+            up, height, _, _ = cut._upward_faces(vertices, fb)
+            tri = vertices[fb[up]]
+            n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+            ny = n[:, 1] / np.maximum(np.linalg.norm(n, axis=1), 1e-300)
+            keep = ny >= min_ny
+            ups.append(b + up[keep])
+            heights.append(height)
+            lows.append(tri[keep, :, 1].min(axis=1))
+        self.up = np.concatenate(ups) if ups else np.zeros(0, dtype=np.int64)
+        self.up_height = np.concatenate(heights) if heights else np.zeros(0)
         # the faces a cut may meet: not the walkable slopes (a cut through a hillside or
         # a ramp is a contour line, not a wall: the tank drives up it)
         walk = np.zeros(len(faces), dtype=bool)
         walk[self.up] = True
         self.cut_faces = faces[~walk]
-        self.low = tri[keep, :, 1].min(axis=1)
+        self.low = np.concatenate(lows) if lows else np.zeros(0)
         self.cache: dict[float, tuple] = {}
 
     def at(self, h: float, box: tuple[float, float, float, float], base: float | None = None):
