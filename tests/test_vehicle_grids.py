@@ -180,3 +180,24 @@ def test_too_few_spawns_for_the_largest_vehicle_names_the_smaller_ones_own(tmp_p
                 {"light": {"clearance": 3.2, "spawns": [[0.0, 0.0, 0.0, 0.0]] * 7}})
     assert said == [f"{tmp_path / 'm.obj'}: room for only 2 spawn point(s) where the largest bundled tank that "
                     f"fits (heavy) fits, at least 8.4 m apart; light has 7 of its own"]
+
+
+def test_stacked_decks_are_the_light_tanks_and_get_spawns_of_their_own(tmp_path):
+    # a car park: deck 1 on pillars over the ground floor, reached by a ramp that ends
+    # beside the ground under it (nav/level_lift.py), deck 2 up a second ramp; the heavy
+    # tank fits neither ramp's entry, the light one reaches all three levels and, with
+    # the levels spread apart (arena_levels.LEVEL_SPREAD), starts on the decks too
+    folder = import_level(tmp_path, "stacked_floors")
+    light = NavGrid.load(folder / "navgrid.light.npz")
+    assert light.levels == 3
+    for lv in range(3):
+        assert (light.valid[lv] & light.reachable[lv]).sum() > 1000, lv
+    ys = np.array(read_toml(folder / "arena.toml")["grids"]["light"]["spawns"])[:, 3]
+    assert (ys > 3.5).sum() >= 2 and (ys > 7.5).sum() >= 1
+    r = CliRunner().invoke(cli, ["check", str(folder)])
+    assert "0 errors" in r.output, r.output
+
+
+def test_the_forts_roof_has_a_spawn_point():
+    info = load_match_arena("fort")
+    assert (info.spawns[:, 3] > 4.5).sum() >= 1 and (info.spawns[:4, 3] == 0.0).all()

@@ -126,6 +126,11 @@ def grid_components(grid: NavGrid) -> tuple[np.ndarray, int]:
 #: spawn points prefer ground no steeper than this (degrees), and no rougher than half
 #: the climb around the plane under the tank's footprint
 SPAWN_SLOPE = 10.0
+#: in spreading the spawn points, one on another level counts as this much farther (m)
+#: from one below it than their distance across: a deck over a passage or a roof gets
+#: spawns of its own, where seen from above it lies among the ground's (fort's roof,
+#: stacked_floors' decks had none, and no tank went up in a match)
+LEVEL_SPREAD = 30.0
 
 
 def ground_under(height: np.ndarray, node: tuple[int, int, int], cell: float, radius: float) -> tuple[float, float]:
@@ -218,9 +223,12 @@ def choose_spawns(lw: LevelWalls, grid: NavGrid, fleet: Fleet, bounds: np.ndarra
                                     fleet.radius)
         return slope <= SPAWN_SLOPE and rough <= 0.5 * climb
 
-    idx = spread(pts, count, fleet.length, start, accept=level_ground)
+    # the level as a third coordinate (all 0 on one level: the same spawns as on the plane)
+    at = np.column_stack([pts, level * LEVEL_SPREAD])
+    start = np.append(start, 0.0)
+    idx = spread(at, count, fleet.length, start, accept=level_ground)
     if len(idx) < min(count, 2):  # no level ground enough: the best there is
-        idx = spread(pts, count, fleet.length, start)
+        idx = spread(at, count, fleet.length, start)
     p = pts[idx]
     return np.column_stack([p, facing_centre(p, bounds), ys[idx]])
 
