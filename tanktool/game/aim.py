@@ -14,6 +14,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 #: how far the crosshair looks along the barrel when no wall is in the way [m]
 SIGHT = 150.0
 #: samples along the flight when looking for tanks on the way
@@ -72,21 +74,24 @@ def predict(world: Any, tank: Any, floor_y: float = 0.0) -> Aim:
     def at(t: float) -> tuple[float, float, float]:
         return x0 + s.vx * t, y0 + s.vy * t - 0.5 * g * t * t, z0 + s.vz * t
 
+    # the flight at SAMPLES times against every other live tank's cylinder, all at once
+    others = [o for o in world.tanks if o.index != tank.index and o.alive]
     target = None
-    steps = max(int(SAMPLES), 2)
-    for k in range(1, steps + 1):
-        t = t_end * k / steps
-        px, py, pz = at(t)
-        for other in world.tanks:
-            if other.index == tank.index or not other.alive:
-                continue
-            oy = float(getattr(other, "y", floor_y))
-            if (px - other.x) ** 2 + (pz - other.z) ** 2 < other.spec.radius ** 2 and oy <= py <= oy + other.spec.height:
-                target = other.index
-                t_end = t
-                break
-        if target is not None:
-            break
+    if others:
+        ts = t_end * np.arange(1, max(int(SAMPLES), 2) + 1) / max(int(SAMPLES), 2)
+        px, py, pz = x0 + s.vx * ts, y0 + s.vy * ts - 0.5 * g * ts * ts, z0 + s.vz * ts
+        ox = np.array([o.x for o in others])
+        oz = np.array([o.z for o in others])
+        oy = np.array([float(getattr(o, "y", floor_y)) for o in others])
+        r2 = np.array([o.spec.radius ** 2 for o in others])
+        top = oy + np.array([o.spec.height for o in others])
+        inside = (((px[:, None] - ox) ** 2 + (pz[:, None] - oz) ** 2 < r2)
+                  & (oy <= py[:, None]) & (py[:, None] <= top))                  # (samples, tanks)
+        hit = np.flatnonzero(inside.any(axis=1))
+        if len(hit):
+            k = int(hit[0])
+            target = others[int(np.flatnonzero(inside[k])[0])].index
+            t_end = float(ts[k])
     return Aim((x0, y0, z0), aim, at(t_end), target, t_end)
 
 
