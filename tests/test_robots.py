@@ -212,6 +212,23 @@ def test_the_novice_reacts_late_aims_badly_and_does_not_lead():
     assert shots >= 4 and novice < 0.5 <= hard
 
 
+def test_the_novice_heads_for_the_enemy_on_the_minimap():
+    """Seeing nothing, it drives towards the nearest enemy the window's minimap shows
+    (the radar), along the maze's paths: corner to corner it comes into sight."""
+    w = _maze_world()
+    w.tanks[0].place(5.65, 5.65, 0.785)
+    w.tanks[1].place(98.26, 98.26, -2.356)
+    novice = driver(Novice(), 1)
+    seen = None
+    for _ in range(int(90.0 / w.dt)):
+        me, other = w.tanks
+        w.step(None, [novice(w, me), IDLE])
+        if not w.walls.blocked(me.x, me.z, other.x, other.z):
+            seen = w.t
+            break
+    assert seen is not None
+
+
 def test_yardsticks_are_drivers_with_their_own_seeded_generators():
     for name, make in YARDSTICKS.items():
         a, b = _maze_world(), _maze_world()

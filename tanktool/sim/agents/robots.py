@@ -18,8 +18,10 @@ opponents held back to judge the agents, not copies), to measure the agents agai
   holds 25-40 m, aims at the exact intercept and fires only under 0.35 m of predicted
   miss.
 * :class:`Novice` -- a stand-in for a first-time player: reaction 0.4 s, a 5 degree
-  aim error, no lead, drives straight at what it sees, and roams like the scripted
-  baseline (``sim.driver.ScriptedDriver``) when it sees nothing.
+  aim error, no lead, drives straight at what it sees, and when it sees nothing heads
+  for the nearest enemy on the minimap (the window shows every tank there) along the
+  map's paths, roaming like the scripted baseline (``sim.driver.ScriptedDriver``)
+  without one.
 
 They drive with the agents' pilot (``driving.Pilot``: speed control and wall feelers,
 so a yardstick does not lose by bumping into walls); their randomness is the view's
@@ -269,12 +271,14 @@ class Duellist(Yardstick):
 
 
 class Novice(Yardstick):
-    """A first-time player (see the module docstring): the scripted baseline's roaming
-    (``sim.driver.Roam``), and for what it sees, reaction 0.4 s, 5 degrees of aim error
-    (drawn anew after each shot), no lead, full speed straight at it."""
+    """A first-time player (see the module docstring): off towards the nearest enemy on
+    the minimap (the radar) or the scripted baseline's roaming (``sim.driver.Roam``), and
+    for what it sees, reaction 0.4 s, 5 degrees of aim error (drawn anew after each
+    shot), no lead, full speed straight at it."""
 
     think_hz = 10.0
-    senses = Senses(vision_range=100.0)
+    #: the window's minimap shows every tank: the radar stands for a glance at it
+    senses = Senses(vision_range=100.0, radar=True)
 
     def __init__(self, reaction: float = 0.4, aim_error: float = math.radians(5.0)) -> None:
         super().__init__()
@@ -295,6 +299,8 @@ class Novice(Yardstick):
         elif target.index != self.seen:
             self.seen, self.seen_at = target.index, t + self.reaction
         if target is None or t < self.seen_at:
+            if view.radar:             # the dots on the minimap: off towards the nearest enemy
+                return self.unstick(view, self.pursue(view, view.radar[0]))
             m = view.map
             return self.roam.command(t, me, me.vehicle.radius, m.walls_of(me.level), m.spawns, m.bounds, view.rng)
         err = wrap(math.atan2(target.z - me.z, target.x - me.x) + self.aim_error - me.heading)
