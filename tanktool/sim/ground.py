@@ -31,6 +31,8 @@ from typing import Any
 
 import numpy as np
 
+from .lazy_rows import heights_row, lazy_levels, plain_row
+
 #: a node is "level ground" when every node this many cells around it has its height
 FLAT_CELLS = 10
 #: steps across the grid: +x, +z, -x, -z as (di, dj), the navgrid's link order
@@ -349,12 +351,12 @@ class Ground:
         self.mesh = mesh
         self._solids: SolidField | None = None
         self.exists = np.isfinite(h)
-        # plain nested lists: the per-tank lookups below are scalar Python
-        self._h = [[[None if not math.isfinite(v) else float(v) for v in row] for row in lv] for lv in h.tolist()]
-        self._link = self.link.tolist()
+        # plain nested lists: the per-tank lookups below are scalar Python (rows made on first use)
+        self._h = lazy_levels(h, heights_row)
+        self._link = lazy_levels(self.link, plain_row)
         # nodes whose whole neighbourhood (FLAT_CELLS around) has their own height:
         # a tank standing there is level, no sampling needed (most of a fort's floor)
-        self._flat = self._level_ground(h).tolist()
+        self._flat = lazy_levels(self._level_ground(h), plain_row)
 
     @property
     def solids(self) -> SolidField | None:
