@@ -417,3 +417,23 @@ def test_the_walls_exact_cuts_in_blocks_of_faces_are_the_same(monkeypatch):
         a, b = getattr(blocks, k), getattr(whole, k)
         assert a.dtype == b.dtype and np.array_equal(a, b), k
     assert len(whole.up) > 0
+
+
+def test_the_move_table_made_row_by_row_is_layered_moves_table():
+    from tanktool.nav.path import _LazyMoves, layered_moves
+
+    V, F = mesh_of("bridge")
+    s = walkable_surface(V, F, PARAMS, 1.0)
+    grids = [grid_from_surface(s, 1.0, s.hf.origin[[0, 2]])]
+    rng = np.random.default_rng(5)
+    valid = rng.random((2, 9, 11)) < 0.7
+    link = rng.integers(-1, 2, size=(2, 9, 11, 4)).astype(np.int8)
+    grids.append(NavGrid(np.zeros(2), 1.0, (9, 11), valid, *(np.zeros(valid.shape, np.int32),) * 4,
+                         valid.copy(), 1.0, link=link))
+    for g in grids:
+        table, _ = layered_moves(g)
+        lazy = _LazyMoves(g)
+        lazy.MAX_KEPT = 50                       # dropped and made again on the way
+        for m in list(range(len(table))) + [3, 0, len(table) - 1]:
+            assert lazy[m] == tuple(table[m]), m
+        assert (table >= 0).sum() > 50

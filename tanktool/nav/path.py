@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import heapq
 import math
+from typing import Any
 
 import numpy as np
 
@@ -256,13 +257,61 @@ def layered_moves(grid: NavGrid) -> tuple[np.ndarray, list[tuple[int, int, float
     return target, moves
 
 
-def _move_table(grid: NavGrid) -> tuple[list, list[float]]:
-    """layered_moves as plain lists, made once per grid (kept on it: a grid is not
-    changed once built, and an agent plans on its grid many times)."""
+class _LazyMoves(dict):
+    """``table[m]``: layered_moves' row of node ``m`` as a tuple, worked out from the
+    grid's links on first use and kept.  The whole table as lists took ~300 bytes a
+    node (2.5 GB and a minute on a 2 km terrain's 16 M nodes) where a path visits a
+    few of them; past MAX_KEPT rows the kept ones are dropped (made again if needed)."""
+
+    MAX_KEPT = 1 << 20
+
+    def __init__(self, grid: NavGrid) -> None:
+        from .navgrid import STEPS
+
+        super().__init__()
+        L, nz, nx = grid.valid.shape
+        self.nz, self.nx, self.per = nz, nx, nz * nx
+        # flat views: indexing a memoryview gives Python ints without numpy scalars
+        self.valid = memoryview(np.ascontiguousarray(grid.valid, dtype=np.uint8).reshape(-1))
+        self.link = memoryview(np.ascontiguousarray(grid.links(), dtype=np.int8).reshape(-1))
+        self.steps = list(STEPS.values())  # +x, +z, -x, -z
+
+    def straight(self, m: int, d: int) -> int:
+        """The target of straight move ``d`` from the valid node ``m`` (-1: none)."""
+        lv, r = divmod(m, self.per)
+        i, j = divmod(r, self.nx)
+        t = self.link[4 * m + d]
+        di, dj = self.steps[d]
+        a, b = i + di, j + dj
+        if t < 0 or not (0 <= a < self.nz and 0 <= b < self.nx):
+            return -1
+        n = t * self.per + a * self.nx + b
+        return n if self.valid[n] else -1
+
+    def __missing__(self, m: int) -> tuple:
+        if not self.valid[m]:
+            row = (-1,) * 8
+        else:
+            s = [self.straight(m, d) for d in range(4)]
+            row = list(s)
+            for d, e in ((0, 1), (1, 2), (2, 3), (3, 0)):
+                via_d = self.straight(s[d], e) if s[d] >= 0 else -1
+                via_e = self.straight(s[e], d) if s[e] >= 0 else -1
+                row.append(via_d if via_d >= 0 and via_d == via_e else -1)
+            row = tuple(row)
+        if len(self) >= self.MAX_KEPT:
+            self.clear()
+        self[m] = row
+        return row
+
+
+def _move_table(grid: NavGrid) -> tuple[Any, list[float]]:
+    """layered_moves' table, a row made on first use (_LazyMoves), once per grid (kept
+    on it: a grid is not changed once built, and an agent plans on its grid many times)."""
     cached = grid.__dict__.get("_move_table")
     if cached is None:
-        target, moves = layered_moves(grid)
-        cached = grid.__dict__["_move_table"] = (target.tolist(), [m[2] for m in moves])
+        cost = [1.0] * 4 + [_SQRT2] * 4   # layered_moves' costs: straight, then diagonal
+        cached = grid.__dict__["_move_table"] = (_LazyMoves(grid), cost)
     return cached
 
 
