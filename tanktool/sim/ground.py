@@ -344,7 +344,7 @@ class Ground:
         h = np.asarray(grid.heights(), dtype=np.float64)
         self.h = h                                    # (L, nz, nx), NaN: no node
         self.levels, self.nz, self.nx = h.shape
-        self.link = np.asarray(grid.links(), dtype=np.int64)
+        self.link = np.asarray(grid.links())  # int8 levels (-1: none): an int64 copy took 32 bytes a node
         self.ox, self.oz = float(grid.origin[0]), float(grid.origin[1])
         self.cell = float(grid.cell)
         self.climb = float(climb)
