@@ -1,7 +1,7 @@
 """Issue 25's end-to-end check: generated levels (tools/make_levels.py: a room with a
-platform reached by ramps, a rolling terrain) imported with import-arena alone and
-played with 8 tanks over several seeds keep every tank on the model's surface (within
-0.3 m of a surface under it) and none inside the solid."""
+platform reached by ramps, a rolling terrain, a floor on pillars over another) imported
+with import-arena alone and played with 8 tanks over several seeds keep every tank on
+the model's surface (within 0.3 m of a surface under it) and none inside the solid."""
 
 from __future__ import annotations
 
@@ -28,10 +28,15 @@ def _surface_heights(mesh: trimesh.Trimesh, x: float, z: float) -> np.ndarray:
 
 @pytest.fixture(scope="module")
 def levels(imported_level):
-    return {name: imported_level(name) for name in ("ramps_and_decks", "rolling_terrain")}
+    return {name: imported_level(name) for name in LEVELS}
 
 
-@pytest.mark.parametrize("name", ["ramps_and_decks", "rolling_terrain"])
+#: a room with a platform on a solid block, a terrain, and an upper floor on pillars over
+#: the ground floor, its ramp's top on the upper floor's level (nav/level_lift.py)
+LEVELS = ("ramps_and_decks", "rolling_terrain", "two_storeys")
+
+
+@pytest.mark.parametrize("name", LEVELS)
 def test_imported_and_played_tanks_stay_on_the_surface(levels, name):
     folder = levels[name]
     info = load_match_arena(folder)

@@ -15,7 +15,8 @@ this module does what Recast's compact heightfield does:
   played on is the largest (or the one holding given seed points);
 * the spans of that region are stacked into *levels*: a span's level is the number of
   the region's spans below it in its column (0 on the ground, 1 on a deck over a
-  passage, ...), so that each level holds at most one span a column.
+  passage, ...), so that each level holds at most one span a column; the top of a
+  ramp up to a deck over the ground joins the deck's level (:mod:`.level_lift`).
 
 Everything is numpy over spans; the links are found by pairing each span with the
 spans of its neighbour column.
