@@ -79,6 +79,7 @@ def test_random_span_graphs_give_the_same_links_and_distances(seed):
     for limit in (3, 8, 40):
         with use_kernels(True):
             da = chamfer_clearance(la, limit)
+            assert np.array_equal(chamfer_clearance(la.astype(np.int64), limit), da)   # int64 links alike
         with use_kernels(False):
             db = chamfer_clearance(la, limit)
         assert np.array_equal(da, db), limit

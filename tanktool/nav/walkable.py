@@ -189,6 +189,10 @@ def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
     if n == 0:
         return dist
     kern = active()
+    if kern is not None and link.dtype != np.int32 and n < 2**31 - 1:
+        # int64 links (the agents' surface graph, layers.surface_clearance): an int32 copy
+        # for the kernel, where numpy's relaxation takes ~130 bytes a span of temporaries
+        link = link.astype(np.int32)
     if kern is not None and link.dtype == np.int32:  # sweeps to the same fixed point (tanktool/_kernels.c)
         kern.chamfer(np.ascontiguousarray(link), dist, int(limit))
         return dist
