@@ -201,13 +201,16 @@ class SolidField:
         first[1:] = col[1:] != col[:-1]
         smin = np.where(first, 0, smin)            # under the ground is solid
         smax = np.minimum(np.maximum(smax, smin + 1), ny)
-        cnt = smax - smin
-        owner = np.repeat(np.arange(len(col)), cnt)
-        k = smin[owner] + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-        solid = np.zeros(nz * nx * ny, dtype=bool)
-        solid[col[owner] * ny + k] = True
-        self.solid = solid
-        self._bytes = solid.tobytes()     # the scalar walk indexes bytes: no numpy per sample
+        # voxels [smin, smax) of each span: +1 at a span's bottom, -1 past its top, summed
+        # up the columns (merged spans do not overlap: 0 or 1); the voxels' indices
+        # took 16 bytes a solid voxel (+1.4 GB on a 2 km terrain)
+        delta = np.zeros(nz * nx * ny + 1, dtype=np.int8)
+        np.add.at(delta, col * ny + smin, 1)
+        np.add.at(delta, col * ny + smax, -1)
+        np.cumsum(delta, dtype=np.int8, out=delta)
+        self._bytes = (delta[:-1] > 0).tobytes()   # the scalar walk indexes bytes: no numpy per sample
+        del delta
+        self.solid = solid = np.frombuffer(self._bytes, dtype=bool)   # the same memory, read-only
         # the highest solid of each block of BLOCK x BLOCK columns (world y; -inf: none)
         B = self.BLOCK
         bz, bx = -(-nz // B), -(-nx // B)
