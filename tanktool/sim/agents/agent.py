@@ -27,6 +27,7 @@ import math
 from typing import TYPE_CHECKING, Any
 
 from ..bots import IDLE, Command
+from ..rules import GRAVITY
 from .combat import CAMP_MEMORY, CAMP_SPEED, OUTGUNNED, WAIT_COOLDOWN, WAIT_NEAR, Attack, Evade, Hunt, LieInWait, ReturnFire
 from .difficulty import DIFFICULTIES, Difficulty, difficulty
 from .dodge import Evasion
@@ -46,6 +47,19 @@ _ALL = ("wander", "watch", "ambush", "search", "attack", "evade", "hunt", "retur
 STATES = _ALL
 _ROAM = ("wander", "watch")
 
+
+#: the steepest link of its grid on relief, as a share of the steepest slope its engine
+#: holds it on (the light tank's 0.31: 17 degrees; the hills' slopes are 10)
+GRADE = 0.8
+#: free moves on relief look this far ahead [m] beyond the footprint radius, plus the
+#: way covered in EDGE_TIME s [s], for a place off the grid EDGE_RISE m [m] above or
+#: below
+EDGE_AHEAD = 1.0
+EDGE_TIME = 0.5
+EDGE_RISE = 0.5
+#: ... looked at every EDGE_STEP m up to EDGE_MAX m [m]
+EDGE_STEP = 1.5
+EDGE_MAX = 14.0
 
 #: a noise heard within NEAR m is turned to, at most once in FACED s [m, s]
 NEAR = 30.0
@@ -97,7 +111,13 @@ class Nav:
 
     def __init__(self, view: "View", rng: Any, cell: float, margin: float, half_angle: float,
                  vision_range: float) -> None:
-        self.grid: "NavGrid" = view.map.grid_for(cell, view.me.vehicle.radius + margin)
+        from .navigation import agent_grid
+
+        v = view.me.vehicle
+        # on relief, no link steeper than the vehicle climbs at a useful speed
+        self.grade = GRADE * v.engine_force / (v.mass * GRAVITY)
+        self.grid: "NavGrid" = agent_grid(view.map, cell, v.radius + margin, self.grade)
+        self.plain: "NavGrid" = agent_grid(view.map, cell, v.radius + margin)
         self.regions = Memory(self.grid, region=16.0)
         self.wanderer = Wanderer(self.grid, self.regions, rng)
         self.views: Views = view.map.sight_table(self.grid)
@@ -144,9 +164,54 @@ class Agent(Pilot):
         self.machine = StateMachine({s.name: s for s in states}, TRANSITIONS, GUARDS, "wander",
                                     on_change=Agent._clear_way)
 
+    #: stuck: less than this far in a second [m] (the light tank climbs a 17 degree
+    #: slope at about 0.4 m/s: not stuck)
+    STUCK_MOVE = 0.25
+
     @property
     def state(self) -> str:
         return self.machine.name
+
+    def _trap(self, view: "View", x: float, z: float, here: float, r: float) -> bool:
+        """Whether (x, z), ``r`` m off, is off our grid and on a slope too steep (cut
+        from it: valid on the plain grid) or more than ``EDGE_RISE`` m above or below
+        ``here`` beyond the slope we climb (a drop)."""
+        nav = self.nav
+        node = nav.grid.node_of(x, z)  # type: ignore[union-attr]
+        if nav.grid.is_valid(node):  # type: ignore[union-attr]
+            return False
+        if nav.plain.layers is not None and nav.plain.is_valid(node):  # type: ignore[union-attr]
+            return True
+        g = view.map.ground
+        return abs(g.height(x, z, view.me.level) - here) > EDGE_RISE + nav.grade * r  # type: ignore[union-attr]
+
+    def drive(self, view: "View", forward: float, lateral: float, rotate: float, fire: bool = False) -> Command:
+        """``Pilot.drive``; on relief, not towards an edge: a wanted forward or sideways
+        speed whose way ahead (footprint radius + ``EDGE_AHEAD`` m + ``EDGE_TIME`` s of
+        it + the way to stop from it) ends off its grid, on a slope steeper than it climbs (cut from its grid) or
+        more than ``EDGE_RISE`` m above or below here beyond the slope it climbs (a drop;
+        not the hills' 10 degrees: holding those back lost half the duels there), is
+        not driven.  The world keeps a tank's centre on the surface, so one driven at a
+        plateau's edge hangs over it, its hull (and gun) pitched 40 degrees; one backed
+        down a ramp too steep stays down."""
+        if view.map.relief and self.nav is not None:
+            me = view.me
+            here = view.map.ground.height(me.x, me.z, me.level)
+            brake = 0.6 * me.vehicle.engine_force / me.vehicle.mass
+            for k, (speed, c, s) in enumerate(((forward, me.c, me.s), (lateral, -me.s, me.c))):
+                if abs(speed) < 0.3:
+                    continue
+                # as far as it takes to stop from the speed it has that way, or wants
+                v = max(abs(speed), math.copysign(1.0, speed) * (me.vx * c + me.vz * s))
+                reach = min(me.vehicle.radius + EDGE_AHEAD + v * EDGE_TIME + v * v / (2.0 * brake), EDGE_MAX)
+                r = me.vehicle.radius
+                while r < reach:
+                    r = min(r + EDGE_STEP, reach)
+                    if self._trap(view, me.x + c * math.copysign(r, speed), me.z + s * math.copysign(r, speed),
+                                  here, r):
+                        forward, lateral = (0.0, lateral) if k == 0 else (forward, 0.0)
+                        break
+        return super().drive(view, forward, lateral, rotate, fire)
 
     # ------------------------------------------------------------------ the bot
     def act(self, view: "View") -> Command:
@@ -168,7 +233,9 @@ class Agent(Pilot):
         nav.coverage.look(me.x, me.z, me.heading, view.t, me.y)  # type: ignore[union-attr]
         p = self.memory.digest(view, self.level)
         cmd = self.machine.think(self, view, p, lambda: self.drive(view, 0.0, 0.0, 0.0))
-        return cmd if self.state == "attack" else self.unstick(view, cmd)
+        # fighting too: wedged on a ramp's side (37 degrees of pitch, the gen-bridge),
+        # hard pushed forward and sideways at 0.1 m/s for the rest of a duel, 0-0
+        return self.unstick(view, cmd, strafe=self.state == "attack")
 
     def evade_shells(self, view: "View", cmd: Command) -> Command:
         """Dodge a shell seen flying at it (``dodge.Evasion``: noticed after the level's

@@ -69,6 +69,13 @@ EVADE_COOLDOWN = 8.0
 OUTGUNNED = 1.5
 #: on relief, the place to shoot from is looked for again after this long [s]
 SPOT_AGAIN = 1.0
+#: fighting with the gun loaded and no shot fired for this long (and no place to shoot
+#: from on relief to drive to), it closes in along the A* way to the enemy, the gun on
+#: it (two tanks at 40 m on different heights, neither shot carrying, stared at each
+#: other for 100 s: 0-0; after 4 s it cost kills against the camper on the hills) [s];
+#: the way is planned again every CLOSE_REPLAN s
+QUIET = 6.0
+CLOSE_REPLAN = 1.0
 #: a shot on relief may pass this far over or under the enemy's body [m] (its
 #: sphere tree is rounder than the box the test assumes)
 HEIGHT_TOLERANCE = 0.25
@@ -92,10 +99,15 @@ class Attack(State["Agent"]):
         self.spot: tuple[float, float] | None = None      # where to shoot from on relief
         self.spot_at = -math.inf
         self.blind_since: float | None = None
+        self.quiet_since = 0.0
+        self.way: list[tuple[float, float]] = []
+        self.way_at = -math.inf
 
     def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
         self.spot, self.spot_at = None, -math.inf
         self.blind_since: float | None = None     # on relief: since when no shot carries from here
+        self.quiet_since = view.t                 # since when loaded and not firing
+        self.way, self.way_at = [], -math.inf
 
     def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
         """Turn onto the intercept point, fire when the shot would hit, hold the level's
@@ -109,11 +121,17 @@ class Attack(State["Agent"]):
         lv, me = agent.level, view.me
         rotate, fire, err = aim_and_fire(agent, view, s)
         top = me.vehicle.top_speed
+        if fire or me.reload > agent.period:
+            self.quiet_since = view.t
         spot = self.firing_spot(agent, view, s) if lv.relief and view.map.relief else None
         if spot is None:
             self.blind_since = None
         elif self.blind_since is None:
             self.blind_since = view.t
+        if spot is None and view.t - self.quiet_since > QUIET:
+            cmd = self.close_in(agent, view, s)
+            if cmd is not None:
+                return Command(cmd.advance, rotate, cmd.strafe, fire)
         if spot is not None:
             # through it, not to a stop on it: a tank standing still is the easiest shot
             ux, uz = spot[0] - me.x, spot[1] - me.z
@@ -138,13 +156,28 @@ class Attack(State["Agent"]):
         lateral = side * 0.5 * top * (0.4 + 0.6 * aligned)
         return agent.drive(view, forward, lateral, rotate, fire)
 
+    def close_in(self, agent: "Agent", view: "View", s: Sighting) -> Command | None:
+        """Along the A* way to the enemy with the gun on it (planned again every
+        ``CLOSE_REPLAN`` s); None when there is no way or it is within 12 m."""
+        me = view.me
+        if math.hypot(s.x - me.x, s.z - me.z) < 12.0:
+            return None
+        if view.t - self.way_at >= CLOSE_REPLAN:
+            self.way = view.map.path((me.x, me.z, me.y), (s.x, s.z, s.y), agent.nav.grid)  # type: ignore[union-attr]
+            self.way_at = view.t
+        trim(self.way, me.x, me.z)
+        if not self.way:
+            return None
+        return agent.approach(view, self.way, (s.x, s.z), 0.7 * me.vehicle.top_speed)
+
     def firing_spot(self, agent: "Agent", view: "View", s: Sighting) -> tuple[float, float] | None:
         """None while a shot from here would pass through the enemy's height; else the
         place to shoot from (``relief.firing_spot``, looked for again every
         ``SPOT_AGAIN`` s or when reached)."""
         me = view.me
         ev = s.vehicle if s.vehicle is not None else me.vehicle
-        if relief.miss_from(view, me.x, me.z, me.eye, me.pitch, s, ev) < relief.TOLERANCE:
+        if relief.miss_from(view, me.x, me.z, me.eye, me.pitch, s, ev) < relief.TOLERANCE and \
+                relief.shell_clear(view, me.x, me.z, me.eye, me.pitch, s):
             self.spot = None
             return None
         near = self.spot is not None and math.hypot(self.spot[0] - me.x, self.spot[1] - me.z) < 1.0

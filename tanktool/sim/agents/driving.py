@@ -31,6 +31,9 @@ class Pilot:
     ``unstick`` draws from ``view.rng``).  Subclasses say whether they are on a path
     (``_on_path``) and drop their plans when stuck (``_replan``)."""
 
+    #: stuck: pushing and moved less than this in a second [m]
+    STUCK_MOVE = 0.5
+
     def __init__(self) -> None:
         self.progress_at = (0.0, math.nan, math.nan)
         self.reverse_until = -math.inf
@@ -176,9 +179,10 @@ class Pilot:
     def back_off(self) -> Command:
         return Command(advance=-0.3, rotate=self.reverse_turn)
 
-    def unstick(self, view: "View", cmd: Command) -> Command:
+    def unstick(self, view: "View", cmd: Command, strafe: bool = False) -> Command:
         """Pushing (or held still on a path) but not moving for a second: reverse and
-        turn for 0.8 s, then replan."""
+        turn for 0.8 s, then replan.  ``strafe``: a hard sideways push counts as
+        pushing too (a fight's moves are mostly sideways)."""
         tank = view.me
         t = view.t
         if t < self.reverse_until:
@@ -188,9 +192,9 @@ class Pilot:
         t0, x0, z0 = self.progress_at
         # pushing, or on a path and neither driving nor turning (a wall feeler holding
         # it still, facing the next waypoint past a corner)
-        pushing = abs(cmd.advance) >= 0.3 or (self._on_path() and abs(cmd.rotate) < 0.1
-                                               and abs(tank.omega) < 0.1)
-        if not pushing or not math.isfinite(x0) or math.hypot(tank.x - x0, tank.z - z0) > 0.5:
+        pushing = abs(cmd.advance) >= 0.3 or (strafe and abs(cmd.strafe) >= 0.6) or (
+            self._on_path() and abs(cmd.rotate) < 0.1 and abs(tank.omega) < 0.1)
+        if not pushing or not math.isfinite(x0) or math.hypot(tank.x - x0, tank.z - z0) > self.STUCK_MOVE:
             self.progress_at = (t, tank.x, tank.z)
             return cmd
         if t - t0 > 1.0:

@@ -52,7 +52,7 @@ _GRIDS: "weakref.WeakKeyDictionary[object, dict[tuple[float, float], NavGrid]]" 
 FALLBACK = (0.85, 0.7, 0.55, 0.4, 0.25, 0.0)
 
 
-def agent_grid(world: "World", cell: float, clearance: float) -> NavGrid:
+def agent_grid(world: "World", cell: float, clearance: float, grade: float = math.inf) -> NavGrid:
     """The navigation grid agents of this clearance use in ``world`` (cached per wall
     set, or per ground on an arena with relief or levels: then a projection carrying
     the layered grid as ``.layers``, see ``agents.layers``).
@@ -60,13 +60,15 @@ def agent_grid(world: "World", cell: float, clearance: float) -> NavGrid:
     Where the clearance leaves no valid node by any spawn (an arena barely wider than
     the tank), the grid is made again with less (``FALLBACK``), down to every node off
     the walls: its ``clearance`` says which it kept.  Agents then plan as close to the
-    walls as they must; the physics keeps them out."""
+    walls as they must; the physics keeps them out.  ``grade``: on a ground, links
+    rising or falling more than this per metre are cut (``layers.ground_agent_grid``)."""
     per = _GRIDS.setdefault(world.ground if world.ground.relief else world.walls, {})
-    key = (float(cell), float(clearance))
+    grade = float(grade) if world.ground.relief else math.inf
+    key = (float(cell), float(clearance)) if not math.isfinite(grade) else (float(cell), float(clearance), grade)
     if key not in per:
         grid = None
         for c in (clearance, *(clearance * f for f in FALLBACK)):
-            grid = _make_grid(world, cell, c)
+            grid = _make_grid(world, cell, c, grade)
             if grid.spawn_nodes and grid.valid.any():
                 break
         per[key] = grid
@@ -79,12 +81,12 @@ def strict_grid(world: "World", cell: float, clearance: float) -> NavGrid:
     return _make_grid(world, cell, clearance)
 
 
-def _make_grid(world: "World", cell: float, clearance: float) -> NavGrid:
+def _make_grid(world: "World", cell: float, clearance: float, grade: float = math.inf) -> NavGrid:
     if world.ground.relief:  # a flat ground: the 2002 grid of the walls
         from .layers import ground_agent_grid
 
         spawns = [(x, z, y) for (x, z, _), y in zip(world.spawns, world.spawn_y)]
-        return ground_agent_grid(world.ground, cell, clearance, spawns)
+        return ground_agent_grid(world.ground, cell, clearance, spawns, grade)
     bounds = np.asarray(world.bounds, dtype=np.float64)
     shape = grid_shape(bounds, cell)
     origin = bounds[0].copy()
