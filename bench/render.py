@@ -34,6 +34,13 @@ absolute fps are not those of a quiet machine (the run itself adds about 2: llvm
 renders on both cores).
 
     python bench/render.py [--frames N] [--rounds R] [--size WxH] [--json]
+
+``--window`` measures instead the game window's own loop (game/app.py's frame: events,
+the fixed-step simulation with the agents, particles, HUD, the 3D view at the default
+preset, the buffer swap) on real time as the window runs it, in SDL's offscreen video
+driver (an EGL window drawn by llvmpipe, nothing shown): 8 tanks (yours, standing at its
+spawn, and 7 normal agents), ``--frames`` frames after 30 to warm up: frames a second,
+and the CPU time a frame takes, all threads and the main thread alone.
 """
 
 from __future__ import annotations
@@ -48,7 +55,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+# --window plays the game window's own loop in SDL's offscreen window (EGL, llvmpipe, as a
+# real window draws, nothing shown); everything else needs no window at all
+os.environ.setdefault("SDL_VIDEODRIVER", "offscreen" if "--window" in sys.argv else "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")   # --json prints one JSON object, nothing else
 
@@ -168,6 +177,41 @@ def bench_arena(name: str, frames: int, rounds: int, size: tuple[int, int], seed
     return row
 
 
+def window_loop(name: str, frames: int, size: tuple[int, int]) -> dict:
+    """The window's loop on ``name`` (see the module docstring): fps and CPU a frame."""
+    import tempfile
+
+    from tanktool.game.app import App
+    from tanktool.game.config import MatchConfig, Opponents, ViewConfig
+
+    cfg = MatchConfig(arena=name, opponents=Opponents(7, "normal"), view=ViewConfig("3d", size, False, DEFAULT),
+                      sound=False)
+    with tempfile.TemporaryDirectory() as tmp:      # the first start saves settings: not the user's
+        app = App(None, cfg, settings_file=Path(tmp) / "settings.toml")
+        app.start()
+        try:
+            if app.view != "3d":
+                raise SystemExit(f"{name}: the window has no OpenGL 3.3 here ({app.notice})")
+            last = time.perf_counter()
+
+            def run(n: int) -> None:
+                nonlocal last
+                for _ in range(n):
+                    now = time.perf_counter()
+                    app.frame(now - last)
+                    last = now
+
+            run(30)
+            t, cpu, main = time.perf_counter(), time.process_time(), time.thread_time()
+            run(frames)
+            wall = time.perf_counter() - t
+            return {"arena": name, "fps": round(frames / wall, 1),
+                    "cpu_ms_frame": round(1000 * (time.process_time() - cpu) / frames, 1),
+                    "main_thread_ms_frame": round(1000 * (time.thread_time() - main) / frames, 1)}
+        finally:
+            app.stop()
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--frames", type=int, default=12, help="frames per preset per round")
@@ -176,10 +220,38 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--arena", action="append", help="only this bundled arena (repeatable)")
     ap.add_argument("--json", action="store_true", help="one JSON object with the same figures")
+    ap.add_argument("--window", action="store_true",
+                    help="the game window's own loop, offscreen (SDL's offscreen driver), --frames frames an arena")
     args = ap.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))
     pygame.init()
     from tanktool.game.app import bundled
+
+    if args.window:
+        load = os.getloadavg()[0]
+        names = [a for a in bundled("arenas") if not args.arena or a in args.arena]
+        if len(names) == 1:
+            rows = [window_loop(names[0], args.frames, size)]
+        else:   # one process an arena: SDL's offscreen driver gives a process one GL window
+            import subprocess
+
+            rows = []
+            for a in names:
+                out = subprocess.run([sys.executable, __file__, "--window", "--json", "--arena", a, "--frames",
+                                      str(args.frames), "--size", args.size], capture_output=True, text=True)
+                if out.returncode != 0:
+                    raise SystemExit(out.stderr.strip().splitlines()[-1] if out.stderr.strip() else f"{a}: failed")
+                rows += json.loads(out.stdout)["window"]
+        if args.json:
+            print(json.dumps({"size": list(size), "default": DEFAULT, "load_average_before": round(load, 2),
+                              "window": rows}))
+            return
+        print(f"the window's loop, offscreen, {size[0]}x{size[1]}, {DEFAULT}, 8 tanks, {args.frames} frames; "
+              f"load average {load:.2f} -> {os.getloadavg()[0]:.2f}")
+        print(f"{'arena':<10} {'fps':>6} {'cpu ms':>7} {'main ms':>8}")
+        for r in rows:
+            print(f"{r['arena']:<10} {r['fps']:>6.1f} {r['cpu_ms_frame']:>7.1f} {r['main_thread_ms_frame']:>8.1f}")
+        return
     from tanktool.game.render3d import standalone_context
 
     load_before = os.getloadavg()
