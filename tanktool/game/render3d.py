@@ -339,8 +339,14 @@ class Renderer3D:
         ctx, s = self.ctx, self.session
         proj, view, eye = self.matrices(alpha)
         pv = proj @ view
-        hud_rects = self._prepare_hud(fps, alpha, message, controls) if hud else []
+        # the CPU's share of the frame before any upload: in a window the first texture
+        # upload waits for llvmpipe to finish the last frame, and what comes before it
+        # runs beside that (the effects, the tanks' places, the HUD drawn)
         self.effects.sync(s, self.floor_y)
+        for t in s.world.tanks:
+            self._tank_model_matrix(t, alpha)
+        fx = self._effect_rows(eye, alpha)
+        hud_rects = self._prepare_hud(fps, alpha, message, controls) if hud else []
         if self.shadows is not None:
             self._shadow_pass(alpha)
         self.fbo.use()
@@ -359,7 +365,7 @@ class Renderer3D:
             self._draw(self.prog, self._lod(t, model, eye), pv, model, tint, TINT)
         self._draw(self.arena_prog, self.arena, pv, np.identity(4), (0, 0, 0), 0.0)
         self._draw_sky(pv, eye)
-        self._draw_effects(pv, eye, alpha)
+        self.fx_pass.draw(*fx, pv, self.view, eye, FOV_Y)
         if hud_rects:
             self._composite_hud(hud_rects)
         if not self.own_ctx:
@@ -418,11 +424,11 @@ class Renderer3D:
         d = np.array(self.light_pos) - np.array([self.centre[0], self.floor_y, self.centre[1]])
         self.sky.draw(pv, self.view, eye, d / np.linalg.norm(d) * np.array([0.4, 1.0, 0.4]), self.session.t)
 
-    def _draw_effects(self, pv: np.ndarray, eye: np.ndarray, alpha: float) -> None:
+    def _effect_rows(self, eye: np.ndarray, alpha: float) -> tuple[np.ndarray, np.ndarray]:
+        """This frame's particle instances and tracer vertices (game/particles.py)."""
         from .particles import SessionEffects
 
-        self.fx_pass.draw(self.effects.particles.instances(eye), SessionEffects.tracers(self.session, alpha, eye),
-                          pv, self.view, eye, FOV_Y)
+        return self.effects.particles.instances(eye), SessionEffects.tracers(self.session, alpha, eye)
 
     def _prepare_hud(self, fps: float, alpha: float, message: str | None,
                      controls: list[tuple[str, str]] | None = None) -> list[Any]:
