@@ -212,6 +212,35 @@ def window_loop(name: str, frames: int, size: tuple[int, int]) -> dict:
             app.stop()
 
 
+def window_table(args: argparse.Namespace, size: tuple[int, int]) -> None:
+    """``--window``: the window's loop on each arena, each in its own process."""
+    from tanktool.game.app import bundled
+
+    load = os.getloadavg()[0]
+    names = [a for a in bundled("arenas") if not args.arena or a in args.arena]
+    if len(names) == 1:
+        rows = [window_loop(names[0], args.frames, size)]
+    else:   # one process an arena: SDL's offscreen driver gives a process one GL window
+        import subprocess
+
+        rows = []
+        for a in names:
+            out = subprocess.run([sys.executable, __file__, "--window", "--json", "--arena", a, "--frames",
+                                  str(args.frames), "--size", args.size], capture_output=True, text=True)
+            if out.returncode != 0:
+                raise SystemExit(out.stderr.strip().splitlines()[-1] if out.stderr.strip() else f"{a}: failed")
+            rows += json.loads(out.stdout)["window"]
+    if args.json:
+        print(json.dumps({"size": list(size), "default": DEFAULT, "load_average_before": round(load, 2),
+                          "window": rows}))
+        return
+    print(f"the window's loop, offscreen, {size[0]}x{size[1]}, {DEFAULT}, 8 tanks, {args.frames} frames; "
+          f"load average {load:.2f} -> {os.getloadavg()[0]:.2f}")
+    print(f"{'arena':<10} {'fps':>6} {'cpu ms':>7} {'main ms':>8}")
+    for r in rows:
+        print(f"{r['arena']:<10} {r['fps']:>6.1f} {r['cpu_ms_frame']:>7.1f} {r['main_thread_ms_frame']:>8.1f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--frames", type=int, default=12, help="frames per preset per round")
@@ -228,29 +257,7 @@ def main() -> None:
     from tanktool.game.app import bundled
 
     if args.window:
-        load = os.getloadavg()[0]
-        names = [a for a in bundled("arenas") if not args.arena or a in args.arena]
-        if len(names) == 1:
-            rows = [window_loop(names[0], args.frames, size)]
-        else:   # one process an arena: SDL's offscreen driver gives a process one GL window
-            import subprocess
-
-            rows = []
-            for a in names:
-                out = subprocess.run([sys.executable, __file__, "--window", "--json", "--arena", a, "--frames",
-                                      str(args.frames), "--size", args.size], capture_output=True, text=True)
-                if out.returncode != 0:
-                    raise SystemExit(out.stderr.strip().splitlines()[-1] if out.stderr.strip() else f"{a}: failed")
-                rows += json.loads(out.stdout)["window"]
-        if args.json:
-            print(json.dumps({"size": list(size), "default": DEFAULT, "load_average_before": round(load, 2),
-                              "window": rows}))
-            return
-        print(f"the window's loop, offscreen, {size[0]}x{size[1]}, {DEFAULT}, 8 tanks, {args.frames} frames; "
-              f"load average {load:.2f} -> {os.getloadavg()[0]:.2f}")
-        print(f"{'arena':<10} {'fps':>6} {'cpu ms':>7} {'main ms':>8}")
-        for r in rows:
-            print(f"{r['arena']:<10} {r['fps']:>6.1f} {r['cpu_ms_frame']:>7.1f} {r['main_thread_ms_frame']:>8.1f}")
+        window_table(args, size)
         return
     from tanktool.game.render3d import standalone_context
 
