@@ -127,3 +127,19 @@ def test_a_quiet_fight_closes_in_along_the_way(bridge):
     assert seen_attack and t.shots == 0
     assert low > 4.5                                    # never down the ramp
     assert far > 35.0 and math.hypot(o.x - t.x, o.z - t.z) < 20.0
+
+
+def test_at_the_top_of_a_ramp_too_steep_it_drives_up_first(bridge):
+    """Spawned facing across the top of the bridge level's ramp (its back to the
+    slope), it climbs onto the plateau before anything else: strafed or turned on
+    the spot, the tank slid down the ramp and stayed at its foot for the duel."""
+    w = _world(bridge)
+    drv = BotDriver(Agent("hard"), 1)
+    t = _placed(w, 6.6, 15.6, 0.41, 5.0)
+    o = w.tanks[1]                  # in sight across the passage: it attacks
+    o.x, o.z = 60.0, 8.0
+    w.stand(o, 5.0)
+    from tanktool.sim.commands import Command
+    for _ in range(int(5.0 / w.dt)):
+        w.step(None, [drv(w, t), Command()])
+    assert t.y > 4.9 and t.z > 16.0

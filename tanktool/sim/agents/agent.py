@@ -34,6 +34,7 @@ from .dodge import Evasion
 from .driving import Pilot
 from .explore import STALE, WATCH_COVER, Search, Wander, Watch
 from .machine import State, StateMachine, Transition, table_text
+from .perception import wrap
 from .memory import AgentMemory
 from .navigation import Memory, Wanderer
 from .sight import Coverage, Vantages, Views, vantages_for
@@ -51,6 +52,8 @@ _ROAM = ("wander", "watch")
 #: the steepest link of its grid on relief, as a share of the steepest slope its engine
 #: holds it on (the light tank's 0.31: 17 degrees; the hills' slopes are 10)
 GRADE = 0.8
+#: off its grid on a slope steeper than this (rise per metre), it drives up it first
+SLOPE = 0.1
 #: free moves on relief look this far ahead [m] beyond the footprint radius, plus the
 #: way covered in EDGE_TIME s [s], for a place off the grid EDGE_RISE m [m] above or
 #: below
@@ -172,6 +175,28 @@ class Agent(Pilot):
     def state(self) -> str:
         return self.machine.name
 
+    def off_slope(self, view: "View") -> Command | None:
+        """On a slope with a trap below (``_trap`` within 6 m downhill: a spawn point at
+        the top of a ramp too steep; the tank slid down it in its first fight and stayed
+        at its foot all duel): up the slope first, whatever the state (its shot is
+        kept), while it still can (from a standstill, not once sliding)."""
+        nav, me = self.nav, view.me
+        if not view.map.relief or nav is None:
+            return None
+        g, lv, h = view.map.ground, me.level, 1.5
+        gx = g.height(me.x + h, me.z, lv) - g.height(me.x - h, me.z, lv)
+        gz = g.height(me.x, me.z + h, lv) - g.height(me.x, me.z - h, lv)
+        n = math.hypot(gx, gz)
+        if n / (2.0 * h) <= SLOPE:
+            return None
+        here = g.height(me.x, me.z, lv)
+        if not any(self._trap(view, me.x - r * gx / n, me.z - r * gz / n, here, r) for r in (2.0, 4.0, 6.0)):
+            return None
+        # straight up, no strafe (the pilot's push off the walls of the ramp's level
+        # strafed it down)
+        err = wrap(math.atan2(gz, gx) - me.heading)
+        return Command(advance=1.0 if abs(err) < 0.8 else 0.0, rotate=self.turn(me, err), strafe=0.0)
+
     def _trap(self, view: "View", x: float, z: float, here: float, r: float) -> bool:
         """Whether (x, z), ``r`` m off, is off our grid and on a slope too steep (cut
         from it: valid on the plain grid) or more than ``EDGE_RISE`` m above or below
@@ -233,6 +258,9 @@ class Agent(Pilot):
         nav.coverage.look(me.x, me.z, me.heading, view.t, me.y)  # type: ignore[union-attr]
         p = self.memory.digest(view, self.level)
         cmd = self.machine.think(self, view, p, lambda: self.drive(view, 0.0, 0.0, 0.0))
+        up = self.off_slope(view)
+        if up is not None:
+            return Command(up.advance, up.rotate, up.strafe, cmd.fire)
         # fighting too: wedged on a ramp's side (37 degrees of pitch, the gen-bridge),
         # hard pushed forward and sideways at 0.1 m/s for the rest of a duel, 0-0
         return self.unstick(view, cmd, strafe=self.state == "attack")
