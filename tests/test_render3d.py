@@ -234,3 +234,26 @@ def test_renderers_in_one_process_each_draw_in_their_own_context():
             b.release()
     finally:
         a.release()
+
+
+def test_the_sky_under_the_clouds_base_is_drawn_without_them_and_looks_the_same():
+    """The sky's rows with no corner over the clouds' base are drawn by the program
+    without the cloud lookup (game/sky.py): the picture is the one all clouds give."""
+    from tanktool.game.render3d import Renderer3D
+
+    s = GameSession("hills", bots=2, seed=0, player=False)
+    run_frames(s, 10)
+    r = Renderer3D(s, SIZE)
+    try:
+        r.camera = "first-person"                   # level: the horizon across the middle
+        r.render(hud=False)
+        split = r.render(hud=False).astype(int)
+        rows = []
+        real = r.sky._cloudy_from
+        r.sky._cloudy_from = lambda inv, eye, lowest: rows.append((lowest, real(inv, eye, lowest))) or lowest
+        whole = r.render(hud=False).astype(int)
+    finally:
+        r.release()
+    lowest, cloudy = rows[0]
+    assert lowest < cloudy < r.sky.rows              # some rows had no clouds to draw, some had
+    assert np.abs(split - whole).max() <= 1
