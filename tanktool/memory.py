@@ -40,3 +40,29 @@ def keep_freed_memory() -> bool:
         return False
     _done = ok
     return ok
+
+
+#: builds that made less than this give nothing back (trimming costs a walk of the heap)
+GIVE_BACK_MIN = 256 * 1024 * 1024
+_trim = None
+
+
+def give_back(nbytes: int) -> bool:
+    """After a build that made ``nbytes`` of arrays and let most of them go, hand the
+    heap's free pages back to the kernel (glibc's malloc_trim; nothing below
+    GIVE_BACK_MIN, or without glibc).  keep_freed_memory keeps freed arrays' pages for
+    reuse, and the ones between live arrays are never reused by the next, larger stage:
+    on a 2 km terrain's import they were ~0.3 GB of the 3.8 GB peak resident size."""
+    global _trim
+    if nbytes < GIVE_BACK_MIN:
+        return False
+    if _trim is None:
+        try:
+            name = ctypes.util.find_library("c")
+            _trim = getattr(ctypes.CDLL(name), "malloc_trim", False) if name else False
+        except OSError:
+            _trim = False
+    if not _trim:
+        return False
+    _trim(0)
+    return True

@@ -36,6 +36,7 @@ import numpy as np
 import shapely
 
 from ..formats.walls_txt import WallList, aux_rectangle
+from ..memory import give_back
 from ..geometry import contours, slivers
 from ..geometry import cross_section as xs
 from ..geometry import walls as cut
@@ -474,6 +475,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     lo = pts.min(axis=0) - AUX_MARGIN
     hi = pts.max(axis=0) + AUX_MARGIN
     walls.aux = aux_rectangle(lo[0], lo[1], hi[0], hi[1])
+    give_back(40 * c.exists.size)   # the layers, links and cuts of _prepare
     return LevelWalls(walls, regions, thin_total, portal_len, repairs)
 
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ArenaError
+from ..memory import give_back
 from ..geometry.kernels import active, i64
 from ..geometry.heightfield import OPEN, Heightfield, build_heightfield, column_starts, neighbour_columns
 from .level_lift import lift_steps, lift_to_portals
@@ -353,6 +354,7 @@ def walkable_surface(vertices: np.ndarray, faces: np.ndarray, params: WalkablePa
     if lean:
         surface.hf = hf.geometry()
         surface.ceil = np.zeros(0, dtype=surface.ceil.dtype)
+    give_back(200 * len(surface.col))   # the rasteriser's pieces and the surface's temporaries
     return surface
 
 
@@ -586,5 +588,6 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
         reachable = layered_reachable(valid, link, seeds_n) if seeds_n else np.zeros_like(valid)
     else:
         reachable = valid.copy()
+    give_back(60 * valid.size)   # the layers' temporaries
     return NavGrid(np.asarray(origin_xz, dtype=np.float64), float(cell), (nz, nx), valid, ri, rt, ci, ct, reachable,
                    float(clearance), spawn_nodes=seeds_n, height=height, link=link)
