@@ -6,13 +6,15 @@ vehicle frame) with their textures and material colours (game/meshes.py).  A fra
 1. **shadow pass** (quality ``shadows`` on): the depth of the arena and the tanks seen
    from the light into a shadow map.  The light is the paper's point light high over
    the middle of the arena; everything lies below it, so one perspective view looking
-   down, its frustum fitted to the arena's bounding box, holds every shadow.  The
-   arena's map is drawn once, the tanks' every frame (game/shadows.py).
+   down, its frustum fitted to the arena's bounding box, holds every shadow.  One
+   map: the arena's depth drawn once, the tanks drawn into it every frame and taken
+   out again the next (game/shadows.py).
 2. **scene**: tanks, then the arena (front to back: the software rasteriser skips what
-   is hidden), Phong-lit per pixel by the point light (position, range, attenuation
-   1/(a0 + a1 d + a2 d²) as D3DLIGHT8) plus ambient, textured, shadowed, fogged
-   towards the horizon (game/shaders.py).  Closed models are drawn with back faces
-   culled.
+   is hidden; the arena's triangles walls first, the lowest floor last), the tanks
+   Phong-lit per pixel by the point light (position, range, attenuation 1/(a0 + a1 d +
+   a2 d²) as D3DLIGHT8) plus ambient, textured, shadowed, fogged towards the horizon
+   (game/shaders.py), the arena by its own program (lit per vertex below ``high``).
+   Models are drawn indexed; closed ones with back faces culled.
 3. **sky** at the far plane, only where nothing was drawn: gradient, the light's glow,
    clouds (game/sky.py, as the effects' pass).
 4. **effects**: particles (game/particles.py: muzzle flashes, fire, smoke, sparks,
@@ -249,7 +251,7 @@ class Renderer3D:
         self.tanks_far = {name: self._gpu(m.far, self.prog) if m.far is not None else self.tanks[name]
                           for name, m in self.tank_models.items()}
         self.sky = Sky(ctx, q.sky == "clouds", trilinear=q.trilinear)
-        # the arena's shadows once (it never moves), the tanks' every frame
+        # one shadow map: the arena's depth once (it never moves), the tanks drawn in every frame
         self.shadows = (ShadowMaps(ctx, self.depth_prog, self.light_pos, self.scene_box, q.shadow_size, self.arena)
                         if q.shadow_size else None)
         self.effects = SessionEffects(q.particles, seed=int(getattr(self.session.world, "seed", 0)))
