@@ -154,8 +154,7 @@ def flat_heights(vertices: np.ndarray, faces: np.ndarray, flat_ny: float = 0.999
         flat = ny >= flat_ny
         hs.append(height[flat])
         areas.append(area[flat])
-    h = np.concatenate(hs) if hs else np.zeros(0)
-    a = np.concatenate(areas) if areas else np.zeros(0)
+    h, a = (np.concatenate(x) if x else np.zeros(0) for x in (hs, areas))
     if len(h) == 0:
         return np.zeros(0), np.zeros(0)
     order = np.argsort(h, kind="stable")
@@ -515,7 +514,8 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
         out.append((pairs.row[p] * nx + j, group[pairs.tri[p]], smin, smax))
     if not out:
         return _merge(*(np.zeros(0, dtype=np.int64) for _ in range(5)), merge_steps), 0
-    col, t_of_cell, smin, smax = (np.concatenate(v) for v in zip(*out))
+    # one group (a terrain: all gentle): its arrays, not copies of them
+    col, t_of_cell, smin, smax = out[0] if len(out) == 1 else (np.concatenate(v) for v in zip(*out))
     spans = _merge(col, smin, smax, walkable[t_of_cell], flat[t_of_cell], merge_steps)
     return spans, len(col)
 
@@ -531,7 +531,7 @@ def _merge(col, smin, smax, walk, flat, thr):
         e = np.zeros(0, dtype=np.int64)
         b = np.zeros(0, dtype=bool)
         return e, e, e, b, b, b
-    key = (col.astype(np.int64) << 34) | (smin << 18) | (smax << 2) | (walk.astype(np.int64) << 1) | flat
+    key = (col.astype(np.int64, copy=False) << 34) | (smin << 18) | (smax << 2) | (walk.astype(np.int64) << 1) | flat
     key.sort()
     kern = active()
     if kern is not None:  # one pass over the sorted keys
