@@ -112,12 +112,20 @@ def build_tiled(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, w
             results = [_band(a, b) for a, b in todo]
     finally:
         _JOB.clear()
-    spans = tuple(np.concatenate(v) for v in zip(*(r[0] for r in results)))
     counts: dict[str, int] = {}
     for _, c in results:
         for k, v in c.items():
             counts[k] = counts.get(k, 0) + v
-    return spans, counts
+    # one array at a time, the bands' pieces of it let go as soon as it is joined: the
+    # bands and the whole level were both alive (2 x 28 bytes a span: +0.45 GB on 2 km)
+    fields = [list(r[0]) for r in results]
+    del results
+    spans = []
+    for k in range(len(fields[0]) if fields else 0):
+        spans.append(np.concatenate([f[k] for f in fields]))
+        for f in fields:
+            f[k] = None
+    return tuple(spans), counts
 
 
 def _can_fork() -> bool:
