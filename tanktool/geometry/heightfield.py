@@ -83,15 +83,16 @@ class Heightfield:
         """World y of each span's top."""
         return self.origin[1] + self.smax * self.ch
 
+    def __post_init__(self) -> None:
+        # int32 (columns < MAX_COLUMNS, steps <= MAX_HEIGHT_STEPS): 12 bytes a span less (0.2 GB on 2 km)
+        self.col, self.smin, self.smax = (np.asarray(a, dtype=np.int32) for a in (self.col, self.smin, self.smax))
+
     def geometry(self) -> "Heightfield":
         """The grid alone (origin, cells, shape, counts) without its spans: what a
         lean walkable surface keeps of it (walkable.walkable_surface(lean=True))."""
-        def none(a: np.ndarray) -> np.ndarray:
-            return np.zeros(0, dtype=a.dtype)  # not a[:0]: a view would keep the spans alive
-
-        return Heightfield(self.origin, self.cs, self.ch, self.shape, none(self.col), none(self.smin),
-                           none(self.smax), none(self.walkable), none(self.flat), none(self.top_walkable),
-                           dict(self.counts), none(self.low_headroom))
+        none = [np.zeros(0, dtype=a.dtype) for a in (self.col, self.smin, self.smax, self.walkable, self.flat,
+                                                    self.top_walkable)]   # not a[:0]: views keep the spans
+        return Heightfield(self.origin, self.cs, self.ch, self.shape, *none, dict(self.counts), np.zeros(0, bool))
 
 
 #: a horizontal face: |n_y| at least this (within ~2.6 degrees)
@@ -129,8 +130,7 @@ def grid_for(vertices: np.ndarray, cs: float, origin_xz=None, shape=None) -> tup
 FLAT_GAP = 0.05
 
 
-#: faces per block of flat_heights
-FACE_BLOCK = 1 << 17
+FACE_BLOCK = 1 << 17  #: faces per block of flat_heights
 
 
 def flat_heights(vertices: np.ndarray, faces: np.ndarray, flat_ny: float = 0.999) -> tuple[np.ndarray, np.ndarray]:

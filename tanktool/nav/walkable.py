@@ -403,7 +403,7 @@ def build_surface(hf: Heightfield, headroom: float, climb: float, max_clearance:
     clim = int(math.floor(climb / hf.ch + 1e-9))
     w = hf.walkable
     ceil_all = hf.ceiling()
-    col, floor, ceil = hf.col[w], hf.smax[w], np.minimum(ceil_all[w], OPEN)
+    col, floor, ceil = hf.col[w].astype(np.int64), hf.smax[w], np.minimum(ceil_all[w], OPEN)
     del ceil_all
     link = link_spans(col, floor, ceil, hf.shape, head, clim)
     # kept as int32 (steps up to OPEN, labels below 2**31): 12 bytes a span less while
