@@ -10,7 +10,7 @@ near its tanks.  ``LazyRows(array, convert)`` is indexed like that list of rows
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
@@ -33,7 +33,7 @@ class LazyRows(dict):
     def __len__(self) -> int:
         return len(self._array)
 
-    def __iter__(self):
+    def __iter__(self) -> Iterator[Any]:
         return (self[i] for i in range(len(self._array)))
 
 
@@ -43,6 +43,7 @@ def heights_row(row: np.ndarray) -> list:
 
 
 def plain_row(row: np.ndarray) -> list:
+    """A row as nested Python lists (ints, bools)."""
     return row.tolist()
 
 
