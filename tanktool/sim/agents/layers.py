@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...nav.navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3, runs
-from ...nav.walkable import chamfer_clearance
+from ...nav.walkable import CELL_HEIGHT, chamfer_clearance
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..ground import Ground
@@ -105,7 +105,9 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
             ti = np.broadcast_to(np.clip(np.arange(NZ)[None, :, None] + di, 0, NZ - 1), cur.shape)
             tj = np.broadcast_to(np.clip(np.arange(NX)[None, None, :] + dj, 0, NX - 1), cur.shape)
             rise = np.abs(heights[cur, ti, tj] - heights)
-            alive &= ~(rise > grade * k * fine)
+            # heights come in voxel steps (CELL_HEIGHT): one step of slack, or a ramp
+            # just under the grade is cut where its steps fall unevenly
+            alive &= ~(rise > grade * k * fine + CELL_HEIGHT)
         link[..., d] = np.where(alive, cur, -1)
     # coarse node (I, J) sits at the centre of surface node (off + k I, off + k J)
     step = k * fine
