@@ -111,6 +111,32 @@ static inline int32_t relax(const int32_t *L, const int32_t *dist, Py_ssize_t s,
     return v;
 }
 
+/* one relaxation of span s over straight links only (2 a step); off the edge is no
+ * source here (surface_report._distance_from) */
+static inline int32_t relax_straight(const int32_t *L, const int32_t *dist, Py_ssize_t s, int32_t v) {
+    for (int d = 0; d < 4; ++d) {
+        const int32_t t = L[4 * s + d];
+        if (t >= 0 && dist[t] + 2 < v) v = dist[t] + 2;
+    }
+    return v;
+}
+
+typedef int32_t (*relax_fn)(const int32_t *, const int32_t *, Py_ssize_t, int32_t);
+
+/* sweeps forward and back (spans come in scan order, so each sweep carries a distance
+ * across the level) until nothing changes: the numpy relaxation's fixed point */
+static inline void sweep(const int32_t *L, int32_t *D, Py_ssize_t n, relax_fn relax_span) {
+    int changed = 1;
+    while (changed) {
+        changed = 0;
+        for (Py_ssize_t k = 0; k < 2 * n; ++k) {
+            const Py_ssize_t s = k < n ? k : 2 * n - 1 - k;
+            const int32_t v = relax_span(L, D, s, D[s]);
+            if (v < D[s]) { D[s] = v; changed = 1; }
+        }
+    }
+}
+
 static PyObject *chamfer(PyObject *self, PyObject *args) {
     Py_buffer link, dist;
     int limit;
@@ -122,21 +148,8 @@ static PyObject *chamfer(PyObject *self, PyObject *args) {
         const int32_t *L = link.buf;
         int32_t *D = dist.buf;
         Py_BEGIN_ALLOW_THREADS
-        /* sweeps forward and back (spans come in scan order, so each sweep carries a
-         * distance across the level) until nothing changes: the same fixed point as
-         * the numpy relaxation, every span at its shortest chamfer path, capped at limit */
-        int changed = 1;
-        while (changed) {
-            changed = 0;
-            for (Py_ssize_t s = 0; s < n; ++s) {
-                const int32_t v = relax(L, D, s, D[s]);
-                if (v < D[s]) { D[s] = v; changed = 1; }
-            }
-            for (Py_ssize_t s = n - 1; s >= 0; --s) {
-                const int32_t v = relax(L, D, s, D[s]);
-                if (v < D[s]) { D[s] = v; changed = 1; }
-            }
-        }
+        /* every span at its shortest chamfer path, capped at limit */
+        sweep(L, D, n, relax);
         Py_END_ALLOW_THREADS
     }
     ret = Py_None;
@@ -161,19 +174,7 @@ static PyObject *reach(PyObject *self, PyObject *args) {
         const int32_t *L = link.buf;
         int32_t *D = dist.buf;
         Py_BEGIN_ALLOW_THREADS
-        int changed = 1;
-        while (changed) {
-            changed = 0;
-            for (Py_ssize_t k = 0; k < 2 * n; ++k) {
-                const Py_ssize_t s = k < n ? k : 2 * n - 1 - k;
-                int32_t v = D[s];
-                for (int d = 0; d < 4; ++d) {
-                    const int32_t t = L[4 * s + d];
-                    if (t >= 0 && D[t] + 2 < v) v = D[t] + 2;
-                }
-                if (v < D[s]) { D[s] = v; changed = 1; }
-            }
-        }
+        sweep(L, D, n, relax_straight);
         Py_END_ALLOW_THREADS
     }
     ret = Py_None;
