@@ -21,7 +21,9 @@ probes has been answered, so that a joiner dialling a stale host's address is no
 into a split session.  (Two sides with as many players, the same term and hosts of the
 same number stay apart: that tie has no winner.)  A member dropped by the
 others (silence) that made itself host of its own session comes back the same way: the
-larger session does not step down to it.  No I/O: part of :class:`~tanktool.net.core.Core` (a probe is a
+larger session does not step down to it.  Two members that dropped each other while
+the host kept both (a cut between them alone) find each other in their own session when
+their probes get through; the higher number rejoins through the host.  No I/O: part of :class:`~tanktool.net.core.Core` (a probe is a
 ``Connect`` action; the answer comes back as any link's bytes).
 """
 
@@ -65,6 +67,10 @@ class TermsMixin:
         self.next_probe = 0.0
         self.first_round = False
         self.step_down_to = None             # a newer session's member we will rejoin through
+        #: members we dropped ourselves (silence, a closed link) while our host stayed:
+        #: (ip, tcp port) -> their number.  Such a member answering a probe in our own
+        #: session means the mesh is one-sided (the host kept both of us)
+        self.dropped_members: dict[tuple[str, int], int] = {}
 
     def _others(self) -> list[int]:
         return [k for k, x in self.table.items() if not x.is_bot and k != self.number]  # type: ignore[attr-defined]
@@ -76,6 +82,9 @@ class TermsMixin:
             return
         now = self.now                                             # type: ignore[attr-defined]
         self.lost[(e.ip, e.tcp_port)] = now
+        if reason != "dropped by the host" and e.number != self.host_number \
+                and not self.is_host and self.host_number in self.table:   # type: ignore[attr-defined]
+            self.dropped_members[(e.ip, e.tcp_port)] = e.number
         if self.closed:                                            # type: ignore[attr-defined]
             return
         if now > self.probe_until:
@@ -135,6 +144,7 @@ class TermsMixin:
         # (term + 1) draws nobody to it.  Our own term and host number is our own session
         # seen by a peer that has not caught up (a kicked player's last view): not another
         if (body.term, body.host) == (self.term, self.host_number):
+            self._one_sided(link.addr)
             return
         if (body.players, body.term, -body.host) > (len(self._others()) + 1, self.term, -self.host_number):
             if self.is_host:                     # type: ignore[attr-defined]
@@ -145,6 +155,19 @@ class TermsMixin:
                         self._queue(member, redirect)                    # type: ignore[attr-defined]
             self._step_down(link.addr, body.host, f"term {body.term} with {body.players} players at "
                                                   f"{link.addr[0]}:{link.addr[1]}")
+
+    def _one_sided(self, addr: tuple[str, int]) -> None:
+        """A member we dropped ourselves answers in our own session: it dropped us too,
+        and the host kept both (each side holds the other as departed, so no table
+        brings it back).  Of the two, the one with the higher number rejoins through the
+        host, as a new player both sides will link to; the other waits for it."""
+        other = self.dropped_members.pop(addr, None)
+        host = self.table.get(self.host_number)                    # type: ignore[attr-defined]
+        if other is None or host is None or self.is_host or self.number < other:  # type: ignore[attr-defined]
+            return
+        self._step_down((host.ip, host.tcp_port), self.host_number,
+                        f"player {other} at {addr[0]}:{addr[1]} is in our session but not linked "
+                        "to us: rejoining through the host")
 
     def _step_down(self, addr: tuple[str, int], host: int, why: str) -> None:
         self.step_down_to = addr
@@ -172,4 +195,5 @@ class TermsMixin:
         # who left our old session says nothing about the new one (whose numbers and
         # epochs may repeat ours: both sides of a partition gave them)
         self.departed.clear()                                         # type: ignore[attr-defined]
+        self.dropped_members.clear()
         self.addr_buckets.clear()                                     # type: ignore[attr-defined]
