@@ -122,3 +122,7 @@ def test_a_cheating_member_is_corrected_everywhere_and_disconnected():
     assert kick.number == 3 and "corrected" in kick.reason
     assert [e.reason for _, e in cheat.events if e.kind == "kicked"] == [kick.reason] and cheat.core.closed
     assert 3 not in host.core.table and 3 not in honest.core.table
+    # the honest member's own judge saw the cheating: it never probes the kicked player
+    # (a kicked cheater answering probes with an invented session would lure no one)
+    assert not [addr for addr in honest.core.lost if addr[0] == cheat.ip]
+    assert not [e for _, e in honest.events if e.kind == "stepdown"]

@@ -269,6 +269,9 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
             return
         self.departed.add((n, e.epoch))
         self.freed.append(n)
+        # a player our own judge would kick is not probed once gone: whatever session
+        # it claims to stand in, we do not follow it there
+        cheat = self.judge is not None and not e.is_bot and self.judge.to_kick(n, self.session_time())
         self._forget(n)
         self.events.append(NetEvent("left", n, e, reason))
         players = [k for k, x in self.table.items() if not x.is_bot]
@@ -288,7 +291,7 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
                     self.events.append(NetEvent("adopt", k, self.table[k]))
         if self.is_host:
             self._send_table()
-        self._lost_player(e, reason)
+        self._lost_player(e, "cheating" if cheat else reason)
 
     def _send_table(self) -> None:
         """The host's table (and term) to every member."""

@@ -43,8 +43,9 @@ PROBE_LONG = 60.0
 #: a probe's connection gives up after this long [s]
 PROBE_TIMEOUT = 1.0
 #: why a player left that says nothing about the session going on elsewhere ("dropped
-#: by the host" does: the host may have lost it to a partition, as we did not)
-CLEAN = ("exit", "replaced")
+#: by the host" does: the host may have lost it to a partition, as we did not).  A player
+#: our own judge found cheating is never followed, whatever its CHALLENGE claims
+CLEAN = ("exit", "replaced", "cheating")
 
 
 class TermsMixin:
