@@ -312,6 +312,34 @@ def test_two_members_cut_from_each_other_only_link_again():
     assert kinds(carol, "stepdown") and not kinds(bob, "stepdown")
 
 
+def test_a_rejoin_whose_target_dies_hosts_alone_and_finds_the_others_later():
+    """Alice, cut off alone, steps down to the session the others went on in; the peer
+    her probe found dies before she rejoins.  She hosts her own session again (not no
+    session at all: chaos seed 2), goes on probing, and joins the survivor."""
+    net = SimCluster(seed=13, **BAD)
+    alice = net.host("alice")
+    others = [net.join(name, alice) for name in ("bob", "carol")]
+    net.run(1.0)
+    net.auto_rejoin = False
+    net.udp.partition(net.now, net.now + 8.0, [alice.ip], [n.ip for n in others])
+    for _ in range(300):
+        net.run(0.1)
+        if alice.core.step_down_to is not None:
+            break
+    target = next(n for n in others if n.address == alice.core.step_down_to)
+    net.kill(target)
+    net.auto_rejoin = True
+    net.rejoin(alice)
+    for _ in range(30):
+        net.run(0.1)
+        if alice.join_error:
+            break
+    assert "closed" in alice.join_error and alice.core.is_host and alice.core.lost
+    net.run(20.0)
+    assert_one_session(net)
+    assert sorted(n.name for n in live(net)) == sorted(["alice"] + [n.name for n in others if n is not target])
+
+
 # ---------------------------------------------------------------- determinism, finding 8
 def _story(seed: int) -> list:
     net = SimCluster(seed=seed, **BAD)
@@ -424,12 +452,15 @@ def _chaos(seed: int) -> SimCluster:
     return net
 
 
-@pytest.mark.parametrize("seed", [7, 41, 3, 17, 29, 181])
+@pytest.mark.parametrize("seed", [7, 41, 3, 17, 29, 176, 181, 377])
 def test_random_faults_end_in_one_session(seed):
     """Seeds 7 and 41 split for good before: two lone peers of the same term (now the
     lower host number goes on), and a pair that rejoined each other and forgot the
     larger side (now the players lost stay probed across a rejoin).  Seed 181: two
-    members that dropped each other while the host kept both (now the higher rejoins)."""
+    members that dropped each other while the host kept both (now the higher rejoins).
+    Seeds 176 and 377: a player joined a splinter whose host then left (176) or died
+    (377), and knew nobody of the larger side (now the host's NUMBER, NEW_PLAYER and
+    TABLE carry the addresses it probes, and its members probe them too)."""
     net = _chaos(seed)
     assert_one_session(net)
     assert len(live(net)) >= 2

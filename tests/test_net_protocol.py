@@ -51,6 +51,19 @@ def test_table_round_trip(kind):
     assert msg.body.table.get(3).name == "bób" and msg.body.table.get(2) is None
 
 
+def test_a_table_carries_the_hosts_probe_list():
+    body = P.Assign(1, 7.0, _table(), 2, (("10.0.0.9", 5000), ("192.168.1.2", 40000)))
+    raw = P.encode(body, 1, 1, 5.0, kind=P.MessageType.TABLE)
+    assert P.decode(raw).body == body
+    c = Counter()
+    count_at = len(raw) - 1 - 2 * 6          # the count byte before the two addresses
+    too_many = raw[:count_at] + bytes([P.MAX_PLAYERS + 1]) + raw[count_at + 1:]
+    assert P.decode(too_many, c) is None and c["range"] == 1
+    assert P.decode(raw[:count_at] + bytes([3]) + raw[count_at + 1:], c) is None and c["length"] == 1
+    with pytest.raises(ValueError):
+        P.encode(P.Assign(1, 7.0, _table(), 2, (("10.0.0.9", 5000),) * 9), 1, 1, 5.0, kind=P.MessageType.TABLE)
+
+
 def test_state_is_small():
     # 30 Hz to 7 peers must stay under 16 KB/s up, even counting IPv4 + UDP headers
     n = len(P.encode(BODIES[3], 1, 1, 0.0))

@@ -5,11 +5,15 @@ address meanwhile is redirected, never taken into a split session."""
 
 from __future__ import annotations
 
+import socket
 import threading
 import time
 
+import pytest
+
 from net_helpers import LOOPBACK, join, peers, play, pump  # noqa: F401 (peers: the fixture)
 
+from tanktool.errors import NetError
 from tanktool.net import protocol as P
 from tanktool.net.peer import Peer
 
@@ -141,3 +145,19 @@ def test_a_frozen_host_match_rejoins_and_its_bots_are_not_duplicated(peers):
         bots = [p for p in rep["peers"] if p["bot"]]
         assert [(p["number"], p["run_by"]) for p in bots] == [(2, 3)]
         assert sorted(p["number"] for p in rep["peers"]) == sorted([2, 3, 4, old["me"]])
+
+
+def test_a_failed_rejoin_hosts_alone_again_on_the_same_ports(peers):
+    """The session a probe found is gone by the time we rejoin: NetError says why, and
+    the peer hosts its own session again on its ports, still probing, not in no session."""
+    host = Peer.host((LOOPBACK, 0), "host", silence=SILENCE)
+    peers.append(host)
+    where = host.tcp_address
+    with socket.socket() as s:                      # a port where nobody listens
+        s.bind((LOOPBACK, 0))
+        gone = s.getsockname()
+    with pytest.raises(NetError, match="cannot reach"):
+        host.rejoin(gone, timeout=1.0)
+    assert host.is_host and host.number == 1 and host.tcp_address == where
+    newcomer = join(peers, where, "late", silence=SILENCE)
+    assert newcomer.host_number == 1 and newcomer.number == 2

@@ -297,7 +297,8 @@ class Core(JoinerMixin, JoiningMixin, DatagramsMixin, LinksMixin, TermsMixin):
         """The host's table (and term) to every member."""
         if not self.links or self.closed:
             return
-        table = self._pack(P.Assign(self.number, self.session_time(), self._table(), self.term), P.MessageType.TABLE)
+        table = self._pack(P.Assign(self.number, self.session_time(), self._table(), self.term,
+                                    self._probe_list()), P.MessageType.TABLE)
         for link in list(self.links.values()):
             if not link.outgoing:
                 self._queue(link, table)

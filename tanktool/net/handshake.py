@@ -112,6 +112,7 @@ class JoinerMixin:
         for pending in list(self.pending):          # a member's HELLO that came first
             if pending.hello is not None:
                 self._try_hello(pending)
+        self._take_probe_list(body.lost)
 
     def _link_to(self, e: P.Entry) -> None:
         """Open the mesh link to a table member (the joiner opens them all).  The link is

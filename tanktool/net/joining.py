@@ -150,8 +150,9 @@ class JoiningMixin:
         self._bind_link(link, n)
         table = self._table()
         t = self.session_time()
-        self._queue(link, self._pack(P.Assign(n, t, table, self.term), P.MessageType.NUMBER))
-        news = self._pack(P.Assign(n, t, table, self.term), P.MessageType.NEW_PLAYER)
+        lost = self._probe_list()
+        self._queue(link, self._pack(P.Assign(n, t, table, self.term, lost), P.MessageType.NUMBER))
+        news = self._pack(P.Assign(n, t, table, self.term, lost), P.MessageType.NEW_PLAYER)
         for k, other in list(self.links.items()):
             if k != n:
                 self._queue(other, news)
@@ -205,7 +206,8 @@ class JoiningMixin:
             name = f"{base}-{k}"
         self.table[n] = P.Entry(n, epoch, me.ip, me.tcp_port, me.udp_port, name, owner=self.number)
         self._saw(self.table[n])
-        news = self._pack(P.Assign(n, self.session_time(), self._table(), self.term), P.MessageType.NEW_PLAYER)
+        news = self._pack(P.Assign(n, self.session_time(), self._table(), self.term, self._probe_list()),
+                          P.MessageType.NEW_PLAYER)
         for link in list(self.links.values()):
             if not link.outgoing:
                 self._queue(link, news)

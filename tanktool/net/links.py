@@ -267,6 +267,7 @@ class LinksMixin:
                     if n not in keep and n != self.number:
                         self._remove(n, "dropped by the host")
             self._merge_table(body.table, body.number)
+            self._take_probe_list(body.lost)
         elif isinstance(body, P.Shot):
             if not self._may_speak(m.sender, body.tank):
                 self.dropped["impostor"] += 1

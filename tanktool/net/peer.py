@@ -228,13 +228,21 @@ class Peer:
     def rejoin(self, address: tuple[str, int] | None = None, timeout: float = 5.0) -> None:
         """Leave what is left of our session (our computer opponents with it) and join
         the one at ``address`` (default: where a probe found a newer session) as a new
-        member, on the same ports.  Blocks like ``Peer.join``; NetError if it fails."""
+        member, on the same ports.  Blocks like ``Peer.join``.  If it fails (that session's
+        peer went away on the way), we host our own session again on our ports, still
+        probing the players we lost, and NetError says why."""
         address = address or self.core.step_down_to
         if address is None:
             raise NetError("no session to rejoin")
         self.core.forget_session(self.clock())
         self._perform()
-        self._join_loop(address, timeout, 0, time.monotonic() + timeout)
+        try:
+            self._join_loop(address, timeout, 0, time.monotonic() + timeout)
+        except NetError:
+            ip, tcp_port = self.tcp_address
+            self.core.host_alone((ip, tcp_port, self.udp_address[1]), self.clock())
+            self._perform()
+            raise
         self._settle(1.0)
 
     # ------------------------------------------------------------------ the game's calls

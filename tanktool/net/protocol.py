@@ -33,8 +33,9 @@ MAGIC = b"TK"
 #: 2: the JOIN carries the digest of the arena and vehicle (peers on different ones
 #: refuse the match), control messages carry the game counter without advancing it;
 #: 3: host terms (Raft-like) in CHALLENGE, NUMBER, NEW_PLAYER and TABLE; the header's
-#: timestamp a u32 of microseconds (4 bytes less a datagram: 16 KB/s per peer sealed)
-VERSION = 3
+#: timestamp a u32 of microseconds (4 bytes less a datagram: 16 KB/s per peer sealed);
+#: 4: NUMBER, NEW_PLAYER and TABLE carry the addresses the host is probing (net/terms.py)
+VERSION = 4
 MAX_PLAYERS = 8
 MAX_NAME = 24                      # bytes of UTF-8
 MAX_PAYLOAD = 512
@@ -144,6 +145,10 @@ class Assign:
     session_t: float
     table: Table
     term: int = 1       # the host's term: +1 at every host change
+    #: (ip, tcp port) of players the host lost uncleanly and is probing (at most
+    #: MAX_PLAYERS): a member that joined after the loss probes them too, so the session
+    #: finds the other side of a partition even if its host leaves (net/terms.py)
+    lost: tuple[tuple[str, int], ...] = ()
 
 
 @dataclass(frozen=True, slots=True)
@@ -220,6 +225,7 @@ _JOIN = struct.Struct(f"!{MAC_SIZE}s{DIGEST_SIZE}sHHB")
 _HELLO = struct.Struct(f"!{MAC_SIZE}sI")
 _ASSIGN = struct.Struct("!BdIBB")         # number, session t, term, table host, entry count
 _ENTRY = struct.Struct("!BBI4sHHB")       # number, owner, epoch, ip, tcp, udp, name length
+_LOST = struct.Struct("!4sH")              # a probed address after the entries (a count byte first)
 #: tank (low 7 bits) and alive (high bit), session time [ms], x, z (f32), heading, vx, vz,
 #: omega (f16): 21 bytes, so a state datagram is 36 bytes (64 on the wire, 72 sealed) and
 #: 30 Hz to 7 peers is 13.4 KB/s (15.1 sealed) counting IPv4/UDP headers.  Hit points are
@@ -271,13 +277,35 @@ def _player(n: int) -> None:
         raise BadMessage("range")
 
 
-def _encode_table(number: int, session_t: float, table: Table, term: int) -> bytes:
-    out = [_ASSIGN.pack(number, session_t, term, table.host, len(table.entries))]
+def _encode_table(body: Assign) -> bytes:
+    table = body.table
+    out = [_ASSIGN.pack(body.number, body.session_t, body.term, table.host, len(table.entries))]
     for e in table.entries:
         name = name_bytes(e.name)
         out.append(_ENTRY.pack(e.number, e.owner, e.epoch, _ip_bytes(e.ip), e.tcp_port, e.udp_port, len(name))
                    + name)
+    if len(body.lost) > MAX_PLAYERS:
+        raise ValueError(f"{len(body.lost)} probed addresses: at most {MAX_PLAYERS}")
+    out.append(bytes([len(body.lost)]))
+    out.extend(_LOST.pack(_ip_bytes(ip), port) for ip, port in body.lost)
     return b"".join(out)
+
+
+def _decode_lost(p: bytes, off: int) -> tuple[tuple[str, int], ...]:
+    if off >= len(p):
+        raise BadMessage("length")
+    count = p[off]
+    if count > MAX_PLAYERS:
+        raise BadMessage("range")
+    if off + 1 + count * _LOST.size != len(p):
+        raise BadMessage("length")
+    lost = []
+    for k in range(count):
+        ip, port = _LOST.unpack_from(p, off + 1 + k * _LOST.size)
+        if port == 0:
+            raise BadMessage("range")
+        lost.append((".".join(str(b) for b in ip), port))
+    return tuple(lost)
 
 
 def _decode_table(p: bytes) -> Assign:
@@ -307,13 +335,12 @@ def _decode_table(p: bytes) -> Assign:
             raise BadMessage("range")
         seen.add(n)
         entries.append(Entry(n, epoch, ".".join(str(b) for b in ip), tcp, udp, name, owner))
-    if off != len(p):
-        raise BadMessage("length")
+    lost = _decode_lost(p, off)
     players = {e.number for e in entries if e.owner == 0}
     # the host is a player, and every computer opponent belongs to a player in the table
     if host not in players or number not in seen or any(e.owner and e.owner not in players for e in entries):
         raise BadMessage("range")
-    return Assign(number, session_t, Table(host, tuple(entries)), term)
+    return Assign(number, session_t, Table(host, tuple(entries)), term, lost)
 
 
 def encode_body(body: Body) -> tuple[MessageType, bytes]:
@@ -353,7 +380,7 @@ def encode(body: Body, sender: int, seq: int, timestamp: float, kind: MessageTyp
     if isinstance(body, Assign):
         if kind not in (MessageType.NUMBER, MessageType.NEW_PLAYER, MessageType.TABLE):
             raise TypeError("an Assign needs kind=NUMBER, NEW_PLAYER or TABLE")
-        mtype, payload = kind, _encode_table(body.number, body.session_t, body.table, body.term)
+        mtype, payload = kind, _encode_table(body)
     else:
         mtype, payload = encode_body(body)
     if len(payload) > MAX_PAYLOAD:

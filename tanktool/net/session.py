@@ -271,9 +271,9 @@ class NetMatch:
         try:
             self.peer.rejoin()
         except NetError as e:
-            self.log(f"could not rejoin: {e}")
-            self.stop = True
-            return
+            # the peer hosts its own session again (net/peer.py): our tank goes on as player 1
+            self.log(f"could not rejoin: {e}; hosting alone again, still looking for the others")
+            self.rejoins[-1]["failed"] = str(e)
         new = self.peer.number
         self.rejoins[-1]["number"] = new
         mine, tank = self.world.tanks[old - 1], self.world.tanks[new - 1]

@@ -45,6 +45,7 @@ class SimNode:
     join_at: float | None = None                            # (again) at this time
     join_error: str = ""
     next_state: float = 0.0
+    rejoining: bool = False                                 # a failed join hosts alone again
 
     @property
     def address(self) -> tuple[str, int]:
@@ -160,6 +161,7 @@ class SimCluster:
         node.core.forget_session(self.now)
         self._perform(node)
         self.start_join(node, to)
+        node.rejoining = True
 
     # ------------------------------------------------------------------ attackers
     def dial(self, from_ip: str, to: SimNode) -> RawConn:
@@ -200,6 +202,10 @@ class SimCluster:
                 node.join_to, node.join_at = outcome.address, now
             else:
                 node.join_error, node.join_to = outcome.text, None
+                if node.rejoining:                   # as Peer.rejoin does
+                    core.host_alone((node.ip, PORT, PORT), now)
+        if outcome is not None and outcome.kind in ("joined", "error"):
+            node.rejoining = False
         core.tick(now)
         if core.number and now >= node.next_state and not core.closed:
             node.next_state = max(node.next_state + 1.0 / self.state_hz, now - 1.0 / self.state_hz)

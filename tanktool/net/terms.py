@@ -96,6 +96,30 @@ class TermsMixin:
             self.next_probe = now
             self.first_round = True
 
+    def _probe_list(self) -> tuple[tuple[str, int], ...]:
+        """The addresses we probe, the latest lost first, for the host's NUMBER,
+        NEW_PLAYER and TABLE (at most MAX_PLAYERS)."""
+        if self.now > self.probe_until:                            # type: ignore[attr-defined]
+            return ()
+        latest = sorted(self.lost, key=self.lost.__getitem__, reverse=True)
+        return tuple(latest[:P.MAX_PLAYERS])
+
+    def _take_probe_list(self, addresses: tuple[tuple[str, int], ...]) -> None:
+        """The host's probe list: we probe those players too (without holding joins),
+        so a member that joined after the loss still finds the other side of a
+        partition if the host leaves or dies before its probes do."""
+        here = {(e.ip, e.tcp_port) for e in self.table.values()}          # type: ignore[attr-defined]
+        now = self.now                                                    # type: ignore[attr-defined]
+        new = [a for a in addresses if a not in here and a not in self.lost]
+        if not new or self.closed:                                        # type: ignore[attr-defined]
+            return
+        for a in new:
+            self.lost[a] = now
+        if now > self.probe_until:
+            self.next_probe = now
+        self.probe_until = now + PROBE_LONG
+        self.probe_fast_until = max(self.probe_fast_until, now + PROBE_TIME)
+
     def probing(self) -> bool:
         """Whether joins wait: the first round of probes is not over yet."""
         return self.first_round and (bool(self.probes) or self.next_probe <= self.now)  # type: ignore[attr-defined]
@@ -175,6 +199,17 @@ class TermsMixin:
         self.first_round = False
         self.dropped["stepped_down"] += 1                          # type: ignore[attr-defined]
         self.events.append(NetEvent("stepdown", host, addr, why))  # type: ignore[attr-defined]
+
+    def host_alone(self, address: tuple[str, int, int], now: float) -> None:
+        """The rejoin after stepping down failed (that session's peer left or died on
+        the way): host our own session again at ``address`` (ip, tcp, udp) and go on
+        probing the players we lost, rather than end up in no session at all."""
+        self.join_outcome = None                                      # type: ignore[attr-defined]
+        self.start_host(address, now)                                 # type: ignore[attr-defined]
+        if self.lost:
+            self.probe_until = now + PROBE_LONG
+            self.probe_fast_until = now + PROBE_TIME
+            self.next_probe = now
 
     def forget_session(self, now: float) -> None:
         """Leave what is left of our session (our computer opponents with it) before
