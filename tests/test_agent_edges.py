@@ -9,7 +9,9 @@
   40 degrees, its gun on the sky;
 * fighting with the gun loaded and no shot fired for ``combat.QUIET`` s, it closes in
   along the A* way to the enemy (two tanks at 40 m on different heights, neither shot
-  carrying, stared at each other for 100 s: a 0-0 draw).
+  carrying, stared at each other for 100 s: a 0-0 draw);
+* pitched or rolled more than ``agent.WEDGED`` (up on a rock, not on a slope), it
+  does not drive "up the slope" into the rock but leaves it to the pilot's unstick.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import pytest
 from bot_helpers import view_of
 from tanktool.bots import BotDriver
 from tanktool.sim.agents import Agent
-from tanktool.sim.agents.agent import GRADE
+from tanktool.sim.agents.agent import GRADE, WEDGED
 from tanktool.sim.agents.combat import QUIET
 from tanktool.sim.agents.navigation import agent_grid
 from tanktool.sim.match import load_match_arena, load_tank_spec
@@ -145,3 +147,22 @@ def test_at_the_top_of_a_ramp_too_steep_it_drives_up_first(bridge):
     for _ in range(int(5.0 / w.dt)):
         w.step(None, [drv(w, t), Command()])
     assert t.y > 4.9 and t.z > 16.0
+
+
+def test_up_on_a_rock_it_does_not_drive_up_the_slope(bridge):
+    """At the top of the ramp (where it drives up first) but with the hull pitched
+    more than any slope it climbs, it is wedged on something: no drive up (on the
+    hills it pushed on up a rock at 34 degrees for 3 s, until shot)."""
+    import dataclasses
+
+    w = _world(bridge)
+    drv = BotDriver(Agent("hard"), 1)
+    _placed(w, 6.6, 15.6, 0.41, 5.0)
+    view = view_of(drv, w)
+    agent = drv.bot
+    agent.act(view)
+    assert agent.off_slope(view) is not None          # on the slope: up first
+    me = view.me
+    for k in ("pitch", "roll"):
+        tilted = dataclasses.replace(view, me=dataclasses.replace(me, **{k: WEDGED + 0.1}))
+        assert agent.off_slope(tilted) is None

@@ -54,6 +54,12 @@ _ROAM = ("wander", "watch")
 GRADE = 0.8
 #: off its grid on a slope steeper than this (rise per metre), it drives up it first
 SLOPE = 0.1
+#: ... but not with its hull pitched or rolled more than this [rad] (26 degrees: more
+#: than any slope its engine holds it on): it is up on a rock, not on the slope, and
+#: driving on (the ground's slope round the rock said "up") wedged it there until it
+#: was shot (the hills: 34 degrees nose up on a rock for 3 s, adv 1.0); the pilot's
+#: unstick backs it off instead
+WEDGED = 0.45
 #: free moves on relief look this far ahead [m] beyond the footprint radius, plus the
 #: way covered in EDGE_TIME s [s], for a place off the grid EDGE_RISE m [m] above or
 #: below
@@ -181,7 +187,7 @@ class Agent(Pilot):
         at its foot all duel): up the slope first, whatever the state (its shot is
         kept), while it still can (from a standstill, not once sliding)."""
         nav, me = self.nav, view.me
-        if not view.map.relief or nav is None:
+        if not view.map.relief or nav is None or abs(me.pitch) > WEDGED or abs(me.roll) > WEDGED:
             return None
         g, lv, h = view.map.ground, me.level, 1.5
         gx = g.height(me.x + h, me.z, lv) - g.height(me.x - h, me.z, lv)
