@@ -44,6 +44,51 @@ def surface_clearance(ground: "Ground", limit: float) -> np.ndarray:
     """(L, nz, nx) metres from each surface node's centre to the nearest edge of the
     walkable surface along its links (capped a little above ``limit``; NaN off the
     surface)."""
+    half = 0.5 * ground.cell
+    dist = _grid_chamfer(ground, limit)
+    if dist is not None:
+        return np.where(ground.exists, dist * half, np.nan)
+    return _compact_clearance(ground, limit)
+
+
+def clear_enough(ground: "Ground", clearance: float) -> np.ndarray:
+    """(L, nz, nx) bool: ``surface_clearance(ground, clearance) >= clearance``, without
+    its float64 grid where the kernel runs (a level at a time, from int32 distances)."""
+    dist = _grid_chamfer(ground, clearance)
+    if dist is None:
+        return np.nan_to_num(_compact_clearance(ground, clearance), nan=-1.0) >= clearance
+    half = 0.5 * ground.cell
+    out = np.empty(dist.shape, dtype=bool)
+    for lv in range(len(dist)):   # the same float64 products, one level's temporaries at a time
+        np.greater_equal(dist[lv] * half, clearance, out=out[lv])
+        out[lv] &= ground.exists[lv]
+    return out
+
+
+def _grid_chamfer(ground: "Ground", limit: float) -> np.ndarray | None:
+    """(L, nz, nx) int32 chamfer distances (half cells) by the compiled kernel on the
+    ground's own int8 links (4 bytes a grid node; the compact graph below took 16 a node
+    and int64 temporaries), or None without the kernel."""
+    from ...geometry.kernels import active
+
+    kern = active()
+    fn = getattr(kern, "chamfer_grid", None)
+    if fn is None:
+        return None
+    L, nz, nx = ground.exists.shape
+    dist = np.empty((L, nz, nx), dtype=np.int32)
+    link = np.ascontiguousarray(ground.link, dtype=np.int8)
+    exists = np.ascontiguousarray(ground.exists).view(np.uint8)
+    fn(link, exists, dist, L, nz, nx, _steps(ground, limit))
+    return dist
+
+
+def _steps(ground: "Ground", limit: float) -> int:
+    return int(math.ceil(limit / (0.5 * ground.cell))) + 2
+
+
+def _compact_clearance(ground: "Ground", limit: float) -> np.ndarray:
+    """surface_clearance in numpy: the surface as a compact graph for ``chamfer_clearance``."""
     exists = ground.exists
     L, nz, nx = exists.shape
     per = nz * nx
@@ -60,7 +105,7 @@ def surface_clearance(ground: "Ground", limit: float) -> np.ndarray:
         target = np.where(ok, link[:, d] * per + np.clip(a, 0, nz - 1) * nx + np.clip(b, 0, nx - 1), L * per)
         nb[:, d] = compact[target]
     half = 0.5 * ground.cell
-    steps = int(math.ceil(limit / half)) + 2
+    steps = _steps(ground, limit)
     out = np.full(L * per, np.nan)
     out[node] = chamfer_clearance(nb, steps) * half
     return out.reshape(L, nz, nx)
@@ -75,8 +120,7 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
     and a tank gone down one stays down for the rest of a duel)."""
     fine = ground.cell
     k = max(int(round(cell / fine)), 1)
-    clear = surface_clearance(ground, clearance)
-    ok_fine = np.nan_to_num(clear, nan=-1.0) >= clearance
+    ok_fine = clear_enough(ground, clearance)
     L, nz, nx = ok_fine.shape
     off = k // 2
     NZ, NX = max((nz - off - 1) // k + 1, 1), max((nx - off - 1) // k + 1, 1)

@@ -1,0 +1,204 @@
+"""Matches on large terrains: steps per second and peak memory beside the box arena.
+
+Runs ``tanktool play --headless``'s match (8 computer agents, ``--seconds`` simulated,
+``--seed``) on the bundled box arena and on each terrain bundle given, each in its own
+child process so every peak is that match's alone (the kernel's high-water mark,
+VmHWM, from exec).  A child also times and sizes its phases: loading the bundle, the
+first think of the agents (their layered grid: ``layers.clear_enough`` and
+``ground_agent_grid``; the SolidField of sight), and the match loop; the memory
+column of a phase is the resident size it added at its peak (a sampler thread reads
+VmRSS every few milliseconds).
+
+The terrains come from ``bench/import_arena.py``'s scale series (``terrain(size)``, a
+rolling terrain at 2 m) imported at the default 0.5 m: ``--make 1000,2000 --cache DIR``
+writes the OBJ and imports them into DIR once (a 2 km import takes about a minute and
+3 GB) and reuses them.
+
+    python bench/match_scale.py --cache /tmp/match [--make 1000,2000] [--arena PATH ...]
+                                [--seconds 20] [--bots 8] [--seed 1] [--json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Any, Callable
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "bench"))
+sys.path.insert(0, str(ROOT / "tools"))
+
+#: (phase, "module:qualified name") timed and sized in the child, outermost first
+HOOKS = [
+    ("load", "tanktool.sim.match:load_match_arena"),
+    ("clearance", "tanktool.sim.agents.layers:clear_enough"),
+    ("agent grid", "tanktool.sim.agents.layers:ground_agent_grid"),
+    ("solid field", "tanktool.sim.ground:SolidField.__init__"),
+]
+
+
+def _status(key: str) -> float:
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith(key):
+            return int(line.split()[1]) / 1024
+    return 0.0
+
+
+class Sampler:
+    """The highest VmRSS seen since :meth:`reset` (MB), read every ``period`` s."""
+
+    def __init__(self, period: float = 0.003) -> None:
+        self.period, self.peak = period, 0.0
+        threading.Thread(target=self._run, daemon=True).start()
+
+    def _run(self) -> None:
+        while True:
+            self.peak = max(self.peak, _status("VmRSS:"))
+            time.sleep(self.period)
+
+    def reset(self) -> float:
+        now = _status("VmRSS:")
+        self.peak = now
+        return now
+
+
+def _hook(phases: dict, sampler: Sampler, name: str, spec: str) -> None:
+    import importlib
+
+    mod_name, qual = spec.split(":")
+    obj: Any = importlib.import_module(mod_name)
+    parts = qual.split(".")
+    for p in parts[:-1]:
+        obj = getattr(obj, p)
+    fn: Callable = getattr(obj, parts[-1])
+
+    def wrapped(*a: Any, **k: Any) -> Any:
+        before = sampler.reset()
+        t0 = time.perf_counter()
+        try:
+            return fn(*a, **k)
+        finally:
+            row = phases.setdefault(name, {"seconds": 0.0, "added_mb": 0.0, "calls": 0})
+            row["seconds"] += time.perf_counter() - t0
+            row["added_mb"] = max(row["added_mb"], max(sampler.peak, _status("VmRSS:")) - before)
+            row["calls"] += 1
+
+    setattr(obj, parts[-1], wrapped)
+    # modules that imported the function by name
+    for m in list(sys.modules.values()):
+        if m is not None and getattr(m, parts[-1], None) is fn and m is not obj:
+            setattr(m, parts[-1], wrapped)
+
+
+def child(arena: str, bots: int, seconds: float, seed: int) -> dict:
+    """One match in this process: phases, steps/s, peak (see the module docstring)."""
+    import tanktool.sim.agents.layers  # noqa: F401  (hooked below)
+    import tanktool.sim.agents.navigation  # noqa: F401
+    from tanktool.sim import match
+
+    sampler = Sampler()
+    phases: dict = {}
+    for name, spec in HOOKS:
+        _hook(phases, sampler, name, spec)
+    base = _status("VmRSS:")
+    info = match.load_match_arena(arena)
+    spec = match.load_tank_spec(match.choose_vehicle(info, None, lambda *_: None)
+                                if hasattr(match, "choose_vehicle") else match.default_vehicle())
+    first_step: dict = {}
+    t0 = time.perf_counter()
+    result = match.run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
+                             on_progress=lambda n: first_step.setdefault("s", time.perf_counter() - t0),
+                             progress_every=1)
+    timing = result.report["timing"]
+    return {"arena": info.name, "nodes": _nodes(info), "steps": result.report["steps"],
+            "steps_per_second": timing["steps_per_second"], "wall_s": timing["wall_clock_s"],
+            "first_step_s": round(first_step.get("s", 0.0), 3), "base_mb": round(base, 1),
+            "peak_mb": round(_status("VmHWM:"), 1),
+            "phases": {k: {"seconds": round(v["seconds"], 3), "added_mb": round(v["added_mb"], 1),
+                           "calls": v["calls"]} for k, v in phases.items()}}
+
+
+def _nodes(info: Any) -> int | None:
+    g = getattr(info, "ground", None)
+    return int(g.exists.sum()) if getattr(g, "relief", False) else None
+
+
+def run_child(arena: str, a: argparse.Namespace) -> dict:
+    cmd = [sys.executable, __file__, "--child", arena, "--bots", str(a.bots), "--seconds", str(a.seconds),
+           "--seed", str(a.seed)]
+    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=a.timeout)
+    if proc.returncode != 0:
+        return {"arena": arena, "error": (proc.stderr.strip().splitlines() or ["failed"])[-1]}
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def make_terrains(sizes: list[float], cache: Path) -> list[str]:
+    """Import the scale series' terrain of each size into ``cache`` once (see the docstring)."""
+    import import_arena
+
+    out = []
+    cache.mkdir(parents=True, exist_ok=True)
+    for size in sizes:
+        bundle = cache / f"t{size:g}"
+        if not (bundle / "arena.toml").is_file():
+            obj = import_arena.terrain(size, cache)
+            subprocess.run([sys.executable, "-m", "tanktool", "import-arena", str(obj), "-o", str(bundle)],
+                           check=True, capture_output=True)
+        out.append(str(bundle))
+    return out
+
+
+def print_table(rows: list[dict]) -> None:
+    names = [n for n, _ in HOOKS]
+    print(f"{'arena':<14}{'nodes':>12}{'steps/s':>9}{'x box':>7}{'peak MB':>9}{'1st step s':>11}  "
+          + "".join(f"{n + ' s/MB':>18}" for n in names))
+    for r in rows:
+        if "error" in r:
+            print(f"{r['arena']:<14} error: {r['error']}")
+            continue
+        ph = r["phases"]
+        cells = "".join(f"{ph[n]['seconds']:>9.2f}/{ph[n]['added_mb']:<8.0f}" if n in ph else f"{'-':>18}"
+                        for n in names)
+        print(f"{r['arena']:<14}{r['nodes'] or 0:>12,}{r['steps_per_second']:>9.0f}{r.get('x_box') or 0:>7.2f}"
+              f"{r['peak_mb']:>9.0f}{r['first_step_s']:>11.2f}  " + cells)
+    print("x box: steps/s over the box arena's in this run; MB of a phase: resident size it added at its peak")
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--child", default=None, help=argparse.SUPPRESS)
+    ap.add_argument("--arena", action="append", default=[], help="a terrain bundle (repeatable)")
+    ap.add_argument("--make", default="", help="terrain sizes (m) to import into --cache, e.g. 1000,2000")
+    ap.add_argument("--cache", type=Path, default=Path("/tmp/tanktool-match-scale"))
+    ap.add_argument("--bots", type=int, default=8)
+    ap.add_argument("--seconds", type=float, default=20.0)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--timeout", type=float, default=900.0)
+    ap.add_argument("--json", action="store_true")
+    a = ap.parse_args(argv)
+    if a.child is not None:
+        print(json.dumps(child(a.child, a.bots, a.seconds, a.seed)))
+        return 0
+    arenas = [str(ROOT / "arenas" / "box")] + a.arena
+    if a.make:
+        arenas += make_terrains([float(s) for s in a.make.split(",") if s], a.cache)
+    rows = [run_child(ar, a) for ar in arenas]
+    box = rows[0].get("steps_per_second")
+    for r in rows:
+        if "error" not in r and box:
+            r["x_box"] = round(r["steps_per_second"] / box, 3)
+    if a.json:
+        print(json.dumps({"bots": a.bots, "seconds": a.seconds, "seed": a.seed, "rows": rows}))
+    else:
+        print_table(rows)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

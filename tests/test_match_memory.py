@@ -1,0 +1,59 @@
+"""The agents' clearance of a ground in the compiled kernel on the ground's own links
+(layers.chamfer_grid: no compact graph) gives the numpy path's values exactly."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from tanktool.geometry import kernels
+from tanktool.geometry.kernels import use_kernels
+from tanktool.sim.agents.layers import clear_enough, surface_clearance
+
+ROOT = Path(__file__).resolve().parent.parent
+needs_kernels = pytest.mark.skipif(not kernels.available(), reason="compiled kernels not built")
+
+
+def _random_ground(seed: int, L: int = 2, nz: int = 37, nx: int = 29) -> SimpleNamespace:
+    """Levels of scattered nodes whose links go to random levels (some to no node)."""
+    rng = np.random.default_rng(seed)
+    exists = rng.random((L, nz, nx)) < 0.8
+    link = rng.integers(-1, L, size=(L, nz, nx, 4)).astype(np.int8)
+    link[~exists] = -1
+    return SimpleNamespace(exists=exists, link=link, cell=0.5)
+
+
+def _both(ground, limit: float):
+    with use_kernels(False):
+        slow, slow_ok = surface_clearance(ground, limit), clear_enough(ground, limit)
+    with use_kernels(True):
+        fast, fast_ok = surface_clearance(ground, limit), clear_enough(ground, limit)
+    return slow, fast, slow_ok, fast_ok
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(6))
+def test_random_grounds_have_the_same_clearance(seed):
+    g = _random_ground(seed)
+    if seed % 2:  # few missing links: distances grow far from the edges
+        g.link = np.repeat(np.where(g.exists[..., None], np.int8(0), np.int8(-1)), 4, axis=3)[:1]
+        g.exists = g.exists[:1]
+    for limit in (0.3, 1.0, 4.6):
+        slow, fast, slow_ok, fast_ok = _both(g, limit)
+        np.testing.assert_array_equal(slow, fast)   # NaN where no node, in both
+        np.testing.assert_array_equal(slow_ok, fast_ok)
+
+
+@needs_kernels
+@pytest.mark.parametrize("name", ["fort", "hills"])
+def test_bundled_grounds_have_the_same_clearance(name):
+    from tanktool.sim.match import load_match_arena
+
+    ground = load_match_arena(ROOT / "arenas" / name).ground
+    slow, fast, slow_ok, fast_ok = _both(ground, 3.2)
+    np.testing.assert_array_equal(slow, fast)
+    np.testing.assert_array_equal(slow_ok, fast_ok)
+    assert fast_ok.any()
