@@ -57,3 +57,21 @@ def test_bundled_grounds_have_the_same_clearance(name):
     np.testing.assert_array_equal(slow, fast)
     np.testing.assert_array_equal(slow_ok, fast_ok)
     assert fast_ok.any()
+
+
+@pytest.mark.parametrize("name", ["two_storeys", "rolling_terrain"])
+def test_the_solid_field_in_bands_is_the_solid_field_in_one_go(name, monkeypatch):
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    import make_levels
+
+    from tanktool.sim.solid import SolidField
+
+    m = make_levels.level(name)
+    V, F = np.asarray(m.vertices, dtype=np.float64), np.asarray(m.faces, dtype=np.int64)
+    whole = SolidField(V, F)
+    monkeypatch.setattr(SolidField, "BAND_VOXELS", 1)   # a row at a time
+    rows = SolidField(V, F)
+    assert bytes(rows._bytes) == bytes(whole._bytes) and whole.solid.any()
+    assert rows._tops == whole._tops
