@@ -47,30 +47,44 @@ class MeshIndex:
         v = np.asarray(vertices, dtype=np.float64)
         f = np.asarray(faces, dtype=np.int64)
         self.vertices, self.faces = v, f
-        tri = v[f]
-        self.v0 = tri[:, 0]
-        self.e1 = tri[:, 1] - tri[:, 0]
-        self.e2 = tri[:, 2] - tri[:, 0]
-        lo = tri.min(axis=1)[:, [0, 2]]
-        hi = tri.max(axis=1)[:, [0, 2]]
+        # the triangles' corners and edges are gathered per query (_edges): kept for every
+        # face they took 72 bytes a face (+144 MB on a 2 km terrain), and as much again
+        # in temporaries; the buckets' bookkeeping is int32 (a bucket or face count)
+        lo = np.empty((len(f), 2))
+        hi = np.empty((len(f), 2))
+        for c, axis in enumerate((0, 2)):
+            a, b, cc = v[f[:, 0], axis], v[f[:, 1], axis], v[f[:, 2], axis]
+            lo[:, c] = np.minimum(np.minimum(a, b), cc)
+            hi[:, c] = np.maximum(np.maximum(a, b), cc)
+            del a, b, cc
         self.bucket = float(bucket)
         self.origin = lo.min(axis=0) if len(lo) else np.zeros(2)
-        b0 = np.floor((lo - self.origin) / bucket).astype(np.int64)
-        b1 = np.floor((hi - self.origin) / bucket).astype(np.int64)
+        b0 = np.floor((lo - self.origin) / bucket).astype(np.int32)
+        b1 = np.floor((hi - self.origin) / bucket).astype(np.int32)
+        del lo, hi
         self.width = int(b1[:, 0].max()) + 1 if len(b1) else 1
         self.height = int(b1[:, 1].max()) + 1 if len(b1) else 1
         n = b1 - b0 + 1
-        cnt = n[:, 0] * n[:, 1]
-        owner = np.repeat(np.arange(len(f)), cnt)
-        k = np.arange(len(owner)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        del b1
+        cnt = n[:, 0].astype(np.int64) * n[:, 1]
+        owner = np.repeat(np.arange(len(f), dtype=np.int32 if len(f) < 2**31 else np.int64), cnt)
+        k = np.arange(len(owner), dtype=np.int64) - np.repeat(np.cumsum(cnt) - cnt, cnt)
         bi = b0[owner, 0] + k % n[owner, 0]
         bj = b0[owner, 1] + k // n[owner, 0]
-        key = bj * self.width + bi
+        del k, b0, n
+        key = bj.astype(np.int64) * self.width + bi
+        del bi, bj
         order = np.argsort(key, kind="stable")
-        self._faces = owner[order]
+        self._faces = owner[order].astype(np.int64)
+        del owner, order
         self._start = np.zeros(self.width * self.height + 1, dtype=np.int64)
         np.cumsum(np.bincount(key, minlength=self.width * self.height), out=self._start[1:])
         self.y_min = float(v[:, 1].min()) if len(v) else 0.0
+
+    def _edges(self, cand: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(first corner, first edge, second edge) of faces ``cand``, (n, 3) each."""
+        tri = self.vertices[self.faces[cand]]
+        return tri[:, 0], tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
 
     def _candidates(self, ax: float, az: float, bx: float, bz: float) -> np.ndarray:
         """Faces in the buckets the segment's (x, z) projection passes (its box of buckets,
@@ -111,7 +125,7 @@ class MeshIndex:
             return None
         ax, ay, az = a
         dx, dy, dz = b[0] - ax, b[1] - ay, b[2] - az
-        e1, e2, v0 = self.e1[cand], self.e2[cand], self.v0[cand]
+        v0, e1, e2 = self._edges(cand)
         # Moller-Trumbore, both faces
         px = dy * e2[:, 2] - dz * e2[:, 1]
         py = dz * e2[:, 0] - dx * e2[:, 2]
@@ -144,7 +158,7 @@ class MeshIndex:
             return None
         a = p[:-1, None, :]                       # (K, 1, 3)
         d = (p[1:] - p[:-1])[:, None, :]          # (K, 1, 3)
-        e1, e2, v0 = self.e1[cand][None], self.e2[cand][None], self.v0[cand][None]
+        v0, e1, e2 = (x[None] for x in self._edges(cand))
         pv = np.cross(d, e2)
         det = (e1 * pv).sum(axis=2)
         ok = np.abs(det) > 1e-12
