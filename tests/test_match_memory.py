@@ -75,3 +75,20 @@ def test_the_solid_field_in_bands_is_the_solid_field_in_one_go(name, monkeypatch
     rows = SolidField(V, F)
     assert bytes(rows._bytes) == bytes(whole._bytes) and whole.solid.any()
     assert rows._tops == whole._tops
+
+
+@pytest.mark.parametrize("name", ["fort", "hills"])
+def test_level_ground_in_bands_is_level_ground_in_one_go(name, monkeypatch):
+    from tanktool.sim import ground as ground_mod
+    from tanktool.sim.match import load_match_arena
+
+    h = load_match_arena(ROOT / "arenas" / name).ground.h
+    h = np.floor(h / 3.0) * 3.0   # terraces: level ground beside its edges
+    whole = ground_mod.Ground._level_ground(h)
+    monkeypatch.setattr(ground_mod, "GROUND_BAND", 7)
+    assert np.array_equal(ground_mod.Ground._level_ground(h), whole) and whole.any()
+    stacked = np.concatenate([h, h - 5.0])   # two levels over each other: near another level
+    monkeypatch.setattr(ground_mod, "GROUND_BAND", 256)
+    whole2 = ground_mod.Ground._level_ground(stacked)
+    monkeypatch.setattr(ground_mod, "GROUND_BAND", 5)
+    assert np.array_equal(ground_mod.Ground._level_ground(stacked), whole2)

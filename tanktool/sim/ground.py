@@ -36,6 +36,8 @@ from .solid import FEW_LINES, SolidField  # noqa: F401  (here before sim/solid.p
 
 #: a node is "level ground" when every node this many cells around it has its height
 FLAT_CELLS = 10
+#: rows of a level filtered at a time (Ground._level_ground)
+GROUND_BAND = 256
 #: steps across the grid: +x, +z, -x, -z as (di, dj), the navgrid's link order
 STEPS = ((0, 1), (1, 0), (0, -1), (-1, 0))
 
@@ -228,14 +230,23 @@ class Ground:
         reach = reach or FLAT_CELLS
         size = 2 * reach + 1
         have = np.isfinite(h)
+        L, nz = h.shape[:2]
         out = np.zeros(h.shape, dtype=bool)
-        for lv in range(h.shape[0]):
-            hv, ok = h[lv], have[lv]
-            hi = ndimage.maximum_filter(np.where(ok, hv, -np.inf), size=size, mode="nearest")
-            lo = ndimage.minimum_filter(np.where(ok, hv, np.inf), size=size, mode="nearest")
-            others = have[np.arange(h.shape[0]) != lv].any(axis=0)
-            near_other = ndimage.maximum_filter(others.astype(np.uint8), size=size, mode="constant") > 0
-            out[lv] = ok & (hi - lo <= 1e-6) & ~near_other
+        # in bands of rows with ``reach`` rows either side: a window never leaves its
+        # band but at the grid's own edges, so the filters' values are the whole
+        # grid's, with a band's float64 temporaries (five whole levels of them took
+        # +640 MB on a 2 km terrain)
+        for lv in range(L):
+            others = have[np.arange(L) != lv]
+            for r0 in range(0, nz, GROUND_BAND):
+                r1 = min(r0 + GROUND_BAND, nz)
+                a, b = max(r0 - reach, 0), min(r1 + reach, nz)
+                hv, ok = h[lv, a:b], have[lv, a:b]
+                hi = ndimage.maximum_filter(np.where(ok, hv, -np.inf), size=size, mode="nearest")
+                lo = ndimage.minimum_filter(np.where(ok, hv, np.inf), size=size, mode="nearest")
+                near = ndimage.maximum_filter(others[:, a:b].any(axis=0).astype(np.uint8), size=size,
+                                              mode="constant") > 0
+                out[lv, r0:r1] = (ok & (hi - lo <= 1e-6) & ~near)[r0 - a:r1 - a]
         return out
 
     # ------------------------------------------------------------------ cells
