@@ -59,9 +59,11 @@ def clear_enough(ground: "Ground", clearance: float) -> np.ndarray:
         return np.nan_to_num(_compact_clearance(ground, clearance), nan=-1.0) >= clearance
     half = 0.5 * ground.cell
     out = np.empty(dist.shape, dtype=bool)
-    for lv in range(len(dist)):   # the same float64 products, one level's temporaries at a time
-        np.greater_equal(dist[lv] * half, clearance, out=out[lv])
-        out[lv] &= ground.exists[lv]
+    flat, done, ex = dist.reshape(-1), out.reshape(-1), ground.exists.reshape(-1)
+    for a in range(0, len(flat), 1 << 20):   # the same float64 products, a million at a time
+        b = a + (1 << 20)
+        np.greater_equal(flat[a:b] * half, clearance, out=done[a:b])
+        done[a:b] &= ex[a:b]
     return out
 
 
@@ -124,12 +126,13 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
     L, nz, nx = ok_fine.shape
     off = k // 2
     NZ, NX = max((nz - off - 1) // k + 1, 1), max((nx - off - 1) // k + 1, 1)
-    ii = off + k * np.arange(NZ)
-    jj = off + k * np.arange(NX)
+    # int32 node indices: the walks below hold several whole coarse grids of them
+    ii = (off + k * np.arange(NZ)).astype(np.int32)
+    jj = (off + k * np.arange(NX)).astype(np.int32)
     valid = ok_fine[:, ii][:, :, jj]
     heights = ground.h[:, ii][:, :, jj]
     link = np.full((L, NZ, NX, 4), -1, dtype=np.int8)
-    lvl = np.broadcast_to(np.arange(L)[:, None, None], valid.shape)
+    lvl = np.broadcast_to(np.arange(L, dtype=np.int32)[:, None, None], valid.shape)
     I = np.broadcast_to(ii[None, :, None], valid.shape)
     J = np.broadcast_to(jj[None, None, :], valid.shape)
     fl = ground.link
