@@ -11,7 +11,7 @@ import pytest
 
 from tanktool.geometry import kernels
 from tanktool.geometry.kernels import use_kernels
-from tanktool.sim.agents.layers import clear_enough, surface_clearance
+from tanktool.sim.agents.layers import _clear_enough, clear_enough, surface_clearance
 
 ROOT = Path(__file__).resolve().parent.parent
 needs_kernels = pytest.mark.skipif(not kernels.available(), reason="compiled kernels not built")
@@ -28,9 +28,9 @@ def _random_ground(seed: int, L: int = 2, nz: int = 37, nx: int = 29) -> SimpleN
 
 def _both(ground, limit: float):
     with use_kernels(False):
-        slow, slow_ok = surface_clearance(ground, limit), clear_enough(ground, limit)
+        slow, slow_ok = surface_clearance(ground, limit), _clear_enough(ground, limit)
     with use_kernels(True):
-        fast, fast_ok = surface_clearance(ground, limit), clear_enough(ground, limit)
+        fast, fast_ok = surface_clearance(ground, limit), _clear_enough(ground, limit)
     return slow, fast, slow_ok, fast_ok
 
 
@@ -57,6 +57,9 @@ def test_bundled_grounds_have_the_same_clearance(name):
     np.testing.assert_array_equal(slow, fast)
     np.testing.assert_array_equal(slow_ok, fast_ok)
     assert fast_ok.any()
+    kept = clear_enough(ground, 3.2)   # the last mask, kept per ground
+    assert np.array_equal(kept, fast_ok) and clear_enough(ground, 3.2) is kept
+    assert clear_enough(ground, 2.0) is not kept
 
 
 @pytest.mark.parametrize("name", ["two_storeys", "rolling_terrain"])
