@@ -95,3 +95,17 @@ def test_level_ground_in_bands_is_level_ground_in_one_go(name, monkeypatch):
     whole2 = ground_mod.Ground._level_ground(stacked)
     monkeypatch.setattr(ground_mod, "GROUND_BAND", 5)
     assert np.array_equal(ground_mod.Ground._level_ground(stacked), whole2)
+
+
+def test_lazy_rows_keep_at_most_their_rows_and_read_the_same():
+    from tanktool.sim.lazy_rows import LazyRows, plain_row, tuple_row
+
+    rng = np.random.default_rng(3)
+    link = rng.integers(-1, 2, size=(40, 9, 4)).astype(np.int8)
+    rows = LazyRows(link, tuple_row, keep=5)
+    for i in rng.integers(0, 40, size=300).tolist():
+        assert [list(t) for t in rows[i]] == link[i].tolist()
+        assert dict.__len__(rows) <= 5
+    assert rows[3][4][2] == int(link[3, 4, 2]) and type(rows[3][4][2]) is int
+    whole = LazyRows(link, plain_row)
+    assert [whole[i] for i in range(40)] and dict.__len__(whole) == 40 and len(whole) == 40

@@ -31,11 +31,13 @@ from typing import Any
 
 import numpy as np
 
-from .lazy_rows import heights_row, lazy_levels, plain_row
+from .lazy_rows import heights_row, lazy_levels, plain_row, tuple_row
 from .solid import FEW_LINES, SolidField  # noqa: F401  (here before sim/solid.py)
 
 #: a node is "level ground" when every node this many cells around it has its height
 FLAT_CELLS = 10
+#: rows of each level kept as Python lists (sim/lazy_rows.py): the tanks' rows and more
+ROWS_KEPT = 512
 #: rows of a level filtered at a time (Ground._level_ground)
 GROUND_BAND = 256
 #: steps across the grid: +x, +z, -x, -z as (di, dj), the navgrid's link order
@@ -201,11 +203,11 @@ class Ground:
         self._solids: SolidField | None = None
         self.exists = np.isfinite(h)
         # plain nested lists: the per-tank lookups below are scalar Python (rows made on first use)
-        self._h = lazy_levels(h, heights_row)
-        self._link = lazy_levels(self.link, plain_row)
+        self._h = lazy_levels(h, heights_row, ROWS_KEPT)
+        self._link = lazy_levels(self.link, tuple_row, ROWS_KEPT)
         # nodes whose whole neighbourhood (FLAT_CELLS around) has their own height:
         # a tank standing there is level, no sampling needed (most of a fort's floor)
-        self._flat = lazy_levels(self._level_ground(h), plain_row)
+        self._flat = lazy_levels(self._level_ground(h), plain_row, ROWS_KEPT)
 
     @property
     def solids(self) -> SolidField | None:
