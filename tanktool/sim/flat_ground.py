@@ -105,9 +105,12 @@ def load_ground(bundle: Any) -> "Any":
         if len(hv) and not float(hv.min()) - FLAT_RANGE <= y <= float(hv.max()) + FLAT_RANGE:
             y = float(np.median(hv))
         return FlatGround(bundle.bounds, y, climb)
+    # the ground first and the grid let go before the model loads: the grid's other
+    # arrays (runs, validity) and the model's at once set a 2 km terrain's peak
+    ground = Ground(grid, None, climb)
+    del grid, h, hv
     model = bundle.file("model")
-    mesh = None
     if model.is_file():
         m = load_model(model, up="y")
-        mesh = MeshIndex(np.asarray(m.vertices), np.asarray(m.faces))
-    return Ground(grid, mesh, climb)
+        ground.mesh = MeshIndex(np.asarray(m.vertices), np.asarray(m.faces))
+    return ground
