@@ -79,15 +79,19 @@ def _hook(phases: dict, sampler: Sampler, name: str, spec: str) -> None:
     fn: Callable = getattr(obj, parts[-1])
 
     def wrapped(*a: Any, **k: Any) -> Any:
+        outer = sampler.peak   # an enclosing phase's peak so far (nested hooks)
         before = sampler.reset()
         t0 = time.perf_counter()
         try:
             return fn(*a, **k)
         finally:
-            row = phases.setdefault(name, {"seconds": 0.0, "added_mb": 0.0, "calls": 0})
+            peak = max(sampler.peak, _status("VmRSS:"))
+            row = phases.setdefault(name, {"seconds": 0.0, "added_mb": 0.0, "peak_mb": 0.0, "calls": 0})
             row["seconds"] += time.perf_counter() - t0
-            row["added_mb"] = max(row["added_mb"], max(sampler.peak, _status("VmRSS:")) - before)
+            row["added_mb"] = max(row["added_mb"], peak - before)
+            row["peak_mb"] = max(row["peak_mb"], peak)
             row["calls"] += 1
+            sampler.peak = max(outer, peak)
 
     setattr(obj, parts[-1], wrapped)
     # modules that imported the function by name
@@ -121,7 +125,7 @@ def child(arena: str, bots: int, seconds: float, seed: int) -> dict:
             "first_step_s": round(first_step.get("s", 0.0), 3), "base_mb": round(base, 1),
             "peak_mb": round(_status("VmHWM:"), 1),
             "phases": {k: {"seconds": round(v["seconds"], 3), "added_mb": round(v["added_mb"], 1),
-                           "calls": v["calls"]} for k, v in phases.items()}}
+                           "peak_mb": round(v["peak_mb"], 1), "calls": v["calls"]} for k, v in phases.items()}}
 
 
 def _nodes(info: Any) -> int | None:
