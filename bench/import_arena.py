@@ -147,8 +147,9 @@ def profile_one(spec: str, work: Path) -> dict:
     stages = {k: prof.stages.get(k, 0.0) for k in STAGES[:-1]}
     stages["other"] = max(total - sum(stages.values()), 0.0)
     p = r.params
+    tank_grid = r.levels.grid if r.levels.grid is not None else r.grid.grid   # the import lets its own go
     return {"faces": int(r.faces), "walls": len(r.walls), "spawns": len(r.spawns),
-            "levels": len(r.levels.levels), "nodes": int(r.levels.grid.valid.sum()),
+            "levels": len(r.levels.levels), "nodes": int(tank_grid.valid.sum()),
             "seconds": total, "cpu_seconds": cpu, "import_seconds": t_import, "modules_seconds": t_modules, "two_step": two_step,
             "stages": stages, "stage_peak_mb": {k: round(v, 1) for k, v in prof.peak_mb.items()},
             "missing_hooks": prof.missing, "kernels": kernels_active(),

@@ -24,6 +24,7 @@ from .arena import MANIFEST, MIN_SPAWNS, NAVGRID_DEFAULTS, walkable_params
 from .errors import ArenaError
 from .formats.limits import check_cells
 from .formats.walls_txt import WallList
+from .memory import GIVE_BACK_MIN, give_back
 
 
 # ---------------------------------------------------------------------------
@@ -43,8 +44,8 @@ class ImportResult:
     thin_walls: int
     seconds: float
     warnings: list[str] = field(default_factory=list)   # non-fatal remarks (a .bzw's unknown objects)
-    levels: Any = None  # nav.arena_levels.ArenaLevels: levels, what was left out, the tank grid (its surface
-    #                     is let go (None) once the pictures are drawn: the import's peak memory)
+    levels: Any = None  # nav.arena_levels.ArenaLevels: levels, what was left out (its surface, model and,
+    #                     with a grid built, tank grid are let go (None) once the pictures are drawn)
     params: Any = None  # the WalkableParams used
     defaults: dict[str, str] = field(default_factory=dict)  # where each default came from
     grid: Any = None    # grid_files.BuiltGrid: the navigation grid written with the bundle (None: not built)
@@ -131,7 +132,10 @@ def import_arena(
     if progress:
         progress("read")
     mesh = _one_mesh(model, scene, params.cell, max_cells)
+    give_back(GIVE_BACK_MIN)   # the parser's temporaries (2 km terrain: ~0.36 GB of free heap kept)
     result = _analyse(model, mesh, params, fleet, height, tolerance, progress)
+    n_faces, model_left_out = len(mesh.faces), list(scene.metadata.get("left_out", []))
+    del mesh   # scene.dump()'s copy: the analysis keeps the arrays it needs (vertices, faces)
     others = _vehicle_grids(result, fleet, remark)
     fits = _remark_fit(model, result, fleet, remark, others)
     src_up = up or default_up(fmt)
@@ -147,14 +151,26 @@ def import_arena(
         if others:   # one grid per smaller vehicle: grid_files builds navgrid.<vehicle>.npz from these
             doc["grids"] = others
         write_toml(tmp / MANIFEST, doc)
-        # the surface (~100 bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m) is not
-        # needed past the pictures, and the grid below builds its own: let go before it
-        result.surface = None
+        # the surface (~100 bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m), the
+        # analysis grid and the model are not needed past the pictures, and the grid below
+        # builds its own from the staged bundle: let go before it (2 km terrain: ~0.9 GB)
+        scene = None
+        _let_go(result, grid)
         # the same files, built the same way, as build-navgrid on the bundle
         built = _stage_grid(tmp, fits, remark, progress) if grid else None
-    return ImportResult(target, name, result.walls.walls, result.spawns, result.floor_y, len(mesh.faces),
+    return ImportResult(target, name, result.walls.walls, result.spawns, result.floor_y, n_faces,
                         result.walls.thin_walls, time.perf_counter() - t0, warnings, result, params, where, built,
-                        list(scene.metadata.get("left_out", [])))
+                        model_left_out)
+
+
+def _let_go(result: Any, grid: bool) -> None:
+    """Drop the analysis' large arrays once the pictures are drawn: its surface, the
+    model it holds and (when the grid stage builds the bundle's own) its tank grid."""
+    result.surface = None
+    result.vertices = result.faces = None
+    if grid:
+        result.grid = None   # ImportResult.grid holds the grid written with the bundle
+    give_back(GIVE_BACK_MIN)
 
 
 def _check_options(model: Path, out: str | os.PathLike | None, name: str | None, force: bool, height: float,
