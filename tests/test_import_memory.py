@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from tanktool.importer import import_arena
 from tanktool.nav import surface_report
@@ -45,3 +46,30 @@ def test_import_lets_go_of_the_analysis_before_the_grid(tmp_path):
     # without the grid stage the analysis grid is what the import has: kept
     r = import_arena(model, tmp_path / "room2", grid=False)
     assert r.grid is None and r.levels.grid is not None and r.levels.surface is None
+
+
+@pytest.mark.parametrize("bucket", [8.0, 0.5])   # 0.5: faces over 4096 buckets, tested by every point
+def test_faces_above_for_a_few_points_counts_as_the_bucket_index(monkeypatch, bucket):
+    from tanktool.geometry import segments
+
+    rng = np.random.default_rng(11)
+    for trial in range(6):
+        vertices = rng.uniform(-50, 50, size=(300, 3))
+        if trial % 2:
+            vertices = np.round(vertices)   # shared edges and corners: the half-open edges matter
+        faces = rng.integers(0, 300, size=(2000, 3))
+        points = np.concatenate([rng.uniform(-60, 60, size=(12, 3)), vertices[:4]])
+        monkeypatch.setattr(segments, "FEW_POINTS", 0)
+        want = segments.faces_above(points, vertices, faces, bucket)
+        monkeypatch.setattr(segments, "FEW_POINTS", 32)
+        monkeypatch.setattr(segments, "FEW_BLOCK", 97)
+        assert np.array_equal(segments.faces_above(points, vertices, faces, bucket), want)
+
+
+def test_member_is_isin():
+    rng = np.random.default_rng(5)
+    labels = rng.integers(0, 40, size=1000).astype(np.int32)
+    for keep in (np.array([3, 7, 39]), np.array([], dtype=np.int64), np.array([-1, 0, 100])):
+        assert np.array_equal(surface_report._member(labels, keep), np.isin(labels, keep))
+    neg = labels - 5   # negative labels: isin itself
+    assert np.array_equal(surface_report._member(neg, np.array([-5, 2])), np.isin(neg, [-5, 2]))
