@@ -206,6 +206,9 @@ class TermsMixin:
         probing the players we lost, rather than end up in no session at all."""
         self.join_outcome = None                                      # type: ignore[attr-defined]
         self.start_host(address, now)                                 # type: ignore[attr-defined]
+        # a term of our own: a lone host numbered 1 under the old term would read the
+        # session it left (host 1 there too) as its own and never step down to it
+        self.term += 1
         if self.lost:
             self.probe_until = now + PROBE_LONG
             self.probe_fast_until = now + PROBE_TIME
