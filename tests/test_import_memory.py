@@ -73,3 +73,19 @@ def test_member_is_isin():
         assert np.array_equal(surface_report._member(labels, keep), np.isin(labels, keep))
     neg = labels - 5   # negative labels: isin itself
     assert np.array_equal(surface_report._member(neg, np.array([-5, 2])), np.isin(neg, [-5, 2]))
+
+
+def test_focus_box_in_blocks_is_the_whole_models(monkeypatch):
+    import tanktool.geometry.heightfield as heightfield
+    from tanktool.nav.arena_levels import focus_box
+
+    plane = [[-1000, 0, -1000], [1000, 0, -1000], [1000, 0, 1000], [-1000, 0, 1000]]
+    rng = np.random.default_rng(2)
+    vertices = np.concatenate([plane, rng.uniform(-50, 50, size=(50, 3))])
+    faces = np.concatenate([[[0, 1, 2], [0, 2, 3]], rng.integers(4, 54, size=(25, 3))])
+    want = focus_box(vertices, faces, 3.0)
+    monkeypatch.setattr(heightfield, "FACE_BLOCK", 4)
+    got = focus_box(vertices, faces, 3.0)
+    rest = vertices[faces[2:]].reshape(-1, 3)[:, [0, 2]]
+    assert np.array_equal(got, want) and np.array_equal(got, [rest.min(axis=0) - 3.0, rest.max(axis=0) + 3.0])
+    assert focus_box(vertices, faces[:2], 3.0) is None   # nothing but the plane
