@@ -114,15 +114,16 @@ def child(arena: str, bots: int, seconds: float, seed: int) -> dict:
     info = match.load_match_arena(arena)
     spec = match.load_tank_spec(match.choose_vehicle(info, None, lambda *_: None)
                                 if hasattr(match, "choose_vehicle") else match.default_vehicle())
-    first_step: dict = {}
+    ticks: list[float] = []   # when each step ended
     t0 = time.perf_counter()
     result = match.run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
-                             on_progress=lambda n: first_step.setdefault("s", time.perf_counter() - t0),
-                             progress_every=1)
+                             on_progress=lambda n: ticks.append(time.perf_counter()), progress_every=1)
     timing = result.report["timing"]
+    after = (len(ticks) - 1) / (ticks[-1] - ticks[0]) if len(ticks) > 1 and ticks[-1] > ticks[0] else None
     return {"arena": info.name, "nodes": _nodes(info), "steps": result.report["steps"],
             "steps_per_second": timing["steps_per_second"], "wall_s": timing["wall_clock_s"],
-            "first_step_s": round(first_step.get("s", 0.0), 3), "base_mb": round(base, 1),
+            "after_first_steps_per_second": round(after, 1) if after else None,
+            "first_step_s": round(ticks[0] - t0, 3) if ticks else None, "base_mb": round(base, 1),
             "peak_mb": round(_status("VmHWM:"), 1),
             "phases": {k: {"seconds": round(v["seconds"], 3), "added_mb": round(v["added_mb"], 1),
                            "peak_mb": round(v["peak_mb"], 1), "calls": v["calls"]} for k, v in phases.items()}}
@@ -160,7 +161,8 @@ def make_terrains(sizes: list[float], cache: Path) -> list[str]:
 
 def print_table(rows: list[dict]) -> None:
     names = [n for n, _ in HOOKS]
-    print(f"{'arena':<14}{'nodes':>12}{'steps/s':>9}{'x box':>7}{'peak MB':>9}{'1st step s':>11}  "
+    print(f"{'arena':<14}{'nodes':>12}{'steps/s':>9}{'x box':>7}{'later':>8}{'x box':>7}{'peak MB':>9}"
+          f"{'1st step s':>11}  "
           + "".join(f"{n + ' s/MB':>18}" for n in names))
     for r in rows:
         if "error" in r:
@@ -170,8 +172,11 @@ def print_table(rows: list[dict]) -> None:
         cells = "".join(f"{ph[n]['seconds']:>9.2f}/{ph[n]['added_mb']:<8.0f}" if n in ph else f"{'-':>18}"
                         for n in names)
         print(f"{r['arena']:<14}{r['nodes'] or 0:>12,}{r['steps_per_second']:>9.0f}{r.get('x_box') or 0:>7.2f}"
-              f"{r['peak_mb']:>9.0f}{r['first_step_s']:>11.2f}  " + cells)
-    print("x box: steps/s over the box arena's in this run; MB of a phase: resident size it added at its peak")
+              f"{r['after_first_steps_per_second'] or 0:>8.0f}{r.get('x_box_later') or 0:>7.2f}"
+              f"{r['peak_mb']:>9.0f}{r['first_step_s'] or 0:>11.2f}  " + cells)
+    print("steps/s: the match loop's (tanktool play's figure, the agents' first think included); later: the steps"
+          " after the first; x box: over the box arena's in this run; 1st step s: from loading to the first"
+          " step's end (World, first think); MB of a phase: resident size it added at its peak")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -193,10 +198,12 @@ def main(argv: list[str] | None = None) -> int:
     if a.make:
         arenas += make_terrains([float(s) for s in a.make.split(",") if s], a.cache)
     rows = [run_child(ar, a) for ar in arenas]
-    box = rows[0].get("steps_per_second")
+    box, box_later = rows[0].get("steps_per_second"), rows[0].get("after_first_steps_per_second")
     for r in rows:
         if "error" not in r and box:
             r["x_box"] = round(r["steps_per_second"] / box, 3)
+        if "error" not in r and box_later and r.get("after_first_steps_per_second"):
+            r["x_box_later"] = round(r["after_first_steps_per_second"] / box_later, 3)
     if a.json:
         print(json.dumps({"bots": a.bots, "seconds": a.seconds, "seed": a.seed, "rows": rows}))
     else:
