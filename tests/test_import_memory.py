@@ -89,3 +89,17 @@ def test_focus_box_in_blocks_is_the_whole_models(monkeypatch):
     rest = vertices[faces[2:]].reshape(-1, 3)[:, [0, 2]]
     assert np.array_equal(got, want) and np.array_equal(got, [rest.min(axis=0) - 3.0, rest.max(axis=0) + 3.0])
     assert focus_box(vertices, faces[:2], 3.0) is None   # nothing but the plane
+
+
+def test_one_placed_mesh_is_analysed_without_a_copy(tmp_path):
+    from pathlib import Path
+
+    from tanktool.formats.models import load_scene
+    from tanktool.importer import _one_mesh
+
+    model = write_room(tmp_path / "room.obj")
+    scene = load_scene(model)
+    mesh = _one_mesh(Path(model), scene, 0.5, None)
+    assert mesh is next(iter(scene.geometry.values()))   # the scene's own mesh, not dump()'s copy
+    (dumped,) = scene.dump()
+    assert np.array_equal(mesh.vertices, dumped.vertices) and np.array_equal(mesh.faces, dumped.faces)
