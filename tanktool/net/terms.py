@@ -167,8 +167,9 @@ class TermsMixin:
         # sides see the same two numbers: two peers left alone do not stay apart).  A
         # member dropped by silence that made itself host of its own one-player session
         # (term + 1) draws nobody to it.  Our own term and host number is our own session
-        # seen by a peer that has not caught up (a kicked player's last view): not another
-        if (body.term, body.host) == (self.term, self.host_number):
+        # seen by a peer that has not caught up (a kicked player's last view): not another.
+        # Alone we have no session to see late: the same two numbers are another's
+        if (body.term, body.host) == (self.term, self.host_number) and self._others():
             self._one_sided(link.addr)
             return
         if (body.players, body.term, -body.host) > (len(self._others()) + 1, self.term, -self.host_number):
