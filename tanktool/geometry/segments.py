@@ -202,13 +202,22 @@ def faces_above(points: np.ndarray, vertices: np.ndarray, faces: np.ndarray, buc
         cand = np.concatenate([owner[a:b], big]) if (pb[m] >= 0).all() and pb[m, 0] < width else big
         if len(cand) == 0:
             continue
-        dd = det[cand]
-        u = ((x - ax[cand]) * (cz[cand] - az[cand]) - (cx[cand] - ax[cand]) * (z - az[cand])) / dd
-        v = ((bx[cand] - ax[cand]) * (z - az[cand]) - (x - ax[cand]) * (bz[cand] - az[cand])) / dd
-        inside = (u >= 0) & (v >= 0) & (u + v < 1)
-        h = ay[cand] + u * (by[cand] - ay[cand]) + v * (cy[cand] - ay[cand])
-        out[m] = int(np.count_nonzero(inside & (h > y)))
+        out[m] = _above_count((x, y, z), cand, (ax, ay, az, bx, by, bz, cx, cy, cz), det)
     return out
+
+
+def _above_count(point: tuple, cand: np.ndarray, corners: tuple, det: np.ndarray) -> int:
+    """How many of the candidate faces (corner coordinate arrays ax..cz) lie above
+    ``point`` (x, y, z): the point's (x, z) inside the face's projection, the face's
+    height there above y."""
+    x, y, z = point
+    ax, ay, az, bx, by, bz, cx, cy, cz = (c[cand] for c in corners)
+    dd = det[cand]
+    u = ((x - ax) * (cz - az) - (cx - ax) * (z - az)) / dd
+    v = ((bx - ax) * (z - az) - (x - ax) * (bz - az)) / dd
+    inside = (u >= 0) & (v >= 0) & (u + v < 1)
+    h = ay + u * (by - ay) + v * (cy - ay)
+    return int(np.count_nonzero(inside & (h > y)))
 
 
 #: up to this many points faces_above scans the faces a block at a time (no bucket index)
@@ -244,10 +253,5 @@ def _faces_above_few(p: np.ndarray, vertices: np.ndarray, faces: np.ndarray, buc
             cand = np.flatnonzero((det != 0) & (~small | covers))
             if len(cand) == 0:
                 continue
-            dd = det[cand]
-            u = ((x - ax[cand]) * (cz[cand] - az[cand]) - (cx[cand] - ax[cand]) * (z - az[cand])) / dd
-            v = ((bx[cand] - ax[cand]) * (z - az[cand]) - (x - ax[cand]) * (bz[cand] - az[cand])) / dd
-            inside = (u >= 0) & (v >= 0) & (u + v < 1)
-            h = ay[cand] + u * (by[cand] - ay[cand]) + v * (cy[cand] - ay[cand])
-            out[m] += int(np.count_nonzero(inside & (h > y)))
+            out[m] += _above_count((x, y, z), cand, (ax, ay, az, bx, by, bz, cx, cy, cz), det)
     return out
