@@ -340,6 +340,22 @@ def test_a_rejoin_whose_target_dies_hosts_alone_and_finds_the_others_later():
     assert sorted(n.name for n in live(net)) == sorted(["alice"] + [n.name for n in others if n is not target])
 
 
+def test_a_lone_peer_does_not_step_down_to_a_full_session():
+    """A full session (8 players) would refuse a rejoin: a lone peer probing it stays
+    the host of its own, instead of stepping down and failing again at every probe
+    (chaos seed 771 raised its term 70 times)."""
+    net = SimCluster(seed=14, **BAD)
+    host = net.host("alice")
+    for k in range(7):
+        net.join(f"p{k}", host, settle=0.5)
+    net.run(2.0)
+    assert len(host.core.table) == 8
+    zed = net.host("zed")
+    zed.core._take_probe_list(((host.ip, host.address[1]),))
+    net.run(5.0)
+    assert zed.core.is_host and not kinds(zed, "stepdown") and zed.core.term == 1
+
+
 # ---------------------------------------------------------------- determinism, finding 8
 def _story(seed: int) -> list:
     net = SimCluster(seed=seed, **BAD)

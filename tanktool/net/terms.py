@@ -172,6 +172,8 @@ class TermsMixin:
         if (body.term, body.host) == (self.term, self.host_number) and self._others():
             self._one_sided(link.addr)
             return
+        if body.players >= P.MAX_PLAYERS:
+            return                 # a full session would refuse us: no reason to leave ours
         if (body.players, body.term, -body.host) > (len(self._others()) + 1, self.term, -self.host_number):
             if self.is_host:                     # type: ignore[attr-defined]
                 # our members follow us there, rather than electing one of them
