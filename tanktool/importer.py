@@ -108,7 +108,7 @@ def import_arena(
     from .fleet import bundled_fleet
     from .formats.bundle import write_toml
     from .formats.bundle_swap import staged_dir
-    from .formats.models import default_up, detect_format, load_scene
+    from .formats.models import default_up, detect_format
 
     t0 = time.perf_counter()
     model = Path(model)
@@ -122,38 +122,29 @@ def import_arena(
             warn(message)
 
     fleet = bundled_fleet(warn=remark)
-    nav = dict(NAVGRID_DEFAULTS)
-    nav.update(navgrid or {})
+    nav = {**NAVGRID_DEFAULTS, **(navgrid or {})}
     params, where = walkable_params(cell if cell is not None else nav.get("cell"), max_slope, climb, headroom,
                                     fleet, walkable)
     _check_heights(params.climb, height, wall_height)
-    scene = load_scene(model, up=up, scale=scale, warn=remark, wall_height=wall_height,
-                       wall_thickness=wall_thickness, progress=progress)
-    if progress:
-        progress("read")
-    mesh = _one_mesh(model, scene, params.cell, max_cells)
-    give_back(GIVE_BACK_MIN)   # the parser's temporaries (2 km terrain: ~0.36 GB of free heap kept)
+    scene, mesh = _read_mesh(model, params.cell, max_cells, progress, up=up, scale=scale, warn=remark,
+                             wall_height=wall_height, wall_thickness=wall_thickness)
     result = _analyse(model, mesh, params, fleet, height, tolerance, progress)
     n_faces, model_left_out = len(mesh.faces), list(scene.metadata.get("left_out", []))
     del mesh   # scene.dump()'s copy: the analysis keeps the arrays it needs (vertices, faces)
     others = _vehicle_grids(result, fleet, remark)
     fits = _remark_fit(model, result, fleet, remark, others)
-    src_up = up or default_up(fmt)
     nav["cell"] = float(params.cell)
     companions = _companion_files(model)
     with staged_dir(target, force=force, manifest=MANIFEST) as tmp:
         textures = _stage_files(tmp, model, companions, scene, target, name, height, result, remark)
         if progress:
             progress("files")
-        source = {"up": src_up, "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness)}
+        source = {"up": up or default_up(fmt), "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness)}
         doc = _manifest(tmp, model, companions, name, source, textures, height, tolerance, params, fits,
                         result, nav)
         if others:   # one grid per smaller vehicle: grid_files builds navgrid.<vehicle>.npz from these
             doc["grids"] = others
         write_toml(tmp / MANIFEST, doc)
-        # the surface (~100 bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m), the
-        # analysis grid and the model are not needed past the pictures, and the grid below
-        # builds its own from the staged bundle: let go before it (2 km terrain: ~0.9 GB)
         scene = None
         _let_go(result, grid)
         # the same files, built the same way, as build-navgrid on the bundle
@@ -164,8 +155,10 @@ def import_arena(
 
 
 def _let_go(result: Any, grid: bool) -> None:
-    """Drop the analysis' large arrays once the pictures are drawn: its surface, the
-    model it holds and (when the grid stage builds the bundle's own) its tank grid."""
+    """Drop the analysis' large arrays once the pictures are drawn: its surface (~100
+    bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m), the model it holds and (when
+    the grid stage builds the bundle's own from the staged files) its tank grid; let go
+    before that stage (2 km terrain: ~0.9 GB)."""
     result.surface = None
     result.vertices = result.faces = None
     if grid:
@@ -199,6 +192,19 @@ def _check_heights(climb: float, height: float, wall_height: float | None) -> No
     if wall_height is not None and not wall_height > height:
         raise ArenaError(f"--wall-height ({wall_height:g}) must be above the cut --height ({height:g}), "
                          f"or the walls would not be cut")
+
+
+def _read_mesh(model: Path, cell: float, max_cells: int | None, progress: Callable[[str], None] | None,
+               **load: Any) -> tuple[Any, Any]:
+    """(scene, its triangles as one mesh): ``load`` goes to load_scene."""
+    from .formats.models import load_scene
+
+    scene = load_scene(model, progress=progress, **load)
+    if progress:
+        progress("read")
+    mesh = _one_mesh(model, scene, cell, max_cells)
+    give_back(GIVE_BACK_MIN)   # the parser's temporaries (2 km terrain: ~0.36 GB of free heap kept)
+    return scene, mesh
 
 
 def _one_mesh(model: Path, scene: Any, cell: float, max_cells: int | None) -> Any:
