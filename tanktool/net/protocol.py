@@ -261,6 +261,10 @@ def _ip_bytes(ip: str) -> bytes:
     return bytes(int(p) for p in parts)
 
 
+def _ip_str(b: bytes) -> str:
+    return ".".join(str(x) for x in b)
+
+
 def _finite(*values: float) -> None:
     for v in values:
         if not math.isfinite(v):
@@ -304,7 +308,7 @@ def _decode_lost(p: bytes, off: int) -> tuple[tuple[str, int], ...]:
         ip, port = _LOST.unpack_from(p, off + 1 + k * _LOST.size)
         if port == 0:
             raise BadMessage("range")
-        lost.append((".".join(str(b) for b in ip), port))
+        lost.append((_ip_str(ip), port))
     return tuple(lost)
 
 
@@ -334,7 +338,7 @@ def _decode_table(p: bytes) -> Assign:
         if n in seen or tcp == 0 or udp == 0 or owner > MAX_PLAYERS or owner == n:
             raise BadMessage("range")
         seen.add(n)
-        entries.append(Entry(n, epoch, ".".join(str(b) for b in ip), tcp, udp, name, owner))
+        entries.append(Entry(n, epoch, _ip_str(ip), tcp, udp, name, owner))
     lost = _decode_lost(p, off)
     players = {e.number for e in entries if e.owner == 0}
     # the host is a player, and every computer opponent belongs to a player in the table

@@ -88,10 +88,7 @@ class TermsMixin:
             self.dropped_members[(e.ip, e.tcp_port)] = e.number
         if self.closed:                                            # type: ignore[attr-defined]
             return
-        if now > self.probe_until:
-            self.next_probe = now
-        self.probe_until = now + PROBE_LONG
-        self.probe_fast_until = now + PROBE_TIME
+        self._arm_probes(now)
         if not self._others():
             self.next_probe = now
             self.first_round = True
@@ -115,10 +112,15 @@ class TermsMixin:
             return
         for a in new:
             self.lost[a] = now
+        self._arm_probes(now)
+
+    def _arm_probes(self, now: float) -> None:
+        """Probe the lost addresses often for PROBE_TIME from now, then seldom up to
+        PROBE_LONG (at once if no round was under way)."""
         if now > self.probe_until:
             self.next_probe = now
         self.probe_until = now + PROBE_LONG
-        self.probe_fast_until = max(self.probe_fast_until, now + PROBE_TIME)
+        self.probe_fast_until = now + PROBE_TIME
 
     def probing(self) -> bool:
         """Whether joins wait: the first round of probes is not over yet."""
@@ -213,8 +215,7 @@ class TermsMixin:
         # session it left (host 1 there too) as its own and never step down to it
         self.term += 1
         if self.lost:
-            self.probe_until = now + PROBE_LONG
-            self.probe_fast_until = now + PROBE_TIME
+            self._arm_probes(now)
             self.next_probe = now
 
     def forget_session(self, now: float) -> None:
