@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
 from typing import Any, Callable, Iterator
 
 from ..errors import TanktoolError
@@ -39,8 +40,17 @@ def run_pool(tasks: list[MatchTask], workers: int) -> Iterator[dict[str, Any]]:
         yield from run_serial(tasks)
         return
     # one match at a time per worker: matches are long next to the cost of sending one
-    with multiprocessing.get_context().Pool(workers) as pool:
+    with multiprocessing.get_context().Pool(workers, initializer=_default_sigterm) as pool:
         yield from pool.imap_unordered(play_match, tasks, chunksize=1)
+        pool.close()        # all done: the workers leave on their own, not by SIGTERM
+        pool.join()
+
+
+def _default_sigterm() -> None:
+    """A forked worker inherits its parent's SIGTERM handler (Ray installs one): a
+    handler that does not exit made Pool.terminate wait for ever on a worker blocked on
+    the task queue (a hung test run).  The default handler lets terminate end it."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _ray() -> Any:
