@@ -74,13 +74,8 @@ def run_network_window(host: str | None, join: str | None, player_name: str | No
     from ..game.app import NoDisplay, run_window
     from ..game.config import MatchConfig, NetworkConfig, Opponents, ViewConfig
 
-    if host is not None and join is not None:
-        raise click.UsageError("--host and --join exclude each other")
     bots = bots or 0
-    if bots and join is not None:
-        raise click.UsageError("computer opponents run on the host: --bots goes with --host")
-    if bots > 7:
-        raise click.UsageError(f"--bots {bots}: a session holds 8 tanks, the host's own included (at most 7 bots)")
+    _check_roles(host, join, bots)
     network = ("host", host) if host is not None else ("join", join)
     try:
         lines = run_window(MatchConfig(arena=arena, vehicle=vehicle, opponents=Opponents(count=bots), seed=seed,
@@ -102,23 +97,17 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
     """Host or join a session, play it, print a summary, write the report.  ``bots``
     (default: ``play``'s own ``--bots``) computer opponents run on the host, the first
     of them driven by ``bot_specs`` (``play --bot``)."""
-    from ..net.peer import Peer, parse_address
     from ..net.names import name_problem
     from ..net.protocol import name_bytes
     from ..net.session import NetMatch
     from ..sim.match import default_arena, load_match_arena, load_tank_spec
 
-    if host is not None and join is not None:
-        raise click.UsageError("--host and --join exclude each other")
     if bots is None:
         # --bots belongs to `play`; read it from there rather than widen play's call
         ctx = click.get_current_context(silent=True)
         bots = ctx.params.get("bots") if ctx is not None else None
     bots = max(bots or 0, len(bot_specs))
-    if bots and join is not None:
-        raise click.UsageError("computer opponents run on the host: --bots goes with --host")
-    if bots > 7:
-        raise click.UsageError(f"--bots {bots}: a session holds 8 tanks, the host's own included (at most 7 bots)")
+    _check_roles(host, join, bots)
     if report_path is not None and not report_path.parent.exists():
         raise TanktoolError(f"{report_path}: folder {report_path.parent} does not exist")
     name = player_name or ("host" if host is not None else "player")
@@ -141,17 +130,7 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
 
     # peers on another arena or vehicle are refused at the join (the digests differ)
     same = {"digest": match_digest(info, spec), "label": match_label(info, spec)}
-    if host is not None:
-        peer = Peer.host(parse_address(host), name, password, **same)
-        ip, port = peer.tcp_address
-        echo(f"hosting on {ip}:{port} as player 1 ({name})")
-    else:
-        assert join is not None
-        peer = Peer.join(parse_address(join, need_host=True), name, password, **same)
-        h = peer.table[peer.host_number]
-        me_ip, me_port = peer.tcp_address
-        echo(f"joined {h.ip}:{h.tcp_port} as player {peer.number} ({name}), listening on {me_ip}:{me_port} "
-             f"(udp {peer.udp_address[1]}); host is player {peer.host_number}")
+    peer = _open_peer(host, join, name, password, same, echo)
     match = None
 
     def stop(signum: int, frame: Any) -> None:
@@ -180,6 +159,35 @@ def run_network(host: str | None, join: str | None, player_name: str | None, pas
         for sig, handler in old.items():
             signal.signal(sig, handler)
     return report
+
+
+def _check_roles(host: str | None, join: str | None, bots: int) -> None:
+    """A usage error for --host with --join, bots on a joining peer, or too many bots."""
+    if host is not None and join is not None:
+        raise click.UsageError("--host and --join exclude each other")
+    if bots and join is not None:
+        raise click.UsageError("computer opponents run on the host: --bots goes with --host")
+    if bots > 7:
+        raise click.UsageError(f"--bots {bots}: a session holds 8 tanks, the host's own included (at most 7 bots)")
+
+
+def _open_peer(host: str | None, join: str | None, name: str, password: str | None, same: dict[str, Any],
+               echo: Callable[[str], None]) -> Any:
+    """Host a session at ``host`` or join the one at ``join``, and say where we are."""
+    from ..net.peer import Peer, parse_address
+
+    if host is not None:
+        peer = Peer.host(parse_address(host), name, password, **same)
+        ip, port = peer.tcp_address
+        echo(f"hosting on {ip}:{port} as player 1 ({name})")
+        return peer
+    assert join is not None
+    peer = Peer.join(parse_address(join, need_host=True), name, password, **same)
+    h = peer.table[peer.host_number]
+    me_ip, me_port = peer.tcp_address
+    echo(f"joined {h.ip}:{h.tcp_port} as player {peer.number} ({name}), listening on {me_ip}:{me_port} "
+         f"(udp {peer.udp_address[1]}); host is player {peer.host_number}")
+    return peer
 
 
 def _summary(report: dict[str, Any], report_path: Path | None, echo: Callable[[str], None]) -> None:

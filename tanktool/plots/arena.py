@@ -28,12 +28,16 @@ NORMAL_COLOUR = "#d04020"
 
 def _spawn_mark(ax, x: float, z: float, th: float, number: int, arrow: float, back: float, zorder: int) -> None:
     """A spawn point: a dot, an arrow ``arrow`` long the way it faces, and its number
-    ``back`` arrow lengths behind it."""
+    ``back`` arrow lengths behind it, each with a white halo so it reads on any height's colour."""
+    from matplotlib.patheffects import withStroke
+
+    halo = [withStroke(linewidth=3.5, foreground="white")]
     ax.annotate("", xy=(x + arrow * np.cos(th), z + arrow * np.sin(th)), xytext=(x, z),
-                arrowprops=dict(arrowstyle="-|>", color="#1a7a1a", lw=1.5), zorder=zorder)
-    ax.plot([x], [z], "o", color="#1a7a1a", ms=4, zorder=zorder)
+                arrowprops=dict(arrowstyle="-|>", color="#1a7a1a", lw=1.5, path_effects=halo), zorder=zorder)
+    ax.plot([x], [z], "o", color="#1a7a1a", mec="white", ms=5, zorder=zorder)
     ax.text(x - back * arrow * np.cos(th), z - back * arrow * np.sin(th), str(number), color="#1a7a1a",
-            fontsize=8, ha="center", va="center", zorder=zorder + 1)
+            fontsize=8, fontweight="bold", ha="center", va="center", zorder=zorder + 1, path_effects=halo)
+
 
 def fill_region(ax: Any, geom: Any, colour: str, zorder: float = 0) -> None:
     """Fill a shapely (Multi)Polygon on ``ax`` as one compound path: every part's
@@ -82,6 +86,19 @@ def draw_segments(ax: Any, seg: np.ndarray, colour: str, width: float, zorder: f
                             capstyle="butt", joinstyle="miter", zorder=zorder))
 
 
+def draw_walls(ax: Any, seg: np.ndarray, normals: np.ndarray, aux: Any, tick: float, width: float) -> None:
+    """Walls (n, 2, 2) ``width`` wide with a ``tick`` of normal at each middle, on the
+    free side, and the auxiliary rectangle ``aux`` (or None) dashed beneath."""
+    from matplotlib.collections import LineCollection
+
+    draw_segments(ax, seg, WALL_COLOUR, width, zorder=2)
+    if len(seg):
+        mid = seg.mean(axis=1)
+        draw_segments(ax, np.stack([mid, mid + normals * tick], axis=1), NORMAL_COLOUR, 0.6 * width, zorder=3)
+    if aux is not None:
+        ax.add_collection(LineCollection(aux, colors="#4060c0", linewidths=0.9, linestyles="dashed", zorder=1))
+
+
 def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = None,
                    size_px: int = 900) -> bytes:
     """PNG bytes of the arena's top view.
@@ -95,7 +112,6 @@ def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = 
     import matplotlib
 
     matplotlib.use("Agg", force=False)
-    from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
 
     (xmin, zmin), (xmax, zmax) = walls.bounds
@@ -108,16 +124,7 @@ def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = 
     ax = fig.add_subplot(1, 1, 1)
     ax.set_aspect("equal")
     fill_region(ax, free, FREE_COLOUR)
-    seg = walls.segments
-    draw_segments(ax, seg, WALL_COLOUR, 1.4, zorder=2)
-    if len(seg):
-        mid = seg.mean(axis=1)
-        tick = 0.012 * max(w, h)
-        tips = mid + walls.normals * tick
-        draw_segments(ax, np.stack([mid, tips], axis=1), NORMAL_COLOUR, 0.8, zorder=3)
-    if walls.aux is not None:
-        ax.add_collection(LineCollection(walls.aux, colors="#4060c0", linewidths=0.9,
-                                         linestyles="dashed", zorder=1))
+    draw_walls(ax, walls.segments, walls.normals, walls.aux, 0.012 * max(w, h), 1.4)
     spawns = np.asarray(spawns, dtype=np.float64)
     spawns = spawns.reshape(len(spawns), -1)[:, :3] if spawns.size else np.zeros((0, 3))
     arrow = 0.03 * max(w, h)
@@ -161,7 +168,7 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     import matplotlib
 
     matplotlib.use("Agg", force=False)
-    from matplotlib.collections import LineCollection, PolyCollection
+    from matplotlib.collections import PolyCollection
     from matplotlib.figure import Figure
     from matplotlib.patches import Patch
 
@@ -188,7 +195,6 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     flat = hi - lo <= 2 * hf.ch
     cmap = matplotlib.colormaps["viridis"]
     image = None
-    spawns = np.asarray(result.spawns, dtype=np.float64)
     for lv in range(L):
         ax = fig.add_subplot(rows, cols, lv + 1)
         ax.set_aspect("equal")
@@ -202,21 +208,7 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
         if lv == 0:
             handles = _left_out_layers(ax, result, hf, surface, (step, extent), PolyCollection, Patch, steep_faces,
                                        too_small, low_headroom, unreachable)
-        sel = walls.level == lv
-        seg = walls.segments[sel]
-        draw_segments(ax, seg, WALL_COLOUR, 1.2, zorder=3)
-        if len(seg):
-            mid = seg.mean(axis=1)
-            tick = 0.012 * max(w, h)
-            draw_segments(ax, np.stack([mid, mid + walls.normals[sel] * tick], axis=1), NORMAL_COLOUR, 0.7, zorder=3)
-        if walls.aux is not None:
-            ax.add_collection(LineCollection(walls.aux, colors="#4060c0", linewidths=0.9, linestyles="dashed",
-                                             zorder=1))
-        on = _spawns_on_level(result, lv)
-        arrow = 0.03 * max(w, h)
-        for k in np.flatnonzero(on):
-            x, z, th = spawns[k, :3]
-            _spawn_mark(ax, x, z, th, k + 1, arrow, 0.45, zorder=5)
+        _walls_and_spawns(ax, result, lv, 0.012 * max(w, h), 0.03 * max(w, h))
         pad = 0.03 * max(w, h)
         ax.set_xlim(xmin - pad, xmax + pad)
         ax.set_ylim(zmin - pad, zmax + pad)
@@ -227,14 +219,36 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
         ax.set_title(sub if L > 1 else f"{title}\n{sub}", fontsize=9)
         ax.grid(True, lw=0.3, alpha=0.5)
         if handles:
-            ax.legend(handles=handles, loc="upper right", fontsize=7, framealpha=0.85)
+            # below the panel, where it hides no spawn or wall
+            from matplotlib.transforms import offset_copy
+
+            under = offset_copy(ax.transAxes, fig, y=-30, units="points")  # past the ticks and the x label
+            ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0), bbox_transform=under, ncol=2,
+                      fontsize=7, framealpha=0.85)
     if image is not None:
         fig.colorbar(image, ax=fig.axes, shrink=0.8, label="surface height y (m)")
     if L > 1:
-        fig.suptitle(title, fontsize=10)
+        # just above the panels: they keep their aspect, so the figure's set height
+        # leaves bands above and below them, which the tight save crops
+        for ax in fig.axes:
+            ax.apply_aspect()
+        top = max(ax.get_position().y1 for ax in fig.axes)
+        fig.suptitle(title, fontsize=10, y=min(top + 0.04, 0.99), va="bottom")
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
+    fig.savefig(buf, format="png", metadata={"Software": None}, bbox_inches="tight", pad_inches=0.15)
     return buf.getvalue()
+
+
+def _walls_and_spawns(ax: Any, result: Any, lv: int, tick: float, arrow: float) -> None:
+    """Level ``lv``'s walls (:func:`draw_walls`) and its spawns as numbered arrows
+    ``arrow`` long."""
+    walls = result.walls.walls
+    sel = walls.level == lv
+    draw_walls(ax, walls.segments[sel], walls.normals[sel], walls.aux, tick, 1.2)
+    spawns = np.asarray(result.spawns, dtype=np.float64)
+    for k in np.flatnonzero(_spawns_on_level(result, lv)):
+        x, z, th = spawns[k, :3]
+        _spawn_mark(ax, x, z, th, k + 1, arrow, 0.45, zorder=5)
 
 
 def image_step(shape: tuple[int, int], origin: np.ndarray, cell: float) -> tuple[int, tuple[float, ...]]:

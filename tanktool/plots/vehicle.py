@@ -58,13 +58,44 @@ def _render_view(vertices: np.ndarray, faces: np.ndarray, colours: np.ndarray, a
     return np.asarray(canvas.buffer_rgba()).copy()
 
 
+def _hull_panel(ax, hull: np.ndarray, axes: tuple[int, int], top: bool, label: str) -> None:
+    """The hull's footprint (top view) or its bounding box (side view) and its points."""
+    from matplotlib.patches import Polygon
+
+    pts2 = hull[:, list(axes)]
+    if top:  # the first half of the hull points is the bottom ring: the footprint
+        ax.add_patch(Polygon(pts2[:len(hull) // 2], closed=True, fill=False, ec="black", lw=1.4, zorder=3))
+    else:
+        ylo, yhi = hull[:, 1].min(), hull[:, 1].max()
+        xlo, xhi = hull[:, 0].min(), hull[:, 0].max()
+        ax.add_patch(Polygon([[xlo, ylo], [xhi, ylo], [xhi, yhi], [xlo, yhi]], closed=True,
+                             fill=False, ec="black", lw=1.4, zorder=3))
+    ax.plot(pts2[:, 0], pts2[:, 1], "o", ms=4, mfc="#ffdd00", mec="black", zorder=4)
+    ax.set_title(f"hull: {len(hull)} points — {label}", fontsize=9)
+
+
+def _level_panel(ax, tree, lev: int, axes: tuple[int, int], label: str) -> None:
+    """The spheres of one sphere-tree level, filled lightly and outlined."""
+    from matplotlib.patches import Circle
+
+    idx = np.flatnonzero(tree.level == lev)
+    colour = LEVEL_COLOURS[(lev - 1) % len(LEVEL_COLOURS)]
+    for i in idx:
+        c = tree.centers[i]
+        ax.add_patch(Circle((c[axes[0]], c[axes[1]]), tree.radii[i], fill=True, fc=colour,
+                            alpha=0.10, ec="none", zorder=2))
+        ax.add_patch(Circle((c[axes[0]], c[axes[1]]), tree.radii[i], fill=False, ec=colour,
+                            lw=1.1, zorder=3))
+        ax.plot(c[axes[0]], c[axes[1]], "+", color=colour, ms=5, zorder=4)
+    ax.set_title(f"level {lev}: {len(idx)} sphere{'s' if len(idx) != 1 else ''} — {label}", fontsize=9)
+
+
 def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: str = "") -> None:
     """Write the preview PNG for a vehicle-frame ``mesh`` with its hull and sphere tree."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.patches import Circle, Polygon
 
     from ..formats.bundle import atomic_write_bytes
 
@@ -77,7 +108,6 @@ def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: s
     colours = 0.35 + 0.65 * colours  # lighten so the outlines on top stay readable
 
     levels = int(tree.level.max())
-    k = len(hull) // 2
     ncol = 1 + levels
     lo = np.minimum(v.min(axis=0), (tree.centers - tree.radii[:, None]).min(axis=0))
     hi = np.maximum(v.max(axis=0), (tree.centers + tree.radii[:, None]).max(axis=0))
@@ -111,28 +141,9 @@ def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: s
             if row == 1:
                 ax.set_xlabel("x (m, forward)", fontsize=8)
             if col == 0:
-                pts2 = hull[:, list(axes)]
-                if row == 0:
-                    ax.add_patch(Polygon(pts2[:k], closed=True, fill=False, ec="black", lw=1.4, zorder=3))
-                else:
-                    ylo, yhi = hull[:, 1].min(), hull[:, 1].max()
-                    xlo, xhi = hull[:, 0].min(), hull[:, 0].max()
-                    ax.add_patch(Polygon([[xlo, ylo], [xhi, ylo], [xhi, yhi], [xlo, yhi]], closed=True,
-                                         fill=False, ec="black", lw=1.4, zorder=3))
-                ax.plot(pts2[:, 0], pts2[:, 1], "o", ms=4, mfc="#ffdd00", mec="black", zorder=4)
-                ax.set_title(f"hull: {len(hull)} points — {label}", fontsize=9)
+                _hull_panel(ax, hull, axes, row == 0, label)
             else:
-                lev = col
-                idx = np.flatnonzero(tree.level == lev)
-                colour = LEVEL_COLOURS[(lev - 1) % len(LEVEL_COLOURS)]
-                for i in idx:
-                    c = tree.centers[i]
-                    ax.add_patch(Circle((c[axes[0]], c[axes[1]]), tree.radii[i], fill=True, fc=colour,
-                                        alpha=0.10, ec="none", zorder=2))
-                    ax.add_patch(Circle((c[axes[0]], c[axes[1]]), tree.radii[i], fill=False, ec=colour,
-                                        lw=1.1, zorder=3))
-                    ax.plot(c[axes[0]], c[axes[1]], "+", color=colour, ms=5, zorder=4)
-                ax.set_title(f"level {lev}: {len(idx)} sphere{'s' if len(idx) != 1 else ''} — {label}", fontsize=9)
+                _level_panel(ax, tree, col, axes, label)
     if title:
         fig.suptitle(title, fontsize=11)
     fig.tight_layout()
