@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 
 .PHONY: play test test-slow install arenas vehicles bench clean
 
-$(STAMP): pyproject.toml setup.py tanktool/_kernels.c tanktool/_kernels_raster.c tanktool/_kernels_grid.c tanktool/_kernels.h
+$(STAMP): pyproject.toml setup.py $(wildcard tanktool/_kernels*.c) tanktool/_kernels.h
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test,bench,rl,cluster]'

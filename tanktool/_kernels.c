@@ -1,7 +1,7 @@
 /* tanktool._kernels: the walkable-surface loops numpy cannot make fast, in C.
  *
- * Three files (the rasteriser in _kernels_raster.c, the grid's loops in _kernels_grid.c,
- * shared definitions in _kernels.h).
+ * Four files (the rasteriser in _kernels_raster.c, the grid's loops in _kernels_grid.c,
+ * the levels in _kernels_levels.c, shared definitions in _kernels.h).
  * Optional: setup.py builds it when a C compiler is there; tanktool/nav/kernels.py
  * falls back to numpy otherwise, with identical results (tests/test_kernels.py
  * compares the two).  No numpy headers: arrays come in through the buffer protocol
@@ -28,6 +28,8 @@
  *   grid_labels(valid, link, L, nz, nx, out) -> k   (_kernels_grid.c)
  *   grid_links(span_of, link, level, col, exists, per, out)   (_kernels_grid.c)
  *   grid_runs(valid, link, L, nz, nx, row_index, row_total, col_index, col_total)   (_kernels_grid.c)
+ *   level_votes(col, keep, link, level, rounds)   (_kernels_levels.c)
+ *   lift_portals(col, level, link, steps)   (_kernels_levels.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -494,6 +496,8 @@ static PyMethodDef methods[] = {
     {"grid_links", tanktool_grid_links, METH_VARARGS, "the layered grid's links from the surface's (_kernels_grid.c)"},
     {"grid_runs", tanktool_grid_runs, METH_VARARGS, "the layered grid's row and column runs (_kernels_grid.c)"},
     {"chamfer_grid", chamfer_grid, METH_VARARGS, "chamfer() on the ground's (L, nz, nx, 4) int8 links, in place"},
+    {"level_votes", tanktool_level_votes, METH_VARARGS, "levels by column rank, then the voting rounds (_kernels_levels.c)"},
+    {"lift_portals", tanktool_lift_portals, METH_VARARGS, "level_lift.lift_to_portals in place (_kernels_levels.c)"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -501,7 +505,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 7
+#define TANKTOOL_KERNELS_ABI 8
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

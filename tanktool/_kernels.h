@@ -1,4 +1,4 @@
-/* tanktool/_kernels.h: what the kernels' two C files share (see _kernels.c). */
+/* tanktool/_kernels.h: what the kernels' C files share (see _kernels.c). */
 #ifndef TANKTOOL_KERNELS_H
 #define TANKTOOL_KERNELS_H
 
@@ -29,5 +29,9 @@ PyObject *tanktool_raster(PyObject *self, PyObject *args);
 PyObject *tanktool_grid_labels(PyObject *self, PyObject *args);
 PyObject *tanktool_grid_links(PyObject *self, PyObject *args);
 PyObject *tanktool_grid_runs(PyObject *self, PyObject *args);
+
+/* the levels (_kernels_levels.c) */
+PyObject *tanktool_level_votes(PyObject *self, PyObject *args);
+PyObject *tanktool_lift_portals(PyObject *self, PyObject *args);
 
 #endif

@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 
+from ..geometry.kernels import active, i64
+
 #: how far down a ramp its top joins the level of the deck it comes up to, where the
 #: deck stands over walkable ground (:func:`lift_to_portals`), in metres: past the
 #: largest bundled footprint radius (heavy, 4.63 m) with a cell to spare.  A constant,
@@ -43,6 +45,13 @@ def lift_to_portals(col: np.ndarray, level: np.ndarray, link: np.ndarray, steps:
     edge, along links on their own level, join the deck's level where it is free in
     their column: the seam moves down the ramp, away from the ground's wall, to a
     portal between the ramp's two levels."""
+    kern = active()
+    if (kern is not None and link.dtype == np.int32 and level.dtype == np.int64 and level.flags.c_contiguous
+            and level.flags.writeable):
+        # one pass a direction and a look along the column for held(), where numpy sorts
+        # every kept span's key and searches it per step (tanktool/_kernels_levels.c)
+        kern.lift_portals(i64(col), level, np.ascontiguousarray(link), int(steps))
+        return
     kept = np.flatnonzero(level >= 0)
     if len(kept) == 0:
         return

@@ -16,7 +16,8 @@ this module does what Recast's compact heightfield does:
 * the spans of that region are stacked into *levels*: a span's level is the number of
   the region's spans below it in its column (0 on the ground, 1 on a deck over a
   passage, ...), so that each level holds at most one span a column; the top of a
-  ramp up to a deck over the ground joins the deck's level (:mod:`.level_lift`).
+  ramp up to a deck over the ground joins the deck's level (:mod:`.level_stack`,
+  :mod:`.level_lift`).
 
 Everything is numpy over spans; the links are found by pairing each span with the
 spans of its neighbour column.
@@ -33,7 +34,8 @@ from ..errors import ArenaError
 from ..memory import give_back
 from ..geometry.kernels import active, i64
 from ..geometry.heightfield import OPEN, Heightfield, build_heightfield, column_starts, neighbour_columns
-from .level_lift import lift_steps, lift_to_portals
+from .level_lift import lift_steps
+from .level_stack import stack_levels
 
 #: the four link directions as (di, dj) on the grid: +x, +z, -x, -z (navgrid.STEPS order)
 DIRS = ((0, 1), (1, 0), (0, -1), (-1, 0))
@@ -246,95 +248,6 @@ def components(link: np.ndarray) -> np.ndarray:
     first[comp[::-1]] = np.arange(n - 1, -1, -1, dtype=np.int64)
     return first[comp]
 
-
-def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = None, rounds: int = 64,
-                 lift: int = 0) -> np.ndarray:
-    """Level of each kept span: first how many kept spans lie below it in its column;
-    then, round by round, a span moves to the level most of its linked neighbours are
-    on when that level is free in its column (the deck over a pillar joins the deck
-    over the passage instead of standing alone on level 0); last, with ``lift`` > 0,
-    the top of a ramp onto a deck over walkable ground joins the deck's level
-    (:func:`tanktool.nav.level_lift.lift_to_portals`)."""
-    level = np.full(len(col), -1, dtype=np.int64)
-    c = col[keep]
-    if len(c) == 0:
-        return level
-    if not (c[1:] == c[:-1]).any():  # one kept span a column (a terrain): all on level 0, nothing to move
-        level[keep] = 0            # (without the kept spans' indices: 8 bytes a span less)
-        return level
-    idx = np.flatnonzero(keep)
-    first = np.ones(len(c), dtype=bool)
-    first[1:] = c[1:] != c[:-1]
-    start = np.flatnonzero(first)
-    level[idx] = np.arange(len(c)) - np.repeat(start, np.diff(np.append(start, len(c))))
-    if link is None or level.max() == 0:
-        return level
-    lv = np.append(level, -1)
-    pos = np.full(len(level) + 1, -1, dtype=np.int64)  # span -> its row in idx
-    pos[idx] = np.arange(len(idx))
-    nb = np.where(link[idx] >= 0, link[idx], len(level))
-    col_rank = np.cumsum(first) - 1  # c is sorted: the rank of each span's column
-    active = (lv[nb] != lv[idx][:, None]).any(axis=1)  # only spans at a level's border can move
-    is_cand = np.zeros(len(idx), dtype=bool)
-    for _ in range(rounds):
-        a = np.flatnonzero(active)
-        if len(a) == 0:
-            break
-        nl = lv[nb[a]]  # (k, 4) levels of the linked neighbours
-        cur = lv[idx[a]]
-        votes = np.stack([(nl == nl[:, d:d + 1]).sum(axis=1) for d in range(4)], axis=1)
-        votes = np.where(nl >= 0, votes, -1)
-        top = votes.max(axis=1)
-        # of the levels with the most votes, the highest
-        best = np.where(votes == top[:, None], nl, -1).max(axis=1)
-        mine = (nl == cur[:, None]).sum(axis=1)
-        # more neighbours there, or as many (at least two) and it is the higher level: a
-        # tie at the corner of a deck's patch over a pillar resolves upwards, but a
-        # corridor one cell wide (one neighbour each way) stays where it is
-        move = (best >= 0) & (best != cur) & ((top > mine) | ((top == mine) & (top >= 2) & (best > cur)))
-        if not move.any():
-            break
-        # the new level must be free in the column: no other kept span there holds it,
-        # and of two spans of one column moving to the same level in a round, neither does
-        cand = a[move]
-        taken = _level_taken(c, col_rank, lv[idx], cand, best[move], is_cand)
-        ok = cand[~taken]
-        if len(ok) == 0:
-            break
-        lv[idx[ok]] = best[move][~taken]
-        active[:] = False
-        near = pos[nb[ok]].ravel()
-        active[near[near >= 0]] = True
-        active[ok] = True
-    level = lv[:-1]
-    if lift > 0:
-        lift_to_portals(col, level, link, lift)
-    # levels numbered from 0 without gaps, in order of height
-    used = np.flatnonzero(np.bincount(level[idx]))  # small counts: no hashing sort
-    remap = np.full(int(used.max()) + 1, -1)
-    remap[used] = np.arange(len(used))
-    level[idx] = remap[level[idx]]
-    return level
-
-
-def _level_taken(c: np.ndarray, col_rank: np.ndarray, lv: np.ndarray, cand: np.ndarray, new: np.ndarray,
-                 is_cand: np.ndarray) -> np.ndarray:
-    """Whether each candidate's new level is held in its column by another kept span
-    (at its current level, or a candidate's new one): the (column, level) keys of the
-    candidates' columns only (``c`` sorted), where one sort over every kept span would
-    find the same."""
-    cc = c[cand]  # sorted, as cand is
-    ucol = cc[np.append(True, cc[1:] != cc[:-1])]
-    lo = np.searchsorted(c, ucol, side="left")
-    cnt = np.searchsorted(c, ucol, side="right") - lo
-    rows = np.repeat(lo, cnt) + (np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt))
-    is_cand[cand] = True
-    others = rows[~is_cand[rows]]
-    is_cand[cand] = False
-    key_cand = col_rank[cand] * 256 + new
-    keys = np.concatenate([col_rank[others] * 256 + lv[others], key_cand])
-    uniq, counts = np.unique(keys, return_counts=True)
-    return counts[np.searchsorted(uniq, key_cand)] > 1
 
 def walkable_surface(vertices: np.ndarray, faces: np.ndarray, params: WalkableParams, clearance: float,
                      origin_xz=None, shape=None, seeds: np.ndarray | None = None, lean: bool = False) -> Surface:

@@ -1,0 +1,250 @@
+/* tanktool._kernels: the levels of the played region's spans (see _kernels.c).
+ *
+ *   level_votes(col, keep, link, level, rounds)
+ *       col: int64 (n,) sorted; keep: bool (n,); link: int32 (n, 4); level: int64 (n,)
+ *       written: each kept span's rank among the kept spans of its column (-1 where not
+ *       kept), then, unless every rank is 0, the voting rounds of
+ *       level_stack._vote_rounds: the same moves and the same conflicts.  Returns the
+ *       highest rank (-1: nothing kept; 0: one kept span a column, no rounds run)
+ *   lift_portals(col, level, link, steps)
+ *       col: int64 (n,) sorted; level: int64 (n,) in place (-1 outside the region);
+ *       link: int32 (n, 4); level_lift.lift_to_portals
+ *
+ * Why in C: numpy's rounds pass over every kept span to set up (neighbour levels,
+ * column ranks, the first active set) and sort (column, level) keys in every round
+ * to find the conflicts; here a conflict is a look along the span's own column (a
+ * few spans), and a round touches only the active spans.  Spans of a column are
+ * adjacent (col sorted), so "the spans of my column" needs no index.
+ */
+#include "_kernels.h"
+
+/* the votes of one span at level cur with neighbour levels nl[4] (-1: none): the
+ * level it moves to, or -1 to stay (level_stack._vote_rounds' rule) */
+static inline i64 vote(const i64 nl[4], i64 cur) {
+    int top = -1, mine = 0;
+    i64 best = -1;
+    for (int d = 0; d < 4; ++d) {
+        int v = -1;
+        if (nl[d] >= 0) {
+            v = 0;
+            for (int e = 0; e < 4; ++e) v += nl[e] == nl[d];
+        }
+        if (v > top) { top = v; best = nl[d]; }
+        else if (v == top && nl[d] > best) best = nl[d];
+        mine += nl[d] == cur;
+    }
+    if (best < 0 || best == cur) return -1;
+    if (top > mine || (top == mine && top >= 2 && best > cur)) return best;
+    return -1;
+}
+
+/* whether another kept span of s's column holds level want: a candidate by its new
+ * level (newlv >= 0), any other by its current one (level_stack._level_taken) */
+static inline int taken(const i64 *col, const uint8_t *keep, const i64 *lv, const i64 *newlv, Py_ssize_t n,
+                        Py_ssize_t s, i64 want) {
+    for (int side = -1; side <= 1; side += 2)
+        for (Py_ssize_t t = s + side; t >= 0 && t < n && col[t] == col[s]; t += side) {
+            if (!keep[t]) continue;
+            if ((newlv[t] >= 0 ? newlv[t] : lv[t]) == want) return 1;
+        }
+    return 0;
+}
+
+/* the rounds; act holds the first active spans (nact of them); scratch arrays of n */
+static void rounds_of(const i64 *col, const uint8_t *keep, const int32_t *L, i64 *lv, Py_ssize_t n, int rounds,
+                      i64 *act, Py_ssize_t nact, i64 *cand, i64 *newlv, uint8_t *flag) {
+    for (int r = 0; r < rounds && nact > 0; ++r) {
+        Py_ssize_t nc = 0;
+        for (Py_ssize_t k = 0; k < nact; ++k) {
+            const i64 s = act[k];
+            i64 nl[4];
+            for (int d = 0; d < 4; ++d) nl[d] = L[4 * s + d] >= 0 ? lv[L[4 * s + d]] : -1;
+            const i64 best = vote(nl, lv[s]);
+            if (best >= 0) { cand[nc++] = s; newlv[s] = best; }
+        }
+        if (nc == 0) break;
+        /* the conflicts against the levels before the round, then the moves */
+        Py_ssize_t nok = 0;
+        for (Py_ssize_t k = 0; k < nc; ++k)
+            if (!taken(col, keep, lv, newlv, n, cand[k], newlv[cand[k]])) act[nok++] = cand[k];
+        for (Py_ssize_t k = 0; k < nok; ++k) lv[act[k]] = newlv[act[k]];
+        for (Py_ssize_t k = 0; k < nc; ++k) newlv[cand[k]] = -1;
+        if (nok == 0) break;
+        /* next round: the spans that moved and their kept neighbours (cand reused) */
+        nact = 0;
+        for (Py_ssize_t k = 0; k < nok; ++k) {
+            const i64 s = act[k];
+            if (!flag[s]) { flag[s] = 1; cand[nact++] = s; }
+            for (int d = 0; d < 4; ++d) {
+                const i64 t = L[4 * s + d];
+                if (t >= 0 && keep[t] && !flag[t]) { flag[t] = 1; cand[nact++] = t; }
+            }
+        }
+        for (Py_ssize_t k = 0; k < nact; ++k) { act[k] = cand[k]; flag[cand[k]] = 0; }
+    }
+}
+
+PyObject *tanktool_level_votes(PyObject *self, PyObject *args) {
+    Py_buffer col, keep, link, level;
+    int rounds;
+    if (!PyArg_ParseTuple(args, "y*y*y*w*i", &col, &keep, &link, &level, &rounds)) return NULL;
+    const Py_ssize_t n = col.len / 8;
+    PyObject *ret = NULL;
+    i64 *act = NULL, *cand = NULL, *newlv = NULL, top = -1;
+    uint8_t *flag = NULL;
+    if (!need(&keep, n, 1, "keep") || !need(&link, 4 * n, 4, "link") || !need(&level, n, 8, "level")) goto done;
+    act = malloc(sizeof(i64) * (n + 1));
+    cand = malloc(sizeof(i64) * (n + 1));
+    newlv = malloc(sizeof(i64) * (n + 1));
+    flag = calloc(n + 1, 1);
+    if (!act || !cand || !newlv || !flag) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    {
+        const i64 *C = col.buf;
+        const uint8_t *K = keep.buf;
+        const int32_t *L = link.buf;
+        i64 *lv = level.buf;
+        Py_BEGIN_ALLOW_THREADS
+        i64 rank = 0;
+        for (Py_ssize_t s = 0; s < n; ++s) {
+            if (s == 0 || C[s] != C[s - 1]) rank = 0;
+            lv[s] = K[s] ? rank++ : -1;
+            if (lv[s] > top) top = lv[s];
+            newlv[s] = -1;
+        }
+        if (top > 0) {
+            /* the first active spans: a kept span with a neighbour on another level
+             * (or none, or outside the region) */
+            Py_ssize_t nact = 0;
+            for (Py_ssize_t s = 0; s < n; ++s) {
+                if (!K[s]) continue;
+                for (int d = 0; d < 4; ++d) {
+                    const i64 t = L[4 * s + d];
+                    if ((t >= 0 ? lv[t] : -1) != lv[s]) { act[nact++] = s; break; }
+                }
+            }
+            rounds_of(C, K, L, lv, n, rounds, act, nact, cand, newlv, flag);
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = PyLong_FromLongLong(top);
+done:
+    free(act);
+    free(cand);
+    free(newlv);
+    free(flag);
+    PyBuffer_Release(&col);
+    PyBuffer_Release(&keep);
+    PyBuffer_Release(&link);
+    PyBuffer_Release(&level);
+    return ret;
+}
+
+/* whether column c holds a span at level want, looking both ways from span p (in
+ * column c or next to it): level_lift's held() over its sorted (column, level) keys.
+ * want -1 is the key c * L - 1 there, which is column c - 1's level L - 1: kept so. */
+static inline int held(const i64 *col, const i64 *lv, Py_ssize_t n, Py_ssize_t p, i64 c, i64 want, i64 L) {
+    if (want < 0) {
+        c -= 1;
+        want = L - 1;
+    }
+    for (Py_ssize_t t = p; t >= 0 && col[t] >= c; --t)
+        if (col[t] == c && lv[t] == want) return 1;
+    for (Py_ssize_t t = p + 1; t < n && col[t] <= c; ++t)
+        if (col[t] == c && lv[t] == want) return 1;
+    return 0;
+}
+
+/* the band straight back from the ledged portals (lift_to_portals' steps) */
+static void lift_band(const i64 *C, const i64 *lv, const int32_t *K, Py_ssize_t n, i64 L, int steps, i64 *target,
+                      int8_t *away, i64 *front, i64 *next, i64 *from) {
+    Py_ssize_t nf = 0;
+    for (Py_ssize_t s = 0; s < n; ++s)
+        if (target[s] >= 0) front[nf++] = s;
+    for (int k = 0; k < steps && nf > 0; ++k) {
+        /* every step judged on the targets before it, then written in order */
+        Py_ssize_t nn = 0;
+        for (Py_ssize_t q = 0; q < nf; ++q) {
+            const i64 f = front[q], u = K[4 * f + away[f]];
+            if (u < 0 || lv[u] != lv[f] || target[u] >= 0 || held(C, lv, n, u, C[u], target[f], L)) continue;
+            from[nn] = f;
+            next[nn++] = u;
+        }
+        for (Py_ssize_t q = 0; q < nn; ++q) {
+            target[next[q]] = target[from[q]];
+            away[next[q]] = away[from[q]];
+            front[q] = next[q];
+        }
+        nf = nn;
+    }
+}
+
+PyObject *tanktool_lift_portals(PyObject *self, PyObject *args) {
+    Py_buffer col, level, link;
+    int steps;
+    if (!PyArg_ParseTuple(args, "y*w*y*i", &col, &level, &link, &steps)) return NULL;
+    const Py_ssize_t n = col.len / 8;
+    PyObject *ret = NULL;
+    i64 *target = NULL, *front = NULL, *next = NULL, *from = NULL;
+    int8_t *away = NULL;
+    if (!need(&level, n, 8, "level") || !need(&link, 4 * n, 4, "link")) goto done;
+    target = malloc(sizeof(i64) * (n + 1));
+    front = malloc(sizeof(i64) * (n + 1));
+    next = malloc(sizeof(i64) * (n + 1));
+    from = malloc(sizeof(i64) * (n + 1));
+    away = malloc(n + 1);
+    if (!target || !front || !next || !from || !away) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    {
+        const i64 *C = col.buf;
+        const int32_t *K = link.buf;
+        i64 *lv = level.buf;
+        Py_BEGIN_ALLOW_THREADS
+        i64 L = 0;
+        for (Py_ssize_t s = 0; s < n; ++s) {
+            if (lv[s] + 1 > L) L = lv[s] + 1;
+            target[s] = -1;
+            away[s] = 0;
+        }
+        if (L > 0) {
+            /* direction by direction, the last that finds a ledged portal wins */
+            for (int d = 0; d < 4; ++d)
+                for (Py_ssize_t s = 0; s < n; ++s) {
+                    const i64 t = K[4 * s + d];
+                    if (lv[s] < 0 || t < 0 || lv[t] == lv[s]) continue;
+                    if (held(C, lv, n, t, C[t], lv[s], L) && !held(C, lv, n, s, C[s], lv[t], L)) {
+                        target[s] = lv[t];
+                        away[s] = (int8_t)((d + 2) % 4);
+                    }
+                }
+            lift_band(C, lv, K, n, L, steps, target, away, front, next, from);
+            /* two spans of one column sent to the same level: neither moves (judged on
+             * the targets alone, so moving as we go changes nothing) */
+            for (Py_ssize_t s = 0; s < n; ++s) {
+                if (target[s] < 0) continue;
+                int twice = 0;
+                for (int side = -1; side <= 1 && !twice; side += 2)
+                    for (Py_ssize_t t = s + side; t >= 0 && t < n && C[t] == C[s]; t += side)
+                        if (target[t] == target[s]) { twice = 1; break; }
+                if (!twice) lv[s] = target[s];
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    free(target);
+    free(front);
+    free(next);
+    free(from);
+    free(away);
+    PyBuffer_Release(&col);
+    PyBuffer_Release(&level);
+    PyBuffer_Release(&link);
+    return ret;
+}

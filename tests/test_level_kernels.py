@@ -1,0 +1,84 @@
+"""The compiled levels (tanktool/_kernels_levels.c) against the numpy code they
+replace: the same levels from stack_levels and level_lift.lift_to_portals on random
+span graphs and on generated levels with decks over walkable ground."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tanktool.geometry import kernels
+from tanktool.geometry.kernels import use_kernels
+from tanktool.nav.level_lift import lift_to_portals
+from tanktool.nav.level_stack import stack_levels
+from tanktool.nav.walkable import WalkableParams, link_spans, walkable_surface
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tools"))
+
+needs_kernels = pytest.mark.skipif(not kernels.available(), reason="tanktool._kernels not built (no C compiler)")
+
+
+def _graph(seed: int, nz: int = 27, nx: int = 33):
+    """Columns of 0-4 spans, close enough in height to link across storeys."""
+    rng = np.random.default_rng(seed)
+    counts = rng.integers(0, 5, nz * nx)
+    col = np.repeat(np.arange(nz * nx), counts)
+    floor = rng.integers(0, 60, len(col))
+    order = np.lexsort((floor, col))
+    col, floor = col[order], floor[order]
+    ceil = floor + rng.integers(2, 25, len(col))
+    return rng, col, link_spans(col, floor, ceil, (nz, nx), 3, 12)
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(8))
+def test_random_span_graphs_stack_the_same_levels(seed):
+    rng, col, link = _graph(seed)
+    for share in (1.0, 0.8, 0.5):
+        keep = rng.random(len(col)) < share
+        for rounds, lift in ((64, 0), (64, 3), (2, 9), (0, 2)):
+            with use_kernels(True):
+                a = stack_levels(col, keep, link, rounds=rounds, lift=lift)
+            with use_kernels(False):
+                b = stack_levels(col, keep, link, rounds=rounds, lift=lift)
+            assert np.array_equal(a, b), (share, rounds, lift)
+            assert a.max() >= 1
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(8))
+def test_random_levels_are_lifted_the_same(seed):
+    """Levels drawn at random (spans outside the region, several of a column on one
+    level): every branch of the lift, conflicts included."""
+    rng, col, link = _graph(seed)
+    moved = 0
+    for top in (2, 4):
+        level = rng.integers(-1, top, len(col)).astype(np.int64)
+        for steps in (0, 1, 5):
+            a, b = level.copy(), level.copy()
+            with use_kernels(True):
+                lift_to_portals(col, a, link, steps)
+            with use_kernels(False):
+                lift_to_portals(col, b, link, steps)
+            assert np.array_equal(a, b), (top, steps)
+            moved += int((a != level).sum())
+    assert moved > 50
+
+
+@needs_kernels
+@pytest.mark.parametrize("name", ["stacked_floors", "bridge", "two_storeys"])
+def test_generated_levels_stack_the_same(name):
+    import make_levels
+
+    m = make_levels.level(name)
+    V, F = np.asarray(m.vertices, np.float64), np.asarray(m.faces, np.int64)
+    params = WalkableParams(0.5, 0.1, 35.0, 0.9, 2.0)
+    with use_kernels(True):
+        a = walkable_surface(V, F, params, 1.0)
+    with use_kernels(False):
+        b = walkable_surface(V, F, params, 1.0)
+    assert np.array_equal(a.level, b.level) and a.levels == b.levels
