@@ -8,7 +8,8 @@ from __future__ import annotations
 
 import io
 import os
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -159,6 +160,57 @@ def save_preview(path: str | os.PathLike, walls: WallList, spawns: np.ndarray, t
 LEFT_OUT_COLOURS = {"unreachable": "#9a9a9a", "headroom": "#f0a030", "small": "#b060c0", "steep": "#d03030"}
 
 
+@dataclass(frozen=True)
+class _LevelsLayout:
+    """Where :func:`render_levels` puts its panels, in inches: laid out by hand from the
+    arena's aspect so the figure has no empty bands (a subplot grid with equal-aspect
+    panels leaves them, and a tight save costs a second draw)."""
+
+    cols: int
+    rows: int
+    panel_w: float
+    panel_h: float
+    bar: bool                       # a colour bar of heights on the right (not on a flat arena)
+    LEFT: ClassVar[float] = 0.8     # the z ticks and label
+    GAP_X: ClassVar[float] = 0.9
+    BELOW: ClassVar[float] = 1.15   # the x ticks and label, and the left-out legend under the first panel
+    TOP: ClassVar[float] = 0.75     # the title (two lines on one level)
+    RIGHT: ClassVar[float] = 1.3    # the colour bar and its label (0.3 without)
+
+    @classmethod
+    def of(cls, levels: int, aspect: float, bar: bool) -> "_LevelsLayout":
+        cols = 1 if levels == 1 else 2
+        panel_w = 9.0 if cols == 1 else 6.0
+        # a very long or very tall arena keeps a readable panel: the axes shrink inside it
+        return cls(cols, (levels + cols - 1) // cols, panel_w, float(np.clip(panel_w * aspect, 1.2, 12.0)), bar)
+
+    @property
+    def width(self) -> float:
+        return self.LEFT + self.cols * self.panel_w + (self.cols - 1) * self.GAP_X + (self.RIGHT if self.bar else 0.3)
+
+    @property
+    def top(self) -> float:
+        """Above the first row: its titles, and the figure's title when there are two panels or more."""
+        return self.TOP + (0.3 if self.rows * self.cols > 1 else 0.0)
+
+    @property
+    def height(self) -> float:
+        return self.top + self.rows * (self.panel_h + self.BELOW)
+
+    def panel(self, i: int) -> tuple[float, float, float, float]:
+        """Level ``i``'s axes as a figure fraction (left, bottom, width, height)."""
+        r, c = divmod(i, self.cols)
+        x = self.LEFT + c * (self.panel_w + self.GAP_X)
+        y = self.height - self.top - (r + 1) * self.panel_h - r * self.BELOW
+        return (x / self.width, y / self.height, self.panel_w / self.width, self.panel_h / self.height)
+
+    def colour_bar(self) -> tuple[float, float, float, float]:
+        """The colour bar's axes beside the panels, as a figure fraction."""
+        x = self.LEFT + self.cols * self.panel_w + (self.cols - 1) * self.GAP_X + 0.3
+        return (x / self.width, self.BELOW / self.height, 0.22 / self.width,
+                (self.height - self.BELOW - self.top) / self.height)
+
+
 def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     """PNG bytes of an arena's levels: a panel per level (one on a one-level arena),
     walkable cells coloured by height (a flat floor in light green), that level's walls
@@ -180,23 +232,20 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     walls = result.walls.walls
     (xmin, zmin), (xmax, zmax) = walls.bounds
     L = max(len(result.levels), 1)
-    cols = 1 if L == 1 else 2
-    rows = (L + cols - 1) // cols
     w = max(xmax - xmin, 1e-6)
     h = max(zmax - zmin, 1e-6)
-    panel_w = 9.0 if cols == 1 else 6.0
-    fig_h = float(np.clip(rows * (panel_w * h / w + 0.9) + 0.6, 3.5, 22.0))
-    fig = Figure(figsize=(panel_w * cols + 1.2, fig_h), dpi=size_px / (panel_w * cols + 1.2))
     exists, height, _, _ = surface_layers(surface, clearance=False)
     nz, nx = hf.shape
     step, extent = image_step((nz, nx), hf.origin[[0, 2]], hf.cs)
     ys = height[exists]
     lo, hi = (float(ys.min()), float(ys.max())) if len(ys) else (0.0, 1.0)
     flat = hi - lo <= 2 * hf.ch
+    layout = _LevelsLayout.of(L, h / w, bar=not flat)
+    fig = Figure(figsize=(layout.width, layout.height), dpi=size_px / layout.width)
     cmap = matplotlib.colormaps["viridis"]
     image = None
     for lv in range(L):
-        ax = fig.add_subplot(rows, cols, lv + 1)
+        ax = fig.add_axes(layout.panel(lv))
         ax.set_aspect("equal")
         if flat:
             fill_region(ax, result.walls.free(lv), FREE_COLOUR)
@@ -226,16 +275,11 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
             ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0), bbox_transform=under, ncol=2,
                       fontsize=7, framealpha=0.85)
     if image is not None:
-        fig.colorbar(image, ax=fig.axes, shrink=0.8, label="surface height y (m)")
+        fig.colorbar(image, cax=fig.add_axes(layout.colour_bar()), label="surface height y (m)")
     if L > 1:
-        # just above the panels: they keep their aspect, so the figure's set height
-        # leaves bands above and below them, which the tight save crops
-        for ax in fig.axes:
-            ax.apply_aspect()
-        top = max(ax.get_position().y1 for ax in fig.axes)
-        fig.suptitle(title, fontsize=10, y=min(top + 0.04, 0.99), va="bottom")
+        fig.suptitle(title, fontsize=10, y=1 - 0.2 / layout.height, va="top")
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None}, bbox_inches="tight", pad_inches=0.15)
+    fig.savefig(buf, format="png", metadata={"Software": None})
     return buf.getvalue()
 
 
