@@ -55,3 +55,28 @@ def test_the_solid_voxels_are_the_spans_filled_in(name):
     for c, a, b in zip(col, smin, smax):
         want[c * sf.ny + a:c * sf.ny + b] = True
     assert np.array_equal(sf.solid, want) and want.sum() > 1000
+
+
+@pytest.mark.parametrize("dtype, width", [(np.int8, 4), (np.int8, 3), (np.int16, 4), (np.int8, 2)])
+def test_rows_by_their_distinct_nodes_are_the_comprehensions(dtype, width):
+    # tuple_row picks each node's tuple among the row's distinct ones (the bytes of a
+    # node as one integer; other widths the per-node path); heights_row through an
+    # object array: both read as the plain comprehensions, types and shared tuples too
+    from tanktool.sim.lazy_rows import tuple_row
+
+    rng = np.random.default_rng(5)
+    row = rng.integers(-1, 3, size=(301, width)).astype(dtype)
+    got = tuple_row(row)
+    assert got == [tuple(r) for r in row.tolist()]
+    assert all(type(t) is tuple and type(t[0]) is int for t in got)
+    same = {}
+    assert all(same.setdefault(t, t) is t for t in got)     # equal tuples are one object
+    assert tuple_row(row[:0]) == []
+    h = rng.normal(size=301)
+    h[::7] = np.nan
+    h[3] = np.inf
+    want = [None if not math.isfinite(v) else float(v) for v in h.tolist()]
+    got_h = heights_row(h)
+    assert got_h == want and [type(v) for v in got_h] == [type(v) for v in want]
+    assert heights_row(h.astype(np.float32)) == [None if not math.isfinite(v) else float(v)
+                                                for v in h.astype(np.float32).tolist()]
