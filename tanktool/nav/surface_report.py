@@ -11,6 +11,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -108,11 +109,26 @@ def left_out(surface: Surface, vertices: np.ndarray, faces: np.ndarray, params: 
 MAX_PARITY_TESTS = 4000
 
 
+def _remembered(surface: Surface, key: tuple, model: tuple, work: Callable[[], np.ndarray]) -> np.ndarray:
+    """``work()`` once per surface, key and model (the report and the picture both ask,
+    with the same arrays): a copy of the remembered mask.  The model's arrays are kept
+    with it, so their ids in the key cannot be taken by other arrays meanwhile."""
+    key = (*key, *(id(a) for a in model))
+    if key not in surface.derived:
+        surface.derived[key] = (work(), model)
+    return surface.derived[key][0].copy()
+
+
 def low_headroom(surface: Surface, vertices: np.ndarray | None = None, faces: np.ndarray | None = None) -> np.ndarray:
     """Spans (of the heightfield) the headroom filter took away next to the played
     region: a tank would drive there but for the ceiling.  Given the model, spans
     inside a closed solid (the floor under a box or a ramp's wedge, which has no
     headroom either) are not counted."""
+    return _remembered(surface, ("low_headroom",), (vertices, faces),
+                       lambda: _low_headroom(surface, vertices, faces))
+
+
+def _low_headroom(surface: Surface, vertices: np.ndarray | None, faces: np.ndarray | None) -> np.ndarray:
     from ..geometry.heightfield import column_starts, neighbour_columns
 
     hf = surface.hf
@@ -153,6 +169,11 @@ def unreachable(surface: Surface, radius: float, vertices: np.ndarray | None = N
     (the tops of walls and boxes, too narrow for any tank, are not worth a word), and,
     given the model, not inside a closed solid (the floor under a box: an odd number
     of faces above it)."""
+    return _remembered(surface, ("unreachable", float(radius)), (vertices, faces),
+                       lambda: _unreachable(surface, radius, vertices, faces))
+
+
+def _unreachable(surface: Surface, radius: float, vertices: np.ndarray | None, faces: np.ndarray | None) -> np.ndarray:
     from ..geometry.segments import faces_above
 
     other = ~surface.main
