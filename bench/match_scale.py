@@ -123,7 +123,8 @@ def child(arena: str, bots: int, seconds: float, seed: int) -> dict:
     return {"arena": info.name, "nodes": _nodes(info), "steps": result.report["steps"],
             "steps_per_second": timing["steps_per_second"], "wall_s": timing["wall_clock_s"],
             "after_first_steps_per_second": round(after, 1) if after else None,
-            "first_step_s": round(ticks[0] - t0, 3) if ticks else None, "base_mb": round(base, 1),
+            "first_step_s": round(ticks[0] - t0, 3) if ticks else None, "prepare_s": timing.get("prepare_s"),
+            "base_mb": round(base, 1),
             "peak_mb": round(_status("VmHWM:"), 1),
             "phases": {k: {"seconds": round(v["seconds"], 3), "added_mb": round(v["added_mb"], 1),
                            "peak_mb": round(v["peak_mb"], 1), "calls": v["calls"]} for k, v in phases.items()}}
@@ -162,7 +163,7 @@ def make_terrains(sizes: list[float], cache: Path) -> list[str]:
 def print_table(rows: list[dict]) -> None:
     names = [n for n, _ in HOOKS]
     print(f"{'arena':<14}{'nodes':>12}{'steps/s':>9}{'x box':>7}{'later':>8}{'x box':>7}{'peak MB':>9}"
-          f"{'1st step s':>11}  "
+          f"{'1st step s':>11}{'prep s':>8}  "
           + "".join(f"{n + ' s/MB':>18}" for n in names))
     for r in rows:
         if "error" in r:
@@ -173,10 +174,10 @@ def print_table(rows: list[dict]) -> None:
                         for n in names)
         print(f"{r['arena']:<14}{r['nodes'] or 0:>12,}{r['steps_per_second']:>9.0f}{r.get('x_box') or 0:>7.2f}"
               f"{r['after_first_steps_per_second'] or 0:>8.0f}{r.get('x_box_later') or 0:>7.2f}"
-              f"{r['peak_mb']:>9.0f}{r['first_step_s'] or 0:>11.2f}  " + cells)
-    print("steps/s: the match loop's (tanktool play's figure, the agents' first think included); later: the steps"
-          " after the first; x box: over the box arena's in this run; 1st step s: from loading to the first"
-          " step's end (World, first think); MB of a phase: resident size it added at its peak")
+              f"{r['peak_mb']:>9.0f}{r['first_step_s'] or 0:>11.2f}{r.get('prepare_s') or 0:>8.2f}  " + cells)
+    print("steps/s: the match loop's (tanktool play's figure; the bots' arena tables are made before it, prep s);"
+          " later: the steps after the first; x box: over the box arena's in this run; 1st step s: from loading to"
+          " the first step's end (World, prep, first think); MB of a phase: resident size it added at its peak")
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -30,7 +30,7 @@ def test_headless_report(tmp_path):
     for t in rep["tanks"]:
         assert {"name", "kills", "deaths", "shots", "hits", "wall_bumps", "distance", "position"} <= set(t)
         assert len(t["position"]) == 2
-    assert set(rep["timing"]) == {"wall_clock_s", "steps_per_second", "realtime_factor", "bots"}
+    assert set(rep["timing"]) == {"wall_clock_s", "steps_per_second", "realtime_factor", "prepare_s", "bots"}
     # each bot's time per call (machine-dependent, so under timing): calls over the budget counted
     assert {"calls", "over_budget", "mean_ms", "max_ms"} <= set(rep["timing"]["bots"]["bot1"])
     # same seed: same report apart from timing

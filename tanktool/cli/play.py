@@ -428,7 +428,8 @@ def _play_headless(o: _Options) -> None:
     echo(scoreboard(report))
     timing = report["timing"]
     echo(f"{report['steps']} steps in {timing['wall_clock_s']:.2f} s: "
-         f"{timing['steps_per_second']:.0f} steps/s, {timing['realtime_factor']:.1f}x real time")
+         f"{timing['steps_per_second']:.0f} steps/s, {timing['realtime_factor']:.1f}x real time"
+         + (f" (bots prepared in {timing['prepare_s']:.2f} s before)" if timing.get("prepare_s", 0) >= 0.05 else ""))
     if o.report_path is not None:
         from ..formats.bundle import atomic_write_text
 

@@ -120,18 +120,25 @@ class Nav:
 
     def __init__(self, view: "View", rng: Any, cell: float, margin: float, half_angle: float,
                  vision_range: float) -> None:
-        from .navigation import agent_grid
-
-        v = view.me.vehicle
-        # on relief, no link steeper than the vehicle climbs at a useful speed
-        self.grade = GRADE * v.engine_force / (v.mass * GRAVITY)
-        self.grid: "NavGrid" = agent_grid(view.map, cell, v.radius + margin, self.grade)
-        self.plain: "NavGrid" = agent_grid(view.map, cell, v.radius + margin)
+        self.grade, self.grid, self.plain, self.views, self.vantages = Nav.tables(
+            view.map, view.me.vehicle, cell, margin, half_angle, vision_range)
         self.regions = Memory(self.grid, region=16.0)
         self.wanderer = Wanderer(self.grid, self.regions, rng)
-        self.views: Views = view.map.sight_table(self.grid)
         self.coverage = Coverage(self.views, half_angle, vision_range)
-        self.vantages: Vantages = vantages_for(self.views, half_angle, vision_range)
+
+    @staticmethod
+    def tables(map: Any, vehicle: Any, cell: float, margin: float, half_angle: float,
+               vision_range: float) -> tuple[float, "NavGrid", "NavGrid", Views, Vantages]:
+        """(grade, grid, plain grid, sight table, vantages) of the arena for this vehicle:
+        the map's, not anything seen (each cached per arena)."""
+        from .navigation import agent_grid
+
+        # on relief, no link steeper than the vehicle climbs at a useful speed
+        grade = GRADE * vehicle.engine_force / (vehicle.mass * GRAVITY)
+        grid = agent_grid(map, cell, vehicle.radius + margin, grade)
+        plain = agent_grid(map, cell, vehicle.radius + margin)
+        views = map.sight_table(grid)
+        return grade, grid, plain, views, vantages_for(views, half_angle, vision_range)
 
 
 class Agent(Pilot):
@@ -245,6 +252,12 @@ class Agent(Pilot):
         return super().drive(view, forward, lateral, rotate, fire)
 
     # ------------------------------------------------------------------ the bot
+    def prepare(self, map: Any, vehicle: Any) -> None:
+        """Make the arena's tables the first think reads (``Nav.tables``, cached per
+        arena): ``run_match`` calls it before its clock, as it loads the arena (on a
+        2 km terrain they take seconds; the steps after them a millisecond)."""
+        Nav.tables(map, vehicle, self.cell, self.margin, self.senses.half_angle, self.senses.vision_range)
+
     def act(self, view: "View") -> Command:
         if self.rng is None:
             self.rng = view.rng

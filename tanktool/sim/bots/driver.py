@@ -85,6 +85,22 @@ class BotDriver:
         self.stats = BotStats()
         self._warned: set[tuple[str, str]] = set()
 
+    def prepare(self, world: "World", tank: "Tank") -> None:
+        """Before the match's clock: the perception (as the first call makes it) and the
+        bot's ``prepare(map, vehicle)`` when it has one (the arena's tables it would
+        make in its first call).  A failing one is logged and counted like a failing
+        ``act``; the match goes on."""
+        if self.perceiver is None:
+            self.perceiver = Perceiver(world, tank.index, self.senses, self._noise_seed)
+        hook = getattr(self.bot, "prepare", None)
+        if not callable(hook):
+            return
+        try:
+            hook(self.perceiver.map, self.perceiver.vehicles[tank.index])
+        except Exception as e:          # a bot's bug must not end the match
+            self.stats.errors += 1
+            log.warning("bot %s (tank %d) failed to prepare: %s: %s", self.name, tank.index, type(e).__name__, e)
+
     def __call__(self, world: "World", tank: "Tank") -> Command:
         if self.perceiver is None:
             self.perceiver = Perceiver(world, tank.index, self.senses, self._noise_seed)
