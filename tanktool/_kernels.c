@@ -12,6 +12,8 @@
  *       col, floor, ceil, start: int64; out: int32 (n, 4), filled in place (n < 2**31)
  *   chamfer(link, dist, limit)
  *       link: int32 (n, 4); dist: int32 (n,), the starting values, relaxed in place
+ *   chamfer_near(link, dist, limit, col, nx, ncols)   (_kernels_levels.c)
+ *       as chamfer, over links between neighbour columns only (col: int64 (n,) sorted)
  *   reach(link, dist)
  *       as chamfer, straight steps of 2 only (surface_report._distance_from)
  *   raster(tri, abc, nz, nx, ch, max_steps, row_lo, row_hi, steep) -> (col, tri, smin, smax) as int64 bytes
@@ -93,25 +95,7 @@ done:
 
 #define OPEN ((i64)1 << 15)
 
-/* the value at span a, 0 off the edge (a < 0: the sentinel of chamfer_clearance) */
-static inline int32_t at(const int32_t *dist, i64 a) { return a < 0 ? 0 : dist[a]; }
-
-/* one relaxation of span s: straight steps cost 2, diagonal ones (a straight link,
- * then the next direction's link from there, either way round) 3 */
-static inline int32_t relax(const int32_t *L, const int32_t *dist, Py_ssize_t s, int32_t v) {
-    const int32_t *l = L + 4 * s;
-    for (int d = 0; d < 4; ++d) {
-        const int e = (d + 1) & 3;
-        const i64 a = l[d], b = l[e];
-        int32_t w = at(dist, a) + 2;
-        if (w < v) v = w;
-        w = (a < 0 ? 0 : at(dist, L[4 * a + e])) + 3;
-        if (w < v) v = w;
-        w = (b < 0 ? 0 : at(dist, L[4 * b + d])) + 3;
-        if (w < v) v = w;
-    }
-    return v;
-}
+/* at() and relax(): _kernels.h (chamfer_near in _kernels_levels.c shares them) */
 
 /* one relaxation of span s over straight links only (2 a step); off the edge is no
  * source here (surface_report._distance_from) */
@@ -487,6 +471,7 @@ done:
 static PyMethodDef methods[] = {
     {"link_spans", link_spans, METH_VARARGS, "links between open spans (see nav/kernels.py)"},
     {"chamfer", chamfer, METH_VARARGS, "chamfer distance relaxed to its fixed point, in place"},
+    {"chamfer_near", tanktool_chamfer_near, METH_VARARGS, "chamfer() relaxing only near the last changes (walkable links)"},
     {"reach", reach, METH_VARARGS, "straight-step distance from the sources relaxed to its fixed point, in place"},
     {"raster", tanktool_raster, METH_VARARGS, "spans of triangles, as heightfield._cells_plane / _cells_exact"},
     {"filters", filters, METH_VARARGS, "Recast's three span filters, as span_filters.filter_masks"},
@@ -505,7 +490,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 8
+#define TANKTOOL_KERNELS_ABI 9
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

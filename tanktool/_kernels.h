@@ -22,6 +22,28 @@ static inline int need(Py_buffer *b, Py_ssize_t items, Py_ssize_t itemsize, cons
 static inline i64 min64(i64 a, i64 b) { return a < b ? a : b; }
 static inline i64 max64(i64 a, i64 b) { return a > b ? a : b; }
 
+/* the chamfer relaxation (chamfer in _kernels.c, chamfer_near in _kernels_levels.c) */
+
+/* the value at span a, 0 off the edge (a < 0: the sentinel of chamfer_clearance) */
+static inline int32_t at(const int32_t *dist, i64 a) { return a < 0 ? 0 : dist[a]; }
+
+/* one relaxation of span s: straight steps cost 2, diagonal ones (a straight link,
+ * then the next direction's link from there, either way round) 3 */
+static inline int32_t relax(const int32_t *L, const int32_t *dist, Py_ssize_t s, int32_t v) {
+    const int32_t *l = L + 4 * s;
+    for (int d = 0; d < 4; ++d) {
+        const int e = (d + 1) & 3;
+        const i64 a = l[d], b = l[e];
+        int32_t w = at(dist, a) + 2;
+        if (w < v) v = w;
+        w = (a < 0 ? 0 : at(dist, L[4 * a + e])) + 3;
+        if (w < v) v = w;
+        w = (b < 0 ? 0 : at(dist, L[4 * b + d])) + 3;
+        if (w < v) v = w;
+    }
+    return v;
+}
+
 /* the rasteriser (_kernels_raster.c) */
 PyObject *tanktool_raster(PyObject *self, PyObject *args);
 
@@ -33,5 +55,6 @@ PyObject *tanktool_grid_runs(PyObject *self, PyObject *args);
 /* the levels (_kernels_levels.c) */
 PyObject *tanktool_level_votes(PyObject *self, PyObject *args);
 PyObject *tanktool_lift_portals(PyObject *self, PyObject *args);
+PyObject *tanktool_chamfer_near(PyObject *self, PyObject *args);
 
 #endif

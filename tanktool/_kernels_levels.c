@@ -1,4 +1,5 @@
-/* tanktool._kernels: the levels of the played region's spans (see _kernels.c).
+/* tanktool._kernels: the levels of the played region's spans, and the chamfer
+ * clearance near the edges only (see _kernels.c).
  *
  *   level_votes(col, keep, link, level, rounds)
  *       col: int64 (n,) sorted; keep: bool (n,); link: int32 (n, 4); level: int64 (n,)
@@ -9,6 +10,8 @@
  *   lift_portals(col, level, link, steps)
  *       col: int64 (n,) sorted; level: int64 (n,) in place (-1 outside the region);
  *       link: int32 (n, 4); level_lift.lift_to_portals
+ *   chamfer_near(link, dist, limit, col, nx, ncols)
+ *       walkable.chamfer_clearance with the spans' columns: as chamfer() in _kernels.c
  *
  * Why in C: numpy's rounds pass over every kept span to set up (neighbour levels,
  * column ranks, the first active set) and sort (column, level) keys in every round
@@ -246,5 +249,103 @@ done:
     PyBuffer_Release(&col);
     PyBuffer_Release(&level);
     PyBuffer_Release(&link);
+    return ret;
+}
+
+/* ------------------------------------------------------------------ clearance */
+
+/* chamfer() over the links of walkable.link_spans, whose reads (a straight step, a
+ * diagonal one) all lie in the 3 x 3 columns around a span's own: a sweep relaxes only
+ * the spans of columns next to one that changed in this sweep or the one before (a
+ * stamp a column, 1 byte; and a stamp a row, to pass over quiet rows whole), where
+ * chamfer() relaxes every span in every sweep.  The same fixed point: the shortest
+ * chamfer paths, unique with positive steps, and a span is relaxed again after every
+ * change it reads.  Sweep 0 "changes" the spans whose start is not the limit or that
+ * lack a link (the edge: the only spans below the limit before the sweeps, and the
+ * only ones read through the sentinel).  Stamps cycle 1..255: an old one read as new
+ * costs a relax, never a miss. */
+static inline int recent(const uint8_t *r, uint8_t prev, uint8_t cur) {
+    return r[0] == prev || r[0] == cur || r[1] == prev || r[1] == cur || r[2] == prev || r[2] == cur;
+}
+
+/* one sweep over the rows (forward or back); whether anything changed */
+static int sweep_near(const int32_t *L, int32_t *D, const i64 *C, const i64 *rs, i64 nz, i64 nx, uint8_t *stamp,
+                      uint8_t *rstamp, uint8_t prev, uint8_t cur, int back) {
+    int changed = 0;
+    for (i64 q = 0; q < nz; ++q) {
+        const i64 r = back ? nz - 1 - q : q;
+        if (!recent(rstamp + r, prev, cur)) continue;  /* rows r - 1 .. r + 1 (padded by one) */
+        for (i64 p = 0; p < rs[r + 1] - rs[r]; ++p) {
+            const i64 s = back ? rs[r + 1] - 1 - p : rs[r] + p;
+            const i64 c = C[s] + nx + 1;
+            /* a column's spans are adjacent: whether it is near a change could be found
+             * once a column, but a change in it makes it near, so each span asks */
+            if (!recent(stamp + c - nx - 1, prev, cur) && !recent(stamp + c - 1, prev, cur) &&
+                !recent(stamp + c + nx - 1, prev, cur))
+                continue;
+            const int32_t v = relax(L, D, s, D[s]);
+            if (v < D[s]) {
+                D[s] = v;
+                changed = 1;
+                stamp[c] = cur;
+                rstamp[r + 1] = cur;
+            }
+        }
+    }
+    return changed;
+}
+
+PyObject *tanktool_chamfer_near(PyObject *self, PyObject *args) {
+    Py_buffer link, dist, col;
+    int limit;
+    i64 nx, ncols;
+    if (!PyArg_ParseTuple(args, "y*w*iy*LL", &link, &dist, &limit, &col, &nx, &ncols)) return NULL;
+    Py_ssize_t n = dist.len / 4;
+    const i64 nz = nx > 0 ? ncols / nx : 0;
+    PyObject *ret = NULL;
+    uint8_t *stamp = NULL, *rstamp = NULL;
+    i64 *rs = NULL;
+    if (!need(&link, 4 * n, 4, "link") || !need(&col, n, 8, "col")) goto done;
+    stamp = calloc((size_t)(ncols + 2 * nx + 2), 1);  /* padded: column c at c + nx + 1 */
+    rstamp = calloc((size_t)(nz + 2), 1);             /* row r at r + 1 */
+    rs = malloc(sizeof(i64) * (size_t)(nz + 1));      /* the first span of each row */
+    if (stamp == NULL || rstamp == NULL || rs == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    {
+        const int32_t *L = link.buf;
+        const i64 *C = col.buf;
+        int32_t *D = dist.buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (i64 r = 0, s = 0; r <= nz; ++r) {
+            while (s < n && C[s] < r * nx) ++s;
+            rs[r] = s;
+        }
+        for (i64 r = 0; r < nz; ++r)
+            for (i64 s = rs[r]; s < rs[r + 1]; ++s) {
+                const int32_t *l = L + 4 * s;
+                if (D[s] != limit || l[0] < 0 || l[1] < 0 || l[2] < 0 || l[3] < 0) {
+                    stamp[C[s] + nx + 1] = 1;
+                    rstamp[r + 1] = 1;
+                }
+            }
+        uint8_t prev, cur = 1;
+        for (int k = 0, changed = 1; changed; ++k) {
+            prev = cur;
+            cur = cur == 255 ? 1 : cur + 1;
+            changed = sweep_near(L, D, C, rs, nz, nx, stamp, rstamp, prev, cur, k % 2);
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    free(stamp);
+    free(rstamp);
+    free(rs);
+    PyBuffer_Release(&link);
+    PyBuffer_Release(&dist);
+    PyBuffer_Release(&col);
     return ret;
 }

@@ -1,6 +1,7 @@
-"""The compiled levels (tanktool/_kernels_levels.c) against the numpy code they
-replace: the same levels from stack_levels and level_lift.lift_to_portals on random
-span graphs and on generated levels with decks over walkable ground."""
+"""The compiled levels and clearance (tanktool/_kernels_levels.c) against the numpy
+code they replace: the same levels from stack_levels and level_lift.lift_to_portals,
+the same chamfer clearance from the sweeps near the changes, on random span graphs
+and on generated levels with decks over walkable ground."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from tanktool.geometry import kernels
 from tanktool.geometry.kernels import use_kernels
 from tanktool.nav.level_lift import lift_to_portals
 from tanktool.nav.level_stack import stack_levels
-from tanktool.nav.walkable import WalkableParams, link_spans, walkable_surface
+from tanktool.nav.walkable import WalkableParams, chamfer_clearance, link_spans, walkable_surface
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tools"))
@@ -67,6 +68,41 @@ def test_random_levels_are_lifted_the_same(seed):
             assert np.array_equal(a, b), (top, steps)
             moved += int((a != level).sum())
     assert moved > 50
+
+
+def _storeys(rng, nz: int, nx: int):
+    """A ground with holes and a deck over part of it (one or two spans a column): wide
+    open areas, edges inside the level too."""
+    ground = rng.random((nz, nx)) > 0.04
+    deck = np.zeros((nz, nx), dtype=bool)
+    for _ in range(4):
+        i, j = rng.integers(0, nz), rng.integers(0, nx)
+        deck[max(i - 6, 0):i + 7, max(j - 9, 0):j + 10] = True
+    cells = np.arange(nz * nx)
+    col = np.concatenate([cells[ground.ravel()], cells[deck.ravel()]])
+    floor = np.concatenate([np.zeros(ground.sum(), np.int64), np.full(deck.sum(), 30)])
+    order = np.lexsort((floor, col))
+    col, floor = col[order], floor[order]
+    ceil = np.where((floor == 0) & np.isin(col, cells[deck.ravel()]), 25, 1000)
+    return col, link_spans(col, floor, ceil, (nz, nx), 3, 12)
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(8))
+def test_random_span_graphs_have_the_same_clearance_near_the_changes(seed):
+    rng = np.random.default_rng(seed)
+    shape = (41 + seed, 23 + 3 * seed)
+    col, link = _storeys(rng, *shape)
+    for share in (0.0, 0.02):  # links cut at random too: one-way links
+        cut = np.where(rng.random(link.shape) < share, -1, link).astype(np.int32)
+        for limit in (1, 3, 6, 20, 200):
+            with use_kernels(True):
+                a = chamfer_clearance(cut, limit, col, shape)
+                assert np.array_equal(a, chamfer_clearance(cut, limit))
+            with use_kernels(False):
+                b = chamfer_clearance(cut, limit, col, shape)
+            assert np.array_equal(a, b), (share, limit)
+            assert limit != 20 or ((a > 6) & (a < limit)).any()  # distances well inside
 
 
 @needs_kernels

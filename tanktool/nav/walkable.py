@@ -179,16 +179,22 @@ def link_spans(col: np.ndarray, floor: np.ndarray, ceil: np.ndarray, shape: tupl
     return link
 
 
-def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
+def chamfer_clearance(link: np.ndarray, limit: int, col: np.ndarray | None = None,
+                      shape: tuple[int, int] | None = None) -> np.ndarray:
     """Chamfer distance (half cells) from each span to the nearest edge of walkable space.
 
     A span with a side lacking a link is half a cell (1) from the edge; a straight step
     costs 2, a diagonal one 3 (through either of its two straight paths, both links
     present).  Values stop growing at ``limit``: only whether a span is that far
-    matters, and the relaxation needs about limit / 2 rounds.
+    matters, and the relaxation needs about limit / 2 rounds.  ``col`` and ``shape``:
+    the spans' columns, when every link leads to a neighbour column (:func:`link_spans`'
+    links): the compiled sweeps then relax only spans near the last changes.
     """
     n = len(link)
-    dist = np.where((link < 0).any(axis=1), np.int32(1), np.int32(limit))  # int32 from the start
+    # int32 from the start; a span's four "no link" flags read as one 4-byte word, where
+    # numpy's any(axis=1) took 1.2 ms on 84 k spans
+    edge = np.ascontiguousarray(link < 0).view(np.uint32).ravel() != 0
+    dist = np.where(edge, np.int32(1), np.int32(limit))
     if n == 0:
         return dist
     kern = active()
@@ -197,7 +203,13 @@ def chamfer_clearance(link: np.ndarray, limit: int) -> np.ndarray:
         # for the kernel, where numpy's relaxation takes ~130 bytes a span of temporaries
         link = link.astype(np.int32)
     if kern is not None and link.dtype == np.int32:  # sweeps to the same fixed point (tanktool/_kernels.c)
-        kern.chamfer(np.ascontiguousarray(link), dist, int(limit))
+        if col is not None and shape is not None:
+            # on open ground most spans are far from any edge and never change: a sweep
+            # skips the columns around which nothing changed (bridge 86 k spans: 3.7 -> 1.0 ms)
+            kern.chamfer_near(np.ascontiguousarray(link), dist, int(limit), i64(col), int(shape[1]),
+                              int(shape[0] * shape[1]))
+        else:
+            kern.chamfer(np.ascontiguousarray(link), dist, int(limit))
         return dist
     # index n is a sentinel at distance 0: a missing link leads off the edge
     safe = [np.ascontiguousarray(np.where(link[:, d] < 0, n, link[:, d])) for d in range(4)]
@@ -322,7 +334,7 @@ def build_surface(hf: Heightfield, headroom: float, climb: float, max_clearance:
     # kept as int32 (steps up to OPEN, labels below 2**31): 12 bytes a span less while
     # the surface lives (~0.2 GB on a 2 km terrain); the same values
     floor, ceil = floor.astype(np.int32), ceil.astype(np.int32)
-    clearance = _clearance(link, max_clearance, hf.cs) if distance else None
+    clearance = _clearance(link, max_clearance, hf.cs, col, hf.shape) if distance else None
     region = components(link) if len(col) else np.zeros(0, dtype=np.int64)
     if len(col) < 2**31 - 1:
         region = region.astype(np.int32)
@@ -332,10 +344,12 @@ def build_surface(hf: Heightfield, headroom: float, climb: float, max_clearance:
                    {"climb_steps": clim, "headroom_steps": head})
 
 
-def _clearance(link: np.ndarray, max_clearance: float, cs: float) -> np.ndarray:
-    """Metres from each span to the nearest edge, inf from ``max_clearance`` on."""
+def _clearance(link: np.ndarray, max_clearance: float, cs: float, col: np.ndarray | None = None,
+               shape: tuple[int, int] | None = None) -> np.ndarray:
+    """Metres from each span to the nearest edge, inf from ``max_clearance`` on
+    (``col``, ``shape``: as :func:`chamfer_clearance`)."""
     limit = int(math.ceil(2 * max_clearance / cs)) + 2
-    dist = chamfer_clearance(link, limit)
+    dist = chamfer_clearance(link, limit, col, shape)
     clearance = dist * (cs / 2)  # the same values as dist * cs / 2 (halving is exact), one array
     clearance[dist >= limit] = np.inf
     return clearance
@@ -359,7 +373,7 @@ def reseed(surface: Surface, max_clearance: float, seeds: np.ndarray | None = No
         clearance = surface.clearance.copy()
         clearance[surface.clearance >= limit * (hf.cs / 2)] = np.inf
     else:
-        clearance = _clearance(surface.link, max_clearance, hf.cs)
+        clearance = _clearance(surface.link, max_clearance, hf.cs, surface.col, hf.shape)
     main = _main_region(hf, surface.col, surface.floor, surface.region, seeds)
     level = stack_levels(surface.col, main, surface.link, lift=lift_steps(hf.cs))
     return Surface(hf, surface.col, surface.floor, surface.ceil, surface.link, clearance, surface.region, main,
