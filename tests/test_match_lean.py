@@ -1,0 +1,40 @@
+"""A match on a large terrain made leaner: what the agents' grids and sight tables
+read is what they read before (run arrays made on demand, one walk for both grades,
+the sight table's blocks in bands)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tanktool.nav.navgrid import layered_runs, runs
+from tanktool.sim.agents.layers import GroundGrid, ground_agent_grid
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="module", params=["fort", "hills"])
+def ground(request):
+    from tanktool.sim.match import load_match_arena
+
+    info = load_match_arena(ROOT / "arenas" / request.param)
+    spawns = [(float(s[0]), float(s[1]), None) for s in info.spawns]
+    return info.ground, spawns
+
+
+def test_run_arrays_on_demand_are_the_eager_ones(ground):
+    g, spawns = ground
+    grid = ground_agent_grid(g, 1.0, 1.9, spawns, grade=0.5)
+    lay = grid.layers
+    assert isinstance(grid, GroundGrid) and isinstance(lay, GroundGrid)
+    assert "_runs" not in vars(lay)            # nothing made until read
+    want = layered_runs(lay.valid, lay.link)
+    for name, w in zip(("row_index", "row_total", "col_index", "col_total"), want):
+        got = getattr(lay, name)
+        assert got.dtype == np.int16 and np.array_equal(got, w)
+    for name, w in zip(("row_index", "row_total", "col_index", "col_total"), runs(grid.valid[0])):
+        assert np.array_equal(getattr(grid, name)[0], w) and getattr(grid, name).shape == grid.valid.shape
+    lay.row_index = want[0]                   # given: kept as given
+    assert lay.row_index is want[0] and np.array_equal(lay.row_total, want[1])
