@@ -1,7 +1,7 @@
 /* tanktool._kernels: the walkable-surface loops numpy cannot make fast, in C.
  *
  * Four files (the rasteriser in _kernels_raster.c, the grid's loops in _kernels_grid.c,
- * the levels in _kernels_levels.c, shared definitions in _kernels.h).
+ * the open spans' passes in _kernels_surface.c, shared definitions in _kernels.h).
  * Optional: setup.py builds it when a C compiler is there; tanktool/nav/kernels.py
  * falls back to numpy otherwise, with identical results (tests/test_kernels.py
  * compares the two).  No numpy headers: arrays come in through the buffer protocol
@@ -12,7 +12,7 @@
  *       col, floor, ceil, start: int64; out: int32 (n, 4), filled in place (n < 2**31)
  *   chamfer(link, dist, limit)
  *       link: int32 (n, 4); dist: int32 (n,), the starting values, relaxed in place
- *   chamfer_near(link, dist, limit, col, nx, ncols)   (_kernels_levels.c)
+ *   chamfer_near(link, dist, limit, col, nx, ncols)   (_kernels_surface.c)
  *       as chamfer, over links between neighbour columns only (col: int64 (n,) sorted)
  *   reach(link, dist)
  *       as chamfer, straight steps of 2 only (surface_report._distance_from)
@@ -25,13 +25,15 @@
  *       int64 spans, bool walk; the five bool outputs of span_filters.filter_masks
  *   components(link, label)
  *       link: int32 (n, 4); label: int64 (n,) written: the smallest span of each component
- *   merge_spans(key, thr, col, smin, smax, walk, flat, top_walk) -> count
- *       key: sorted int64 packed pieces; outputs int64 / bool arrays as long as key
+ *   merge_pieces(col, smin, smax, walk, flat, thr, col, smin, smax, walk, flat, top_walk) -> count
+ *       (_kernels_raster.c) heightfield._merge: the pieces (int64 col, smin, smax; bool walk,
+ *       flat) merged into spans; outputs int64 / bool arrays as long as the pieces
  *   grid_labels(valid, link, L, nz, nx, out) -> k   (_kernels_grid.c)
  *   grid_links(span_of, link, level, col, exists, per, out)   (_kernels_grid.c)
  *   grid_runs(valid, link, L, nz, nx, row_index, row_total, col_index, col_total)   (_kernels_grid.c)
- *   level_votes(col, keep, link, level, rounds)   (_kernels_levels.c)
- *   lift_portals(col, level, link, steps)   (_kernels_levels.c)
+ *   open_spans(col, smin, smax, walk, out_col, out_floor, out_ceil) -> m   (_kernels_surface.c)
+ *   level_votes(col, keep, link, level, rounds)   (_kernels_surface.c)
+ *   lift_portals(col, level, link, steps)   (_kernels_surface.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -61,8 +63,18 @@ static PyObject *link_spans(PyObject *self, PyObject *args) {
         const i64 *c = col.buf, *f = floor_.buf, *ce = ceil_.buf, *st = start.buf;
         int32_t *o = out.buf;
         Py_BEGIN_ALLOW_THREADS
+        i64 last = -1, i = 0, j = 0;
         for (Py_ssize_t s = 0; s < n; ++s) {
-            const i64 i = c[s] / nx, j = c[s] % nx;
+            if (c[s] != last) {  /* col sorted: the next column's (i, j) by steps, a division at a gap */
+                if (last >= 0 && c[s] - last < nx) {
+                    j += c[s] - last;
+                    if (j >= nx) { j -= nx; ++i; }
+                } else {
+                    i = c[s] / nx;
+                    j = c[s] - i * nx;
+                }
+                last = c[s];
+            }
             for (int d = 0; d < 4; ++d) {
                 const i64 ii = i + DI[d], jj = j + DJ[d];
                 i64 found = -1;
@@ -95,7 +107,7 @@ done:
 
 #define OPEN ((i64)1 << 15)
 
-/* at() and relax(): _kernels.h (chamfer_near in _kernels_levels.c shares them) */
+/* at() and relax(): _kernels.h (chamfer_near in _kernels_surface.c shares them) */
 
 /* one relaxation of span s over straight links only (2 a step); off the edge is no
  * source here (surface_report._distance_from) */
@@ -211,72 +223,6 @@ static PyObject *components(PyObject *self, PyObject *args) {
 done:
     PyBuffer_Release(&link);
     PyBuffer_Release(&label);
-    return ret;
-}
-
-/* ------------------------------------------------------------------ merging */
-
-/* heightfield._merge over the sorted packed keys (column << 34 | bottom << 18 | top << 2
- * | walkable << 1 | flat): the overlapping or touching pieces of a column become one
- * span; its flags are those of the pieces whose tops lie within thr of its top (and
- * top_walk: of the pieces reaching its very top).  Writes the spans into the six
- * output arrays (at most as long as the keys) and returns how many. */
-static PyObject *merge_spans(PyObject *self, PyObject *args) {
-    Py_buffer key, col, smin, smax, walk, flat, topw;
-    i64 thr;
-    if (!PyArg_ParseTuple(args, "y*Lw*w*w*w*w*w*", &key, &thr, &col, &smin, &smax, &walk, &flat, &topw))
-        return NULL;
-    const Py_ssize_t n = key.len / 8;
-    Py_ssize_t m = 0;
-    PyObject *ret = NULL;
-    if (!need(&col, n, 8, "col") || !need(&smin, n, 8, "smin") || !need(&smax, n, 8, "smax") ||
-        !need(&walk, n, 1, "walk") || !need(&flat, n, 1, "flat") || !need(&topw, n, 1, "top_walk"))
-        goto done;
-    {
-        const i64 *K = key.buf;
-        i64 *C = col.buf, *S0 = smin.buf, *S1 = smax.buf;
-        char *W = walk.buf, *F = flat.buf, *T = topw.buf;
-        Py_BEGIN_ALLOW_THREADS
-        Py_ssize_t a = 0;
-        while (a < n) {
-            const i64 c = K[a] >> 34;
-            i64 top = (K[a] >> 2) & 0xFFFF;
-            Py_ssize_t b = a + 1;
-            while (b < n && (K[b] >> 34) == c && ((K[b] >> 18) & 0xFFFF) <= top) {
-                const i64 t = (K[b] >> 2) & 0xFFFF;
-                if (t > top) top = t;
-                ++b;
-            }
-            char w = 0, f = 0, tw = 0;
-            for (Py_ssize_t k = a; k < b; ++k) {
-                const i64 t = (K[k] >> 2) & 0xFFFF;
-                const int kw = (K[k] & 2) != 0, kf = (K[k] & 1) != 0;
-                if (t >= top - thr) {
-                    w |= kw;
-                    f |= kf;
-                }
-                if (t == top) tw |= kw;
-            }
-            C[m] = c;
-            S0[m] = (K[a] >> 18) & 0xFFFF;
-            S1[m] = top;
-            W[m] = w;
-            F[m] = f;
-            T[m] = tw;
-            ++m;
-            a = b;
-        }
-        Py_END_ALLOW_THREADS
-    }
-    ret = PyLong_FromSsize_t(m);
-done:
-    PyBuffer_Release(&key);
-    PyBuffer_Release(&col);
-    PyBuffer_Release(&smin);
-    PyBuffer_Release(&smax);
-    PyBuffer_Release(&walk);
-    PyBuffer_Release(&flat);
-    PyBuffer_Release(&topw);
     return ret;
 }
 
@@ -476,13 +422,14 @@ static PyMethodDef methods[] = {
     {"raster", tanktool_raster, METH_VARARGS, "spans of triangles, as heightfield._cells_plane / _cells_exact"},
     {"filters", filters, METH_VARARGS, "Recast's three span filters, as span_filters.filter_masks"},
     {"components", components, METH_VARARGS, "component labels (smallest span index), in place"},
-    {"merge_spans", merge_spans, METH_VARARGS, "the merged spans of sorted packed keys"},
+    {"merge_pieces", tanktool_merge_pieces, METH_VARARGS, "the merged spans of unsorted pieces (_kernels_raster.c)"},
     {"grid_labels", tanktool_grid_labels, METH_VARARGS, "component labels of the grid's valid nodes (_kernels_grid.c)"},
     {"grid_links", tanktool_grid_links, METH_VARARGS, "the layered grid's links from the surface's (_kernels_grid.c)"},
     {"grid_runs", tanktool_grid_runs, METH_VARARGS, "the layered grid's row and column runs (_kernels_grid.c)"},
     {"chamfer_grid", chamfer_grid, METH_VARARGS, "chamfer() on the ground's (L, nz, nx, 4) int8 links, in place"},
-    {"level_votes", tanktool_level_votes, METH_VARARGS, "levels by column rank, then the voting rounds (_kernels_levels.c)"},
-    {"lift_portals", tanktool_lift_portals, METH_VARARGS, "level_lift.lift_to_portals in place (_kernels_levels.c)"},
+    {"open_spans", tanktool_open_spans, METH_VARARGS, "the walkable spans' columns, floors, ceilings (_kernels_surface.c)"},
+    {"level_votes", tanktool_level_votes, METH_VARARGS, "levels by column rank, then the voting rounds (_kernels_surface.c)"},
+    {"lift_portals", tanktool_lift_portals, METH_VARARGS, "level_lift.lift_to_portals in place (_kernels_surface.c)"},
     {NULL, NULL, 0, NULL},
 };
 
@@ -490,7 +437,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 9
+#define TANKTOOL_KERNELS_ABI 11
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

@@ -22,7 +22,7 @@ static inline int need(Py_buffer *b, Py_ssize_t items, Py_ssize_t itemsize, cons
 static inline i64 min64(i64 a, i64 b) { return a < b ? a : b; }
 static inline i64 max64(i64 a, i64 b) { return a > b ? a : b; }
 
-/* the chamfer relaxation (chamfer in _kernels.c, chamfer_near in _kernels_levels.c) */
+/* the chamfer relaxation (chamfer in _kernels.c, chamfer_near in _kernels_surface.c) */
 
 /* the value at span a, 0 off the edge (a < 0: the sentinel of chamfer_clearance) */
 static inline int32_t at(const int32_t *dist, i64 a) { return a < 0 ? 0 : dist[a]; }
@@ -46,13 +46,15 @@ static inline int32_t relax(const int32_t *L, const int32_t *dist, Py_ssize_t s,
 
 /* the rasteriser (_kernels_raster.c) */
 PyObject *tanktool_raster(PyObject *self, PyObject *args);
+PyObject *tanktool_merge_pieces(PyObject *self, PyObject *args);
 
 /* the grid (_kernels_grid.c) */
 PyObject *tanktool_grid_labels(PyObject *self, PyObject *args);
 PyObject *tanktool_grid_links(PyObject *self, PyObject *args);
 PyObject *tanktool_grid_runs(PyObject *self, PyObject *args);
 
-/* the levels (_kernels_levels.c) */
+/* the open spans, their clearance and levels (_kernels_surface.c) */
+PyObject *tanktool_open_spans(PyObject *self, PyObject *args);
 PyObject *tanktool_level_votes(PyObject *self, PyObject *args);
 PyObject *tanktool_lift_portals(PyObject *self, PyObject *args);
 PyObject *tanktool_chamfer_near(PyObject *self, PyObject *args);

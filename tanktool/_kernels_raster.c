@@ -1,6 +1,7 @@
 /* tanktool/_kernels_raster.c: heightfield.rasterize's loops in C (see _kernels.c):
  * the spans of each (triangle, cell) pair, the same arithmetic in the same order as
- * the numpy code, so that the spans are identical. */
+ * the numpy code, so that the spans are identical; and heightfield._merge's, the
+ * pieces of each column merged into spans. */
 #include "_kernels.h"
 
 /* ------------------------------------------------------------------ rasterising */
@@ -297,3 +298,132 @@ done:
     return ret;
 }
 
+/* ------------------------------------------------------------------ merging */
+
+/* heightfield._merge (numpy) over the sorted packed keys (column << 34 | bottom << 18 | top << 2
+ * | walkable << 1 | flat): the overlapping or touching pieces of a column become one
+ * span; its flags are those of the pieces whose tops lie within thr of its top (and
+ * top_walk: of the pieces reaching its very top).  Writes the spans into the six
+ * output arrays (at most as long as the keys) and returns how many. */
+static Py_ssize_t merge_keys(const i64 *K, Py_ssize_t n, i64 thr, i64 *C, i64 *S0, i64 *S1, char *W, char *F,
+                             char *T) {
+    Py_ssize_t m = 0, a = 0;
+    while (a < n) {
+        const i64 c = K[a] >> 34;
+        i64 top = (K[a] >> 2) & 0xFFFF;
+        Py_ssize_t b = a + 1;
+        while (b < n && (K[b] >> 34) == c && ((K[b] >> 18) & 0xFFFF) <= top) {
+            const i64 t = (K[b] >> 2) & 0xFFFF;
+            if (t > top) top = t;
+            ++b;
+        }
+        char w = 0, f = 0, tw = 0;
+        for (Py_ssize_t k = a; k < b; ++k) {
+            const i64 t = (K[k] >> 2) & 0xFFFF;
+            const int kw = (K[k] & 2) != 0, kf = (K[k] & 1) != 0;
+            if (t >= top - thr) {
+                w |= kw;
+                f |= kf;
+            }
+            if (t == top) tw |= kw;
+        }
+        C[m] = c;
+        S0[m] = (K[a] >> 18) & 0xFFFF;
+        S1[m] = top;
+        W[m] = w;
+        F[m] = f;
+        T[m] = tw;
+        ++m;
+        a = b;
+    }
+    return m;
+}
+
+/* the six output arrays of the merges, checked against n items */
+static int merge_outputs(Py_buffer *o, Py_ssize_t n) {
+    return need(&o[0], n, 8, "col") && need(&o[1], n, 8, "smin") && need(&o[2], n, 8, "smax") &&
+           need(&o[3], n, 1, "walk") && need(&o[4], n, 1, "flat") && need(&o[5], n, 1, "top_walk");
+}
+
+static int cmp_i64(const void *a, const void *b) {
+    const i64 x = *(const i64 *)a, y = *(const i64 *)b;
+    return (x > y) - (x < y);
+}
+
+/* the pieces' packed keys in sorted order without sorting them all: counted into their
+ * columns (over the columns' range only: a band of a tiled build), then each column's
+ * few keys sorted in place.  The same array np.sort gives, so the same spans */
+static int sorted_keys(const i64 *col, const i64 *lo, const i64 *hi, const uint8_t *walk, const uint8_t *flat,
+                       Py_ssize_t n, i64 *K) {
+    i64 cmin = col[0], cmax = col[0];
+    for (Py_ssize_t s = 1; s < n; ++s) {
+        if (col[s] < cmin) cmin = col[s];
+        if (col[s] > cmax) cmax = col[s];
+    }
+    const i64 range = cmax - cmin + 1;
+    i64 *start = calloc((size_t)range + 1, sizeof(i64));
+    if (start == NULL) return 0;
+    for (Py_ssize_t s = 0; s < n; ++s) start[col[s] - cmin + 1]++;
+    for (i64 c = 0; c < range; ++c) start[c + 1] += start[c];
+    for (Py_ssize_t s = 0; s < n; ++s)  /* start[c] runs to the column's end, then back below */
+        K[start[col[s] - cmin]++] = (col[s] << 34) | (lo[s] << 18) | (hi[s] << 2) | ((i64)(walk[s] != 0) << 1) |
+                                    (i64)(flat[s] != 0);
+    for (i64 c = 0, a = 0; c < range; ++c) {
+        const i64 b = start[c];  /* the column's keys are K[a:b] */
+        if (b - a > 24) {
+            qsort(K + a, (size_t)(b - a), sizeof(i64), cmp_i64);
+        } else {
+            for (i64 k = a + 1; k < b; ++k) {  /* insertion: a column holds a few pieces */
+                const i64 v = K[k];
+                i64 q = k - 1;
+                while (q >= a && K[q] > v) {
+                    K[q + 1] = K[q];
+                    --q;
+                }
+                K[q + 1] = v;
+            }
+        }
+        a = b;
+    }
+    free(start);
+    return 1;
+}
+
+PyObject *tanktool_merge_pieces(PyObject *self, PyObject *args) {
+    Py_buffer col, lo, hi, walk, flat, o[6];
+    i64 thr;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*y*Lw*w*w*w*w*w*", &col, &lo, &hi, &walk, &flat, &thr, &o[0], &o[1], &o[2],
+                          &o[3], &o[4], &o[5]))
+        return NULL;
+    const Py_ssize_t n = col.len / 8;
+    Py_ssize_t m = 0;
+    PyObject *ret = NULL;
+    i64 *K = NULL;
+    if (!need(&lo, n, 8, "smin") || !need(&hi, n, 8, "smax") || !need(&walk, n, 1, "walk") ||
+        !need(&flat, n, 1, "flat") || !merge_outputs(o, n))
+        goto done;
+    K = malloc(sizeof(i64) * (size_t)(n + 1));
+    if (K == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    int ok = 1;
+    Py_BEGIN_ALLOW_THREADS
+    if (n > 0) ok = sorted_keys(col.buf, lo.buf, hi.buf, walk.buf, flat.buf, n, K);
+    if (ok) m = merge_keys(K, n, thr, o[0].buf, o[1].buf, o[2].buf, o[3].buf, o[4].buf, o[5].buf);
+    Py_END_ALLOW_THREADS
+    if (!ok) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    ret = PyLong_FromSsize_t(m);
+done:
+    free(K);
+    PyBuffer_Release(&col);
+    PyBuffer_Release(&lo);
+    PyBuffer_Release(&hi);
+    PyBuffer_Release(&walk);
+    PyBuffer_Release(&flat);
+    for (int k = 0; k < 6; ++k) PyBuffer_Release(&o[k]);
+    return ret;
+}

@@ -1,4 +1,4 @@
-"""The compiled levels and clearance (tanktool/_kernels_levels.c) against the numpy
+"""The compiled levels and clearance (tanktool/_kernels_surface.c) against the numpy
 code they replace: the same levels from stack_levels and level_lift.lift_to_portals,
 the same chamfer clearance from the sweeps near the changes, on random span graphs
 and on generated levels with decks over walkable ground."""

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ArenaError
-from .kernels import active
+from .kernels import active, i64
 from .span_filters import OPEN, _next_in_column, column_starts, filter_spans, neighbour_columns  # noqa: F401
 
 #: refuse heightfields larger than this (columns) or spans beyond this many cells high
@@ -531,15 +531,14 @@ def _merge(col, smin, smax, walk, flat, thr):
         e = np.zeros(0, dtype=np.int64)
         b = np.zeros(0, dtype=bool)
         return e, e, e, b, b, b
+    kern = active()
+    if kern is not None:  # keys counted into columns, no sort of them all; one pass (_kernels_raster.c)
+        out = [np.empty(len(col), dtype=t) for t in (np.int64,) * 3 + (bool,) * 3]
+        m = kern.merge_pieces(i64(col), i64(smin), i64(smax), *(np.ascontiguousarray(a, dtype=bool) for a in
+                                                                 (walk, flat)), int(thr), *out)
+        return tuple(a[:m] for a in out)
     key = (col.astype(np.int64, copy=False) << 34) | (smin << 18) | (smax << 2) | (walk.astype(np.int64) << 1) | flat
     key.sort()
-    kern = active()
-    if kern is not None:  # one pass over the sorted keys
-        n = len(key)
-        col, smin, smax = (np.empty(n, dtype=np.int64) for _ in range(3))
-        walk, flat, top_walk = (np.empty(n, dtype=bool) for _ in range(3))
-        m = kern.merge_spans(key, int(thr), col, smin, smax, walk, flat, top_walk)
-        return col[:m], smin[:m], smax[:m], walk[:m], flat[:m], top_walk[:m]
     col = key >> 34
     smin = (key >> 18) & 0xFFFF
     smax = (key >> 2) & 0xFFFF

@@ -49,7 +49,7 @@ def lift_to_portals(col: np.ndarray, level: np.ndarray, link: np.ndarray, steps:
     if (kern is not None and link.dtype == np.int32 and level.dtype == np.int64 and level.flags.c_contiguous
             and level.flags.writeable):
         # one pass a direction and a look along the column for held(), where numpy sorts
-        # every kept span's key and searches it per step (tanktool/_kernels_levels.c)
+        # every kept span's key and searches it per step (tanktool/_kernels_surface.c)
         kern.lift_portals(i64(col), level, np.ascontiguousarray(link), int(steps))
         return
     kept = np.flatnonzero(level >= 0)

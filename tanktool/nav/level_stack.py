@@ -26,7 +26,7 @@ def stack_levels(col: np.ndarray, keep: np.ndarray, link: np.ndarray | None = No
     level = np.full(len(col), -1, dtype=np.int64)
     kern = active()
     if kern is not None and link is not None and link.dtype == np.int32:
-        # the ranks and the rounds in one call (tanktool/_kernels_levels.c): the same
+        # the ranks and the rounds in one call (tanktool/_kernels_surface.c): the same
         # moves, without numpy's passes over every kept span to set them up
         top = kern.level_votes(i64(col), np.ascontiguousarray(keep, dtype=bool), np.ascontiguousarray(link),
                                level, int(rounds))

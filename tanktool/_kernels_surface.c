@@ -1,6 +1,11 @@
-/* tanktool._kernels: the levels of the played region's spans, and the chamfer
- * clearance near the edges only (see _kernels.c).
+/* tanktool._kernels: the walkable surface's passes over its open spans (see _kernels.c):
+ * the open spans themselves, the chamfer clearance near the edges only, the levels of
+ * the played region's spans.
  *
+ *   open_spans(col, smin, smax, walk, out_col, out_floor, out_ceil) -> m
+ *       col, smin, smax: int32 (n,) the heightfield's spans; walk: bool (n,); written:
+ *       the m walkable spans' column (int64), floor (their top) and ceiling (the next
+ *       span's bottom in the column, OPEN above the top one), int32
  *   level_votes(col, keep, link, level, rounds)
  *       col: int64 (n,) sorted; keep: bool (n,); link: int32 (n, 4); level: int64 (n,)
  *       written: each kept span's rank among the kept spans of its column (-1 where not
@@ -20,6 +25,46 @@
  * adjacent (col sorted), so "the spans of my column" needs no index.
  */
 #include "_kernels.h"
+
+#define OPEN_STEPS ((int32_t)1 << 15)  /* span_filters.OPEN */
+
+/* walkable.build_surface's open spans in one pass, where numpy made the ceilings of
+ * every span (heightfield.ceiling) and then three masked copies */
+PyObject *tanktool_open_spans(PyObject *self, PyObject *args) {
+    Py_buffer col, smin, smax, walk, oc, of, oce;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*w*w*w*", &col, &smin, &smax, &walk, &oc, &of, &oce)) return NULL;
+    const Py_ssize_t n = col.len / 4, m = of.len / 4;
+    PyObject *ret = NULL;
+    Py_ssize_t k = 0;
+    if (!need(&smin, n, 4, "smin") || !need(&smax, n, 4, "smax") || !need(&walk, n, 1, "walk") ||
+        !need(&oc, m, 8, "out_col") || !need(&oce, m, 4, "out_ceil"))
+        goto done;
+    {
+        const int32_t *C = col.buf, *lo = smin.buf, *hi = smax.buf;
+        const uint8_t *W = walk.buf;
+        i64 *outc = oc.buf;
+        int32_t *outf = of.buf, *outce = oce.buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t s = 0; s < n && k < m; ++s) {
+            if (!W[s]) continue;
+            const int32_t up = s + 1 < n && C[s + 1] == C[s] ? lo[s + 1] : OPEN_STEPS;
+            outc[k] = C[s];
+            outf[k] = hi[s];
+            outce[k++] = up < OPEN_STEPS ? up : OPEN_STEPS;
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = PyLong_FromSsize_t(k);
+done:
+    PyBuffer_Release(&col);
+    PyBuffer_Release(&smin);
+    PyBuffer_Release(&smax);
+    PyBuffer_Release(&walk);
+    PyBuffer_Release(&oc);
+    PyBuffer_Release(&of);
+    PyBuffer_Release(&oce);
+    return ret;
+}
 
 /* the votes of one span at level cur with neighbour levels nl[4] (-1: none): the
  * level it moves to, or -1 to stay (level_stack._vote_rounds' rule) */
