@@ -16,18 +16,18 @@
  *       as chamfer, over links between neighbour columns only (col: int64 (n,) sorted)
  *   reach(link, dist)
  *       as chamfer, straight steps of 2 only (surface_report._distance_from)
- *   raster(tri, abc, nz, nx, ch, max_steps, row_lo, row_hi, steep) -> (col, tri, smin, smax) as int64 bytes
- *       (the cells of rows row_lo .. row_hi - 1 only); steep: the triangles' exact sections
- *       (heightfield._cells_exact) instead of their planes (_cells_plane; abc unused)
- *       tri: float64 (n, 9) x0 x1 x2 z0 z1 z2 y0 y1 y2 in grid units (y in metres);
- *       abc: float64 (n, 3) the plane y = A + B x + C z of each triangle
  *   filters(col, smin, smax, walk, nz, nx, headroom, climb, w3, lifted, ledge, steep, low)
  *       int64 spans, bool walk; the five bool outputs of span_filters.filter_masks
  *   components(link, label)
  *       link: int32 (n, 4); label: int64 (n,) written: the smallest span of each component
- *   merge_pieces(col, smin, smax, walk, flat, thr, col, smin, smax, walk, flat, top_walk) -> count
- *       (_kernels_raster.c) heightfield._merge: the pieces (int64 col, smin, smax; bool walk,
- *       flat) merged into spans; outputs int64 / bool arrays as long as the pieces
+ *   raster_merge(tri, abc, steep, walk, flat, nz, nx, ch, max_steps, row_lo, row_hi, thr)
+ *       -> (pieces, col, smin, smax, walk, flat, top_walk)   (_kernels_raster.c)
+ *       the pieces of every triangle (of rows row_lo .. row_hi - 1 only): steep ones by
+ *       their exact sections (heightfield._cells_exact), gentle ones by their planes
+ *       (_cells_plane); merged as heightfield._merge does; the spans as bytearrays
+ *       (int64 col, smin, smax; bool flags).  tri: float64 (n, 9) x0 x1 x2 z0 z1 z2
+ *       y0 y1 y2 in grid units (y in metres); abc: float64 (n, 3) the plane
+ *       y = A + B x + C z of each gentle triangle; steep, walk, flat: bool (n,)
  *   grid_labels(valid, link, L, nz, nx, out) -> k   (_kernels_grid.c)
  *   grid_links(span_of, link, level, col, exists, per, out)   (_kernels_grid.c)
  *   grid_runs(valid, link, L, nz, nx, row_index, row_total, col_index, col_total)   (_kernels_grid.c)
@@ -419,10 +419,9 @@ static PyMethodDef methods[] = {
     {"chamfer", chamfer, METH_VARARGS, "chamfer distance relaxed to its fixed point, in place"},
     {"chamfer_near", tanktool_chamfer_near, METH_VARARGS, "chamfer() relaxing only near the last changes (walkable links)"},
     {"reach", reach, METH_VARARGS, "straight-step distance from the sources relaxed to its fixed point, in place"},
-    {"raster", tanktool_raster, METH_VARARGS, "spans of triangles, as heightfield._cells_plane / _cells_exact"},
     {"filters", filters, METH_VARARGS, "Recast's three span filters, as span_filters.filter_masks"},
     {"components", components, METH_VARARGS, "component labels (smallest span index), in place"},
-    {"merge_pieces", tanktool_merge_pieces, METH_VARARGS, "the merged spans of unsorted pieces (_kernels_raster.c)"},
+    {"raster_merge", tanktool_raster_merge, METH_VARARGS, "every triangle's pieces merged into spans (_kernels_raster.c)"},
     {"grid_labels", tanktool_grid_labels, METH_VARARGS, "component labels of the grid's valid nodes (_kernels_grid.c)"},
     {"grid_links", tanktool_grid_links, METH_VARARGS, "the layered grid's links from the surface's (_kernels_grid.c)"},
     {"grid_runs", tanktool_grid_runs, METH_VARARGS, "the layered grid's row and column runs (_kernels_grid.c)"},
@@ -437,7 +436,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 11
+#define TANKTOOL_KERNELS_ABI 12
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

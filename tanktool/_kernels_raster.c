@@ -6,13 +6,28 @@
 
 /* ------------------------------------------------------------------ rasterising */
 
-/* growable int64 columns of the rasteriser's output */
+/* growable int64 columns of the rasteriser's output; with walk and flat (raster_merge)
+ * one packed key a piece instead (column << 34 | bottom << 18 | top << 2 | walkable << 1
+ * | flat: the key heightfield._merge sorts), 8 bytes a piece where the columns take 32 */
 typedef struct {
     i64 *col, *tri, *smin, *smax;
     Py_ssize_t n, cap;
+    const uint8_t *walk, *flat;  /* per triangle */
 } Cells;
 
 static int cells_push(Cells *c, i64 col, i64 tri, i64 smin, i64 smax) {
+    if (c->walk != NULL) {
+        if (c->n == c->cap) {
+            Py_ssize_t cap = c->cap ? 2 * c->cap : 4096;
+            i64 *a = realloc(c->col, cap * 8);
+            if (a == NULL) return 0;
+            c->col = a;
+            c->cap = cap;
+        }
+        c->col[c->n++] = (col << 34) | (smin << 18) | (smax << 2) | ((i64)(c->walk[tri] != 0) << 1) |
+                         (i64)(c->flat[tri] != 0);
+        return 1;
+    }
     if (c->n == c->cap) {
         Py_ssize_t cap = c->cap ? 2 * c->cap : 1024;
         i64 *a = realloc(c->col, cap * 8), *b = a ? realloc(c->tri, cap * 8) : NULL;
@@ -252,52 +267,6 @@ static int raster_one(Cells *out, Scratch *buf, int steep, i64 t, const double *
     return 1;
 }
 
-static PyObject *as_bytes(const i64 *a, Py_ssize_t n) {
-    return PyBytes_FromStringAndSize(n ? (const char *)a : "", n * 8);
-}
-
-PyObject *tanktool_raster(PyObject *self, PyObject *args) {
-    Py_buffer tri, abc;
-    i64 nz, nx, maxh, row_lo, row_hi;
-    double ch;
-    int steep;
-    if (!PyArg_ParseTuple(args, "y*y*LLdLLLp", &tri, &abc, &nz, &nx, &ch, &maxh, &row_lo, &row_hi, &steep))
-        return NULL;
-    if (row_lo < 0) row_lo = 0;
-    if (row_hi > nz) row_hi = nz;
-    const Py_ssize_t n = tri.len / (9 * 8);
-    PyObject *ret = NULL;
-    Cells out = {0};
-    Scratch buf = {0};
-    int ok = 1;
-    if (!need(&tri, 9 * n, 8, "tri") || !need(&abc, 3 * n, 8, "abc")) goto done;
-    {
-        const double *T = tri.buf, *P = abc.buf;
-        Py_BEGIN_ALLOW_THREADS
-        for (Py_ssize_t t = 0; t < n && ok; ++t) {
-            const double *v = T + 9 * t; /* x0 x1 x2 z0 z1 z2 y0 y1 y2 */
-            ok = raster_one(&out, &buf, steep, t, v, v + 3, v + 6, P[3 * t], P[3 * t + 1], P[3 * t + 2], row_lo,
-                            row_hi, nx, ch, maxh);
-        }
-        Py_END_ALLOW_THREADS
-    }
-    if (!ok) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    ret = Py_BuildValue("(NNNN)", as_bytes(out.col, out.n), as_bytes(out.tri, out.n), as_bytes(out.smin, out.n),
-                        as_bytes(out.smax, out.n));
-done:
-    free(buf.v);
-    free(out.col);
-    free(out.tri);
-    free(out.smin);
-    free(out.smax);
-    PyBuffer_Release(&tri);
-    PyBuffer_Release(&abc);
-    return ret;
-}
-
 /* ------------------------------------------------------------------ merging */
 
 /* heightfield._merge (numpy) over the sorted packed keys (column << 34 | bottom << 18 | top << 2
@@ -350,37 +319,36 @@ static int cmp_i64(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
-/* the pieces' packed keys in sorted order without sorting them all: counted into their
- * columns (over the columns' range only: a band of a tiled build), then each column's
- * few keys sorted in place.  The same array np.sort gives, so the same spans */
-static int sorted_keys(const i64 *col, const i64 *lo, const i64 *hi, const uint8_t *walk, const uint8_t *flat,
-                       Py_ssize_t n, i64 *K) {
-    i64 cmin = col[0], cmax = col[0];
+/* the packed keys K (n) in sorted order into S, without sorting them all: counted into
+ * their columns (over the columns' range only: a band of a tiled build), then each
+ * column's few keys sorted in place.  The array np.sort gives, so the same spans */
+static int sort_packed(const i64 *K, Py_ssize_t n, i64 *S) {
+    if (n == 0) return 1;
+    i64 cmin = K[0] >> 34, cmax = cmin;
     for (Py_ssize_t s = 1; s < n; ++s) {
-        if (col[s] < cmin) cmin = col[s];
-        if (col[s] > cmax) cmax = col[s];
+        const i64 c = K[s] >> 34;
+        if (c < cmin) cmin = c;
+        if (c > cmax) cmax = c;
     }
     const i64 range = cmax - cmin + 1;
     i64 *start = calloc((size_t)range + 1, sizeof(i64));
     if (start == NULL) return 0;
-    for (Py_ssize_t s = 0; s < n; ++s) start[col[s] - cmin + 1]++;
+    for (Py_ssize_t s = 0; s < n; ++s) start[(K[s] >> 34) - cmin + 1]++;
     for (i64 c = 0; c < range; ++c) start[c + 1] += start[c];
-    for (Py_ssize_t s = 0; s < n; ++s)  /* start[c] runs to the column's end, then back below */
-        K[start[col[s] - cmin]++] = (col[s] << 34) | (lo[s] << 18) | (hi[s] << 2) | ((i64)(walk[s] != 0) << 1) |
-                                    (i64)(flat[s] != 0);
+    for (Py_ssize_t s = 0; s < n; ++s) S[start[(K[s] >> 34) - cmin]++] = K[s];  /* start[c]: the column's end after */
     for (i64 c = 0, a = 0; c < range; ++c) {
-        const i64 b = start[c];  /* the column's keys are K[a:b] */
+        const i64 b = start[c];  /* the column's keys are S[a:b] */
         if (b - a > 24) {
-            qsort(K + a, (size_t)(b - a), sizeof(i64), cmp_i64);
+            qsort(S + a, (size_t)(b - a), sizeof(i64), cmp_i64);
         } else {
             for (i64 k = a + 1; k < b; ++k) {  /* insertion: a column holds a few pieces */
-                const i64 v = K[k];
+                const i64 v = S[k];
                 i64 q = k - 1;
-                while (q >= a && K[q] > v) {
-                    K[q + 1] = K[q];
+                while (q >= a && S[q] > v) {
+                    S[q + 1] = S[q];
                     --q;
                 }
-                K[q + 1] = v;
+                S[q + 1] = v;
             }
         }
         a = b;
@@ -389,41 +357,76 @@ static int sorted_keys(const i64 *col, const i64 *lo, const i64 *hi, const uint8
     return 1;
 }
 
-PyObject *tanktool_merge_pieces(PyObject *self, PyObject *args) {
-    Py_buffer col, lo, hi, walk, flat, o[6];
-    i64 thr;
-    if (!PyArg_ParseTuple(args, "y*y*y*y*y*Lw*w*w*w*w*w*", &col, &lo, &hi, &walk, &flat, &thr, &o[0], &o[1], &o[2],
-                          &o[3], &o[4], &o[5]))
+static PyObject *as_array(const void *a, Py_ssize_t bytes) {
+    return PyByteArray_FromStringAndSize(bytes ? (const char *)a : "", bytes);
+}
+
+/* heightfield.rasterize then _merge, for every triangle in one call: the pieces as
+ * packed keys, counted into columns, merged.  The same pieces (each triangle's, as
+ * raster() makes them; steep per triangle) and so, sorted, the same spans.  Returns
+ * (pieces, col, smin, smax, walk, flat, top_walk): a count, then bytearrays of int64
+ * and bool. */
+PyObject *tanktool_raster_merge(PyObject *self, PyObject *args) {
+    Py_buffer tri, abc, steep, walk, flat;
+    i64 nz, nx, maxh, row_lo, row_hi, thr;
+    double ch;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*y*LLdLLLL", &tri, &abc, &steep, &walk, &flat, &nz, &nx, &ch, &maxh, &row_lo,
+                          &row_hi, &thr))
         return NULL;
-    const Py_ssize_t n = col.len / 8;
-    Py_ssize_t m = 0;
+    if (row_lo < 0) row_lo = 0;
+    if (row_hi > nz) row_hi = nz;
+    const Py_ssize_t n = tri.len / (9 * 8);
     PyObject *ret = NULL;
-    i64 *K = NULL;
-    if (!need(&lo, n, 8, "smin") || !need(&hi, n, 8, "smax") || !need(&walk, n, 1, "walk") ||
-        !need(&flat, n, 1, "flat") || !merge_outputs(o, n))
-        goto done;
-    K = malloc(sizeof(i64) * (size_t)(n + 1));
-    if (K == NULL) {
-        PyErr_NoMemory();
-        goto done;
-    }
+    Cells out = {0};
+    Scratch buf = {0};
+    i64 *S = NULL, *C = NULL;
+    char *F = NULL;
+    Py_ssize_t m = 0;
     int ok = 1;
-    Py_BEGIN_ALLOW_THREADS
-    if (n > 0) ok = sorted_keys(col.buf, lo.buf, hi.buf, walk.buf, flat.buf, n, K);
-    if (ok) m = merge_keys(K, n, thr, o[0].buf, o[1].buf, o[2].buf, o[3].buf, o[4].buf, o[5].buf);
-    Py_END_ALLOW_THREADS
+    if (!need(&tri, 9 * n, 8, "tri") || !need(&abc, 3 * n, 8, "abc") || !need(&steep, n, 1, "steep") ||
+        !need(&walk, n, 1, "walk") || !need(&flat, n, 1, "flat"))
+        goto done;
+    out.walk = walk.buf;
+    out.flat = flat.buf;
+    {
+        const double *T = tri.buf, *P = abc.buf;
+        const uint8_t *St = steep.buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t t = 0; t < n && ok; ++t) {
+            const double *v = T + 9 * t; /* x0 x1 x2 z0 z1 z2 y0 y1 y2 */
+            ok = raster_one(&out, &buf, St[t] != 0, t, v, v + 3, v + 6, P[3 * t], P[3 * t + 1], P[3 * t + 2],
+                            row_lo, row_hi, nx, ch, maxh);
+        }
+        /* the sorted keys, then the spans: col, smin, smax (3 x int64) and walk, flat,
+         * top_walk (3 x bool) in one block as long as the pieces */
+        S = ok ? malloc(sizeof(i64) * (size_t)(out.n + 1)) : NULL;
+        C = S ? malloc((3 * sizeof(i64) + 3) * (size_t)(out.n + 1)) : NULL;
+        ok = C != NULL && sort_packed(out.col, out.n, S);
+        if (ok) {
+            F = (char *)(C + 3 * (out.n + 1));
+            m = merge_keys(S, out.n, thr, C, C + (out.n + 1), C + 2 * (out.n + 1), F, F + (out.n + 1),
+                           F + 2 * (out.n + 1));
+        }
+        Py_END_ALLOW_THREADS
+    }
     if (!ok) {
         PyErr_NoMemory();
         goto done;
     }
-    ret = PyLong_FromSsize_t(m);
+    {
+        const Py_ssize_t w = out.n + 1;
+        ret = Py_BuildValue("(nNNNNNN)", out.n, as_array(C, m * 8), as_array(C + w, m * 8), as_array(C + 2 * w, m * 8),
+                            as_array(F, m), as_array(F + w, m), as_array(F + 2 * w, m));
+    }
 done:
-    free(K);
-    PyBuffer_Release(&col);
-    PyBuffer_Release(&lo);
-    PyBuffer_Release(&hi);
+    free(buf.v);
+    free(out.col);
+    free(S);
+    free(C);
+    PyBuffer_Release(&tri);
+    PyBuffer_Release(&abc);
+    PyBuffer_Release(&steep);
     PyBuffer_Release(&walk);
     PyBuffer_Release(&flat);
-    for (int k = 0; k < 6; ++k) PyBuffer_Release(&o[k]);
     return ret;
 }

@@ -36,7 +36,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ArenaError
-from .kernels import active, i64
+from .kernels import active
+from .raster_merge import raster_merge
 from .span_filters import OPEN, _next_in_column, column_starts, filter_spans, neighbour_columns  # noqa: F401
 
 #: refuse heightfields larger than this (columns) or spans beyond this many cells high
@@ -486,8 +487,11 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
     # |n_y| / |n| in world units (the grid scales x and z by 1 / cs)
     # (a zero-area triangle, n = 0, is not gentle: its plane would divide 0 by 0)
     gentle = (n_y != 0) & (np.abs(n_y) >= GENTLE_NY * np.sqrt((n_x * cs) ** 2 + (n_z * cs) ** 2 + n_y * n_y))
-    out = []
     kern = active()
+    if kern is not None:  # every triangle's pieces, merged, in one call (geometry/raster_merge.py)
+        return raster_merge(kern, X, Z, Y, (n_x, n_z, n_y), gentle, walkable, flat, shape, ch, rows,
+                            (merge_steps, MAX_HEIGHT_STEPS))
+    out = []
     for group in (np.flatnonzero(gentle), np.flatnonzero(~gentle)):
         if len(group) == 0:
             continue
@@ -499,13 +503,6 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
             ny_ = n_y[group]
             B, C = -n_x[group] / ny_, -n_z[group] / ny_
             A = Yg[0] - B * Xg[0] - C * Zg[0]
-        if kern is not None:  # the same spans in one pass over the triangles
-            res = kern.raster(np.ascontiguousarray(np.column_stack(Xg + Zg + Yg)),
-                              np.ascontiguousarray(np.column_stack([A, B, C])), nz, nx, float(ch), MAX_HEIGHT_STEPS,
-                              *(rows or (0, nz)), steep)
-            c_col, c_tri, smin, smax = (np.frombuffer(b, dtype=np.int64) for b in res)
-            out.append((c_col, group[c_tri], smin, smax))
-            continue
         pairs = _rows(Xg, Zg, Yg, nz, nx, rows)
         if steep:
             p, j, smin, smax = _cells_exact(pairs, Xg, Zg, Yg, ch)
@@ -531,12 +528,6 @@ def _merge(col, smin, smax, walk, flat, thr):
         e = np.zeros(0, dtype=np.int64)
         b = np.zeros(0, dtype=bool)
         return e, e, e, b, b, b
-    kern = active()
-    if kern is not None:  # keys counted into columns, no sort of them all; one pass (_kernels_raster.c)
-        out = [np.empty(len(col), dtype=t) for t in (np.int64,) * 3 + (bool,) * 3]
-        m = kern.merge_pieces(i64(col), i64(smin), i64(smax), *(np.ascontiguousarray(a, dtype=bool) for a in
-                                                                 (walk, flat)), int(thr), *out)
-        return tuple(a[:m] for a in out)
     key = (col.astype(np.int64, copy=False) << 34) | (smin << 18) | (smax << 2) | (walk.astype(np.int64) << 1) | flat
     key.sort()
     col = key >> 34
