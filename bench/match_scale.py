@@ -115,14 +115,24 @@ def child(arena: str, bots: int, seconds: float, seed: int) -> dict:
     spec = match.load_tank_spec(match.choose_vehicle(info, None, lambda *_: None)
                                 if hasattr(match, "choose_vehicle") else match.default_vehicle())
     ticks: list[float] = []   # when each step ended
+    cpu: list[float] = []     # the process's CPU seconds then (steadier than the wall on a shared machine)
     t0 = time.perf_counter()
-    result = match.run_match(info, spec, bots=bots, seconds=seconds, seed=seed,
-                             on_progress=lambda n: ticks.append(time.perf_counter()), progress_every=1)
+
+    def tick(_n: int) -> None:
+        ticks.append(time.perf_counter())
+        if len(cpu) < 2:
+            cpu.append(time.process_time())
+        else:
+            cpu[1] = time.process_time()
+
+    result = match.run_match(info, spec, bots=bots, seconds=seconds, seed=seed, on_progress=tick, progress_every=1)
     timing = result.report["timing"]
     after = (len(ticks) - 1) / (ticks[-1] - ticks[0]) if len(ticks) > 1 and ticks[-1] > ticks[0] else None
+    after_cpu = (len(ticks) - 1) / (cpu[1] - cpu[0]) if len(cpu) > 1 and cpu[1] > cpu[0] else None
     return {"arena": info.name, "nodes": _nodes(info), "steps": result.report["steps"],
             "steps_per_second": timing["steps_per_second"], "wall_s": timing["wall_clock_s"],
             "after_first_steps_per_second": round(after, 1) if after else None,
+            "after_first_steps_per_cpu_second": round(after_cpu, 1) if after_cpu else None,
             "first_step_s": round(ticks[0] - t0, 3) if ticks else None, "prepare_s": timing.get("prepare_s"),
             "base_mb": round(base, 1),
             "peak_mb": round(_status("VmHWM:"), 1),
@@ -162,7 +172,8 @@ def make_terrains(sizes: list[float], cache: Path) -> list[str]:
 
 def print_table(rows: list[dict]) -> None:
     names = [n for n, _ in HOOKS]
-    print(f"{'arena':<14}{'nodes':>12}{'steps/s':>9}{'x box':>7}{'later':>8}{'x box':>7}{'peak MB':>9}"
+    print(f"{'arena':<14}{'nodes':>12}{'steps/s':>9}{'x box':>7}{'later':>8}{'x box':>7}{'cpu':>7}{'x box':>7}"
+          f"{'peak MB':>9}"
           f"{'1st step s':>11}{'prep s':>8}  "
           + "".join(f"{n + ' s/MB':>18}" for n in names))
     for r in rows:
@@ -174,9 +185,10 @@ def print_table(rows: list[dict]) -> None:
                         for n in names)
         print(f"{r['arena']:<14}{r['nodes'] or 0:>12,}{r['steps_per_second']:>9.0f}{r.get('x_box') or 0:>7.2f}"
               f"{r['after_first_steps_per_second'] or 0:>8.0f}{r.get('x_box_later') or 0:>7.2f}"
+              f"{r.get('after_first_steps_per_cpu_second') or 0:>7.0f}{r.get('x_box_cpu') or 0:>7.2f}"
               f"{r['peak_mb']:>9.0f}{r['first_step_s'] or 0:>11.2f}{r.get('prepare_s') or 0:>8.2f}  " + cells)
     print("steps/s: the match loop's (tanktool play's figure; the bots' arena tables are made before it, prep s);"
-          " later: the steps after the first; x box: over the box arena's in this run; 1st step s: from loading to"
+          " later: the steps after the first (cpu: per CPU second of the process); x box: over the box arena's in this run; 1st step s: from loading to"
           " the first step's end (World, prep, first think); MB of a phase: resident size it added at its peak")
 
 
@@ -200,11 +212,14 @@ def main(argv: list[str] | None = None) -> int:
         arenas += make_terrains([float(s) for s in a.make.split(",") if s], a.cache)
     rows = [run_child(ar, a) for ar in arenas]
     box, box_later = rows[0].get("steps_per_second"), rows[0].get("after_first_steps_per_second")
+    box_cpu = rows[0].get("after_first_steps_per_cpu_second")
     for r in rows:
         if "error" not in r and box:
             r["x_box"] = round(r["steps_per_second"] / box, 3)
         if "error" not in r and box_later and r.get("after_first_steps_per_second"):
             r["x_box_later"] = round(r["after_first_steps_per_second"] / box_later, 3)
+        if "error" not in r and box_cpu and r.get("after_first_steps_per_cpu_second"):
+            r["x_box_cpu"] = round(r["after_first_steps_per_cpu_second"] / box_cpu, 3)
     if a.json:
         print(json.dumps({"bots": a.bots, "seconds": a.seconds, "seed": a.seed, "rows": rows}))
     else:

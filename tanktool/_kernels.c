@@ -1,7 +1,8 @@
 /* tanktool._kernels: the walkable-surface loops numpy cannot make fast, in C.
  *
- * Four files (the rasteriser in _kernels_raster.c, the grid's loops in _kernels_grid.c,
- * the open spans' passes in _kernels_surface.c, shared definitions in _kernels.h).
+ * Five files (the rasteriser in _kernels_raster.c, the grid's loops in _kernels_grid.c,
+ * the open spans' passes in _kernels_surface.c, the ground under a tank in
+ * _kernels_ground.c, shared definitions in _kernels.h).
  * Optional: setup.py builds it when a C compiler is there; tanktool/nav/kernels.py
  * falls back to numpy otherwise, with identical results (tests/test_kernels.py
  * compares the two).  No numpy headers: arrays come in through the buffer protocol
@@ -34,6 +35,7 @@
  *   open_spans(col, smin, smax, walk, out_col, out_floor, out_ceil) -> m   (_kernels_surface.c)
  *   level_votes(col, keep, link, level, rounds)   (_kernels_surface.c)
  *   lift_portals(col, level, link, steps)   (_kernels_surface.c)
+ *   ground_tilt(h, flat, L, nz, nx, ox, oz, cell, climb, reach, level, x, z, c, s, hl, hw)   (_kernels_ground.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -429,6 +431,7 @@ static PyMethodDef methods[] = {
     {"open_spans", tanktool_open_spans, METH_VARARGS, "the walkable spans' columns, floors, ceilings (_kernels_surface.c)"},
     {"level_votes", tanktool_level_votes, METH_VARARGS, "levels by column rank, then the voting rounds (_kernels_surface.c)"},
     {"lift_portals", tanktool_lift_portals, METH_VARARGS, "level_lift.lift_to_portals in place (_kernels_surface.c)"},
+    {"ground_tilt", tanktool_ground_tilt, METH_VARARGS, "Ground.tilt on the ground's arrays (_kernels_ground.c)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -58,4 +58,7 @@ PyObject *tanktool_level_votes(PyObject *self, PyObject *args);
 PyObject *tanktool_lift_portals(PyObject *self, PyObject *args);
 PyObject *tanktool_chamfer_near(PyObject *self, PyObject *args);
 
+/* the ground under a tank (_kernels_ground.c) */
+PyObject *tanktool_ground_tilt(PyObject *self, PyObject *args);
+
 #endif

@@ -38,3 +38,28 @@ def test_run_arrays_on_demand_are_the_eager_ones(ground):
         assert np.array_equal(getattr(grid, name)[0], w) and getattr(grid, name).shape == grid.valid.shape
     lay.row_index = want[0]                   # given: kept as given
     assert lay.row_index is want[0] and np.array_equal(lay.row_total, want[1])
+
+
+@pytest.mark.skipif(not __import__("tanktool.geometry.kernels", fromlist=["x"]).available(),
+                    reason="compiled kernels not built")
+def test_the_tilt_kernel_is_the_python_tilt_to_the_bit(ground):
+    import math
+
+    from tanktool.geometry.kernels import use_kernels
+
+    g = ground[0]
+    rng = np.random.default_rng(7)
+    n = 3000
+    xs = rng.uniform(g.ox - 3, g.ox + g.nx * g.cell + 3, n)
+    zs = rng.uniform(g.oz - 3, g.oz + g.nz * g.cell + 3, n)
+    xs[:300] = g.ox + rng.integers(-2, g.nx + 2, 300) * g.cell * 0.5     # on cell edges and centres
+    zs[:300] = g.oz + rng.integers(-2, g.nz + 2, 300) * g.cell * 0.5
+    args = [(int(rng.integers(-1, g.levels + 1)), float(x), float(z), math.cos(a), math.sin(a),
+             float(rng.choice([0.0, 1.2, 2.9, 6.0])), float(rng.choice([0.0, 0.9, 1.6, 5.5])))
+            for x, z, a in zip(xs, zs, rng.uniform(-4, 4, n))]
+    with use_kernels(False):
+        slow = [g.tilt(x, z, lv, c, s, hl, hw) for lv, x, z, c, s, hl, hw in args]
+    with use_kernels(True):
+        fast = [g.tilt(x, z, lv, c, s, hl, hw) for lv, x, z, c, s, hl, hw in args]
+    assert [tuple(t) for t in fast] == [tuple(t) for t in slow]
+    assert sum(p != 0.0 for _, p, _ in fast) > 100      # slopes sampled, not only level ground

@@ -1,0 +1,163 @@
+/* The ground under a tank (sim/ground.py's Ground.tilt), in C: (see _kernels.c)
+ *
+ *   ground_tilt(h, flat, L, nz, nx, ox, oz, cell, climb, reach, level, x, z, c, s, half_length,
+ *               half_width) -> (y, pitch, roll), or None where Python must answer
+ *       h: float64 (L, nz, nx) node heights (not finite: no node); flat: bool (L, nz, nx) level
+ *       ground (Ground._level_ground); reach: FLAT_CELLS * cell
+ *
+ * Ground.tilt's arithmetic one operation at a time (no fused multiply-adds: built with
+ * -ffp-contract=off), Python's float floor division in cell_of, its atan2 (libm's), so
+ * the values are the Python code's to the bit (tests/test_match_lean.py).  None for what
+ * the Python code would not answer with numbers (a NaN coordinate, a level with no node
+ * where it reads one): it runs then and says what it says.
+ */
+#include "_kernels.h"
+
+typedef struct {
+    const double *h;
+    const uint8_t *flat;
+    i64 L, nz, nx;
+    double ox, oz, cell, climb;
+} Ground;
+
+/* Python's float // (CPython's _float_div_mod), as an index clamped into [0, n) */
+static i64 floor_div_clamped(double vx, double wx, i64 n) {
+    double mod = fmod(vx, wx), div = (vx - mod) / wx, fd;
+    if (mod) {
+        if ((wx < 0) != (mod < 0)) div -= 1.0;
+    }
+    if (div) {
+        fd = floor(div);
+        if (div - fd > 0.5) fd += 1.0;
+    } else {
+        fd = 0.0;
+    }
+    if (fd < 0.0) return 0;
+    if (fd >= (double)n) return n - 1;
+    return (i64)fd;
+}
+
+static inline double H(const Ground *g, i64 lv, i64 i, i64 j) { return g->h[(lv * g->nz + i) * g->nx + j]; }
+
+/* Ground.locate(x, z) without a height: the lowest level with a node in the cell, -1 */
+static i64 lowest(const Ground *g, i64 i, i64 j) {
+    for (i64 lv = 0; lv < g->L; ++lv)
+        if (isfinite(H(g, lv, i, j))) return lv;
+    return -1;
+}
+
+/* Ground._nearest: the node height at (i, j) nearest y within the climb (NaN: none) */
+static double nearest(const Ground *g, i64 i, i64 j, double y) {
+    if (!(0 <= i && i < g->nz && 0 <= j && j < g->nx)) return NAN;
+    double best = NAN, best_d = g->climb + 1e-9;
+    for (i64 lv = 0; lv < g->L; ++lv) {
+        const double hv = H(g, lv, i, j);
+        if (isfinite(hv) && fabs(hv - y) <= best_d) {
+            best = hv;
+            best_d = fabs(hv - y);
+        }
+    }
+    return best;
+}
+
+/* Ground.height; returns 0 and leaves *out when Python must answer */
+static int height(const Ground *g, double x, double z, i64 level, double *out) {
+    double u = (x - g->ox) / g->cell, w = (z - g->oz) / g->cell;
+    i64 i, j;
+    if (!(fabs(u) < 1e15 && fabs(w) < 1e15)) return 0;   /* far off the grid: Python's */
+    if (u >= 0.0 && w >= 0.0 && u < (double)g->nx && w < (double)g->nz) {
+        j = (i64)u;   /* int(u): truncation, u >= 0 */
+        i = (i64)w;
+    } else {
+        j = floor_div_clamped(x - g->ox, g->cell, g->nx);
+        i = floor_div_clamped(z - g->oz, g->cell, g->nz);
+    }
+    double hc = (0 <= level && level < g->L) ? H(g, level, i, j) : NAN;
+    if (!isfinite(hc)) {
+        /* locate(x, z) reads cell_of(x, z), which may differ from (i, j) by rounding:
+           then Python's answer */
+        const i64 ci = floor_div_clamped(z - g->oz, g->cell, g->nz), cj = floor_div_clamped(x - g->ox, g->cell, g->nx);
+        if (ci != i || cj != j) return 0;
+        const i64 lv = lowest(g, i, j);
+        if (lv < 0) {
+            *out = 0.0;
+            return 1;
+        }
+        level = lv;
+        hc = H(g, lv, i, j);
+    }
+    u -= 0.5;
+    w -= 0.5;
+    const double fj0 = floor(u), fi0 = floor(w);
+    const double fu = u - fj0, fw = w - fi0;
+    const i64 j0 = (i64)fj0, i0 = (i64)fi0;
+    if (0 <= i0 && i0 + 1 < g->nz && 0 <= j0 && j0 + 1 < g->nx) {
+        const double a = H(g, level, i0, j0), b = H(g, level, i0, j0 + 1);
+        const double c = H(g, level, i0 + 1, j0), d = H(g, level, i0 + 1, j0 + 1);
+        if (isfinite(a) && isfinite(b) && isfinite(c) && isfinite(d)) {
+            const double lim = g->climb;
+            if (fabs(a - hc) <= lim && fabs(b - hc) <= lim && fabs(c - hc) <= lim && fabs(d - hc) <= lim) {
+                *out = (a * (1.0 - fu) + b * fu) * (1.0 - fw) + (c * (1.0 - fu) + d * fu) * fw;
+                return 1;
+            }
+        }
+    }
+    double total = 0.0, acc = 0.0;
+    const i64 is[2] = {i0, i0 + 1}, js[2] = {j0, j0 + 1};
+    const double wis[2] = {1.0 - fw, fw}, wjs[2] = {1.0 - fu, fu};
+    for (int p = 0; p < 2; ++p)
+        for (int q = 0; q < 2; ++q) {
+            const double wgt = wis[p] * wjs[q];
+            if (wgt <= 0.0) continue;
+            const double hv = nearest(g, is[p], js[q], hc);
+            if (!isnan(hv)) {
+                acc += wgt * hv;
+                total += wgt;
+            }
+        }
+    *out = total > 0.0 ? acc / total : hc;
+    return 1;
+}
+
+PyObject *tanktool_ground_tilt(PyObject *self, PyObject *args) {
+    Py_buffer hb, fb;
+    Ground g;
+    double reach, x, z, c, s, hl, hw;
+    Py_ssize_t L, nz, nx, level;
+    if (!PyArg_ParseTuple(args, "y*y*nnndddddndddddd", &hb, &fb, &L, &nz, &nx, &g.ox, &g.oz, &g.cell, &g.climb,
+                          &reach, &level, &x, &z, &c, &s, &hl, &hw))
+        return NULL;
+    PyObject *ret = NULL;
+    const i64 n = (i64)L * nz * nx;
+    if (!need(&hb, n, 8, "h") || !need(&fb, n, 1, "flat")) goto done;
+    g.h = hb.buf;
+    g.flat = fb.buf;
+    g.L = L, g.nz = nz, g.nx = nx;
+    if (!(isfinite(x) && isfinite(z) && isfinite(c) && isfinite(s) && isfinite(hl) && isfinite(hw))) {
+        ret = Py_None;
+        Py_INCREF(ret);
+        goto done;
+    }
+    {
+        const i64 j = floor_div_clamped(x - g.ox, g.cell, nx), i = floor_div_clamped(z - g.oz, g.cell, nz);
+        if (0 <= level && level < L && g.flat[(level * nz + i) * nx + j] && hl <= reach && hw <= reach) {
+            ret = Py_BuildValue("(ddd)", H(&g, level, i, j), 0.0, 0.0);
+            goto done;
+        }
+        double y, hf, hbk, hr, hlft;
+        if (!height(&g, x, z, level, &y) || !height(&g, x + c * hl, z + s * hl, level, &hf) ||
+            !height(&g, x - c * hl, z - s * hl, level, &hbk) || !height(&g, x - s * hw, z + c * hw, level, &hr) ||
+            !height(&g, x + s * hw, z - c * hw, level, &hlft)) {
+            ret = Py_None;
+            Py_INCREF(ret);
+            goto done;
+        }
+        const double pitch = hl > 0 ? atan2(hf - hbk, 2.0 * hl) : 0.0;
+        const double roll = hw > 0 ? atan2(hlft - hr, 2.0 * hw) : 0.0;
+        ret = Py_BuildValue("(ddd)", y, pitch, roll);
+    }
+done:
+    PyBuffer_Release(&hb);
+    PyBuffer_Release(&fb);
+    return ret;
+}
