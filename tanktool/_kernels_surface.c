@@ -6,6 +6,10 @@
  *       col, smin, smax: int32 (n,) the heightfield's spans; walk: bool (n,); written:
  *       the m walkable spans' column (int64), floor (their top) and ceiling (the next
  *       span's bottom in the column, OPEN above the top one), int32
+ *   snap_heights(floor, walk, flat, heights, origin_y, ch, out)
+ *       walkable.snap_heights: floor int32 (m,) the open spans'; walk, flat bool (n,) the
+ *       heightfield's spans' (the open spans are its walkable ones, in order); heights
+ *       float64 sorted; out float64 (m,) written
  *   level_votes(col, keep, link, level, rounds)
  *       col: int64 (n,) sorted; keep: bool (n,); link: int32 (n, 4); level: int64 (n,)
  *       written: each kept span's rank among the kept spans of its column (-1 where not
@@ -63,6 +67,51 @@ done:
     PyBuffer_Release(&oc);
     PyBuffer_Release(&of);
     PyBuffer_Release(&oce);
+    return ret;
+}
+
+/* walkable.snap_heights in one pass, the same arithmetic (no fused multiply-adds):
+ * a flat span's floor is the highest cluster height at or below its top (searchsorted
+ * side right, minus one) when that lies within its top voxel step, else the step's
+ * middle */
+PyObject *tanktool_snap_heights(PyObject *self, PyObject *args) {
+    Py_buffer floor_, walk, flat, heights, out;
+    double oy, ch;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*ddw*", &floor_, &walk, &flat, &heights, &oy, &ch, &out)) return NULL;
+    const Py_ssize_t m = floor_.len / 4, n = walk.len, nh = heights.len / 8;
+    PyObject *ret = NULL;
+    if (!need(&flat, n, 1, "flat") || !need(&out, m, 8, "out")) goto done;
+    {
+        const int32_t *Fl = floor_.buf;
+        const uint8_t *W = walk.buf, *Fh = flat.buf;
+        const double *H = heights.buf, half = 0.5 * ch;
+        double *O = out.buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t s = 0, k = 0; s < n && k < m; ++s) {
+            if (!W[s]) continue;
+            const double top = oy + (double)Fl[k] * ch;
+            double y = top - half;
+            if (Fh[s] && nh > 0) {
+                const double v = top + 1e-9;
+                Py_ssize_t lo = 0, hi = nh;  /* the first height above v */
+                while (lo < hi) {
+                    const Py_ssize_t mid = lo + (hi - lo) / 2;
+                    if (H[mid] <= v) lo = mid + 1; else hi = mid;
+                }
+                if (lo > 0 && H[lo - 1] >= top - ch - 1e-9) y = H[lo - 1];
+            }
+            O[k++] = y;
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&floor_);
+    PyBuffer_Release(&walk);
+    PyBuffer_Release(&flat);
+    PyBuffer_Release(&heights);
+    PyBuffer_Release(&out);
     return ret;
 }
 

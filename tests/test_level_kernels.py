@@ -1,7 +1,8 @@
-"""The compiled levels and clearance (tanktool/_kernels_surface.c) against the numpy
-code they replace: the same levels from stack_levels and level_lift.lift_to_portals,
-the same chamfer clearance from the sweeps near the changes, on random span graphs
-and on generated levels with decks over walkable ground."""
+"""The compiled surface passes (tanktool/_kernels_surface.c) against the numpy code
+they replace: the same levels from stack_levels and level_lift.lift_to_portals, the
+same chamfer clearance from the sweeps near the changes, the same open spans and
+snapped heights, on random span graphs and on generated levels (decks over walkable
+ground, bumps, terraces)."""
 
 from __future__ import annotations
 
@@ -106,7 +107,7 @@ def test_random_span_graphs_have_the_same_clearance_near_the_changes(seed):
 
 
 @needs_kernels
-@pytest.mark.parametrize("name", ["stacked_floors", "bridge", "two_storeys"])
+@pytest.mark.parametrize("name", ["stacked_floors", "bridge", "two_storeys", "bumpy_floor", "terraces"])
 def test_generated_levels_stack_the_same(name):
     import make_levels
 
@@ -118,3 +119,5 @@ def test_generated_levels_stack_the_same(name):
     with use_kernels(False):
         b = walkable_surface(V, F, params, 1.0)
     assert np.array_equal(a.level, b.level) and a.levels == b.levels
+    for key in ("col", "floor", "ceil", "link", "clearance", "height"):  # open spans, snapped heights
+        assert np.array_equal(getattr(a, key), getattr(b, key)), key

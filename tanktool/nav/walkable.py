@@ -297,6 +297,12 @@ def snap_heights(surface: Surface, flat: np.ndarray) -> np.ndarray:
     n = len(surface.floor)
     out = np.empty(n)
     walk = hf.walkable
+    kern = active()
+    if kern is not None and surface.floor.dtype == np.int32:   # one pass, no blocks of temporaries
+        kern.snap_heights(np.ascontiguousarray(surface.floor), np.ascontiguousarray(walk, dtype=bool),
+                          np.ascontiguousarray(hf.flat, dtype=bool), np.ascontiguousarray(flat, dtype=np.float64),
+                          float(hf.origin[1]), float(hf.ch), out)
+        return out
     pos = 0
     for a in range(0, max(len(walk), 1), BLOCK):  # the surface's spans are the walkable ones, in order
         w = a + np.flatnonzero(walk[a:a + BLOCK])
