@@ -37,6 +37,8 @@
  *   level_votes(col, keep, link, level, rounds)   (_kernels_surface.c)
  *   lift_portals(col, level, link, steps)   (_kernels_surface.c)
  *   ground_tilt(h, flat, L, nz, nx, ox, oz, cell, climb, reach, level, x, z, c, s, hl, hw)   (_kernels_ground.c)
+ *   ground_height(h, L, nz, nx, ox, oz, cell, climb, level, x, z), ground_follow(link, L, nz, nx, level,
+ *       i0, j0, i1, j1)   (_kernels_ground.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -434,6 +436,8 @@ static PyMethodDef methods[] = {
     {"level_votes", tanktool_level_votes, METH_VARARGS, "levels by column rank, then the voting rounds (_kernels_surface.c)"},
     {"lift_portals", tanktool_lift_portals, METH_VARARGS, "level_lift.lift_to_portals in place (_kernels_surface.c)"},
     {"ground_tilt", tanktool_ground_tilt, METH_VARARGS, "Ground.tilt on the ground's arrays (_kernels_ground.c)"},
+    {"ground_height", tanktool_ground_height, METH_VARARGS, "Ground.height on the ground's heights (_kernels_ground.c)"},
+    {"ground_follow", tanktool_ground_follow, METH_VARARGS, "Ground.follow on the ground's links (_kernels_ground.c)"},
     {NULL, NULL, 0, NULL},
 };
 

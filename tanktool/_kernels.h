@@ -61,5 +61,7 @@ PyObject *tanktool_chamfer_near(PyObject *self, PyObject *args);
 
 /* the ground under a tank (_kernels_ground.c) */
 PyObject *tanktool_ground_tilt(PyObject *self, PyObject *args);
+PyObject *tanktool_ground_height(PyObject *self, PyObject *args);
+PyObject *tanktool_ground_follow(PyObject *self, PyObject *args);
 
 #endif

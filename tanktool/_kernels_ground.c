@@ -1,9 +1,12 @@
-/* The ground under a tank (sim/ground.py's Ground.tilt), in C: (see _kernels.c)
+/* The ground under a tank (sim/ground.py's Ground.tilt, height, follow), in C: (see _kernels.c)
  *
  *   ground_tilt(h, flat, L, nz, nx, ox, oz, cell, climb, reach, level, x, z, c, s, half_length,
  *               half_width) -> (y, pitch, roll), or None where Python must answer
  *       h: float64 (L, nz, nx) node heights (not finite: no node); flat: bool (L, nz, nx) level
  *       ground (Ground._level_ground); reach: FLAT_CELLS * cell
+ *   ground_height(h, L, nz, nx, ox, oz, cell, climb, level, x, z) -> float, or None
+ *   ground_follow(link, L, nz, nx, level, i0, j0, i1, j1) -> level (-1: no way), or None
+ *       link: int8 (L, nz, nx, 4), the ground's links
  *
  * Ground.tilt's arithmetic one operation at a time (no fused multiply-adds: built with
  * -ffp-contract=off), Python's float floor division in cell_of, its atan2 (libm's), so
@@ -159,5 +162,94 @@ PyObject *tanktool_ground_tilt(PyObject *self, PyObject *args) {
 done:
     PyBuffer_Release(&hb);
     PyBuffer_Release(&fb);
+    return ret;
+}
+
+/* Ground.height(x, z, level), or None where Python must answer */
+PyObject *tanktool_ground_height(PyObject *self, PyObject *args) {
+    Py_buffer hb;
+    Ground g;
+    double x, z, y;
+    Py_ssize_t L, nz, nx, level;
+    if (!PyArg_ParseTuple(args, "y*nnnddddndd", &hb, &L, &nz, &nx, &g.ox, &g.oz, &g.cell, &g.climb, &level, &x, &z))
+        return NULL;
+    PyObject *ret = NULL;
+    if (!need(&hb, (i64)L * nz * nx, 8, "h")) goto done;
+    g.h = hb.buf;
+    g.flat = NULL;
+    g.L = L, g.nz = nz, g.nx = nx;
+    if (isfinite(x) && isfinite(z) && height(&g, x, z, level, &y)) {
+        ret = PyFloat_FromDouble(y);
+    } else {
+        ret = Py_None;
+        Py_INCREF(ret);
+    }
+done:
+    PyBuffer_Release(&hb);
+    return ret;
+}
+
+/* the link of node (lv, i, j) in direction d: a level, -1 none */
+static inline int step_link(const int8_t *K, i64 nz, i64 nx, i64 lv, i64 i, i64 j, int d) {
+    return K[((lv * nz + i) * nx + j) * 4 + d];
+}
+
+/* Ground.follow for cells one step apart (a straight or diagonal move); i1, j1 in the grid */
+static i64 follow1(const int8_t *K, i64 L, i64 nz, i64 nx, i64 level, i64 i0, i64 j0, i64 i1, i64 j1) {
+    if (i0 == i1 && j0 == j1) return level;
+    if (level < 0 || level >= L) return -2;   /* Python's list indexing: its answer */
+    const i64 di = i1 - i0, dj = j1 - j0;
+    if (di == 0 || dj == 0) {
+        const int d = dj == 1 ? 0 : dj == -1 ? 2 : di == 1 ? 1 : 3;
+        return step_link(K, nz, nx, level, i0, j0, d);
+    }
+    const int d_i = di == 1 ? 1 : 3, d_j = dj == 1 ? 0 : 2;
+    const int firsts[2] = {d_i, d_j}, seconds[2] = {d_j, d_i};
+    const i64 mi[2] = {i1, i0}, mj[2] = {j0, j1};
+    for (int k = 0; k < 2; ++k) {
+        const i64 lv = step_link(K, nz, nx, level, i0, j0, firsts[k]);
+        if (lv >= 0) {
+            const i64 lv2 = step_link(K, nz, nx, lv, mi[k], mj[k], seconds[k]);
+            if (lv2 >= 0) return lv2;
+        }
+    }
+    return -1;
+}
+
+/* Ground.follow(level, i0, j0, i1, j1) on the ground's int8 links, or None where
+ * Python must answer (a level or cell off the grid: its list indexing) */
+PyObject *tanktool_ground_follow(PyObject *self, PyObject *args) {
+    Py_buffer kb;
+    Py_ssize_t L, nz, nx, level, i0, j0, i1, j1;
+    if (!PyArg_ParseTuple(args, "y*nnnnnnnn", &kb, &L, &nz, &nx, &level, &i0, &j0, &i1, &j1)) return NULL;
+    PyObject *ret = NULL;
+    if (!need(&kb, (i64)L * nz * nx * 4, 1, "link")) goto done;
+    {
+        const int8_t *K = kb.buf;
+        i64 lv = -2;
+        if (0 <= i0 && i0 < nz && 0 <= j0 && j0 < nx && 0 <= i1 && i1 < nz && 0 <= j1 && j1 < nx) {
+            if (i1 - i0 > 1 || i0 - i1 > 1 || j1 - j0 > 1 || j0 - j1 > 1) {
+                /* a jump of more than a cell: walked in unit steps, as Python does */
+                i64 i = i0, j = j0;
+                lv = level;
+                while ((i != i1 || j != j1) && lv >= 0) {
+                    const i64 si = (i1 > i) - (i1 < i), sj = (j1 > j) - (j1 < j);
+                    lv = follow1(K, L, nz, nx, lv, i, j, i + si, j + sj);
+                    i += si;
+                    j += sj;
+                }
+            } else {
+                lv = follow1(K, L, nz, nx, level, i0, j0, i1, j1);
+            }
+        }
+        if (lv < -1) {
+            ret = Py_None;
+            Py_INCREF(ret);
+        } else {
+            ret = PyLong_FromLongLong(lv);
+        }
+    }
+done:
+    PyBuffer_Release(&kb);
     return ret;
 }

@@ -63,3 +63,36 @@ def test_the_tilt_kernel_is_the_python_tilt_to_the_bit(ground):
         fast = [g.tilt(x, z, lv, c, s, hl, hw) for lv, x, z, c, s, hl, hw in args]
     assert [tuple(t) for t in fast] == [tuple(t) for t in slow]
     assert sum(p != 0.0 for _, p, _ in fast) > 100      # slopes sampled, not only level ground
+
+
+@pytest.mark.skipif(not __import__("tanktool.geometry.kernels", fromlist=["x"]).available(),
+                    reason="compiled kernels not built")
+def test_the_height_and_follow_kernels_are_the_python_ones(ground):
+    from tanktool.geometry.kernels import use_kernels
+
+    g = ground[0]
+    rng = np.random.default_rng(11)
+    n = 4000
+    pts = [(float(x), float(z), int(lv)) for x, z, lv in zip(
+        rng.uniform(g.ox - 3, g.ox + g.nx * g.cell + 3, n), rng.uniform(g.oz - 3, g.oz + g.nz * g.cell + 3, n),
+        rng.integers(-1, g.levels + 1, n))]
+    moves = []
+    for _ in range(n):
+        i0, j0 = int(rng.integers(0, g.nz)), int(rng.integers(0, g.nx))
+        span = int(rng.choice([1, 1, 1, 3]))      # mostly one cell, some jumps walked in steps
+        i1 = int(np.clip(i0 + rng.integers(-span, span + 1), 0, g.nz - 1))
+        j1 = int(np.clip(j0 + rng.integers(-span, span + 1), 0, g.nx - 1))
+        moves.append((int(rng.integers(-1, g.levels)), i0, j0, i1, j1))   # -1: the last (a list)
+    # where tanks are: on nodes, moving to their neighbours
+    lv, ii, jj = np.nonzero(g.exists)
+    pick = rng.integers(0, len(lv), n)
+    moves += [(int(lv[k]), int(ii[k]), int(jj[k]), int(np.clip(ii[k] + a, 0, g.nz - 1)),
+               int(np.clip(jj[k] + b, 0, g.nx - 1))) for k, a, b in zip(pick, rng.integers(-1, 2, n),
+                                                                         rng.integers(-1, 2, n))]
+    with use_kernels(False):
+        slow = [g.height(*p) for p in pts], [g.follow(*m) for m in moves]
+    with use_kernels(True):
+        fast = [g.height(*p) for p in pts], [g.follow(*m) for m in moves]
+    assert fast == slow
+    assert all(type(v) is float for v in fast[0]) and all(type(v) is int for v in fast[1])
+    assert sum(v >= 0 for v in fast[1]) > n // 2

@@ -218,9 +218,12 @@ class Ground:
         self._flat = lazy_levels(flat, plain_row, ROWS_KEPT)
         # the arrays as the tilt kernel reads them (_kernels_ground.c): no copies when
         # they already are float64 and bool, C-ordered
-        self._tilt_args = (np.ascontiguousarray(h, dtype=np.float64), np.ascontiguousarray(flat, dtype=bool),
-                           self.levels, self.nz, self.nx, self.ox, self.oz, self.cell, self.climb,
-                           FLAT_CELLS * self.cell)
+        h64 = np.ascontiguousarray(h, dtype=np.float64)
+        dims = (self.levels, self.nz, self.nx)
+        self._tilt_args = (h64, np.ascontiguousarray(flat, dtype=bool), *dims, self.ox, self.oz, self.cell,
+                           self.climb, FLAT_CELLS * self.cell)
+        self._height_args = (h64, *dims, self.ox, self.oz, self.cell, self.climb)
+        self._follow_args = (np.ascontiguousarray(self.link, dtype=np.int8), *dims)
 
     @property
     def solids(self) -> SolidField | None:
@@ -320,6 +323,11 @@ class Ground:
         diagonal move may go either way round)."""
         if (i0, j0) == (i1, j1):
             return level
+        kern = active_kernels()
+        if kern is not None:   # on the links themselves: no rows of Python lists made
+            lv = kern.ground_follow(*self._follow_args, level, i0, j0, i1, j1)
+            if lv is not None:
+                return lv
         di, dj = i1 - i0, j1 - j0
         if abs(di) > 1 or abs(dj) > 1:  # a jump of more than a cell: walk it in unit steps
             lv, i, j = level, i0, j0
@@ -348,6 +356,11 @@ class Ground:
         """Surface height at (x, z) on ``level``: bilinear over the four nodes around it,
         each taken on the level nearest the node under (x, z) in height (the surface
         goes on across a level's edge onto the next one)."""
+        kern = active_kernels()
+        if kern is not None:   # the same values from the heights array (_kernels_ground.c)
+            y = kern.ground_height(*self._height_args, level, x, z)
+            if y is not None:
+                return y
         u = (x - self.ox) / self.cell
         w = (z - self.oz) / self.cell
         j, i = int(u), int(w)
