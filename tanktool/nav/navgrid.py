@@ -241,12 +241,14 @@ class NavGrid:
         levels = 1 if v.ndim == 2 else v.shape[0]
         if link is not None and ((link < -1) | (link >= levels)).any():
             raise FormatError(f"{path}: link holds levels outside -1 .. {levels - 1}")
+        # copy=False: arrays already of their type are kept, not copied (a 2 km terrain's
+        # grid was read twice over at once: the load's peak of a match on it)
         return cls(
-            origin, cell, shape, arrays["valid"].astype(bool),
-            *(arrays[k].astype(np.int32) for k in ("row_index", "row_total", "col_index", "col_total")),
-            arrays["reachable"].astype(bool),
-            height=None if height is None else height.astype(np.float64),
-            link=None if link is None else link.astype(np.int8),
+            origin, cell, shape, arrays.pop("valid").astype(bool, copy=False),
+            *(arrays.pop(k).astype(np.int32, copy=False) for k in ("row_index", "row_total", "col_index", "col_total")),
+            arrays.pop("reachable").astype(bool, copy=False),
+            height=None if height is None else height.astype(np.float64, copy=False),
+            link=None if link is None else link.astype(np.int8, copy=False),
         )
 
 
