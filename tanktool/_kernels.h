@@ -55,6 +55,7 @@ PyObject *tanktool_grid_runs(PyObject *self, PyObject *args);
 /* the open spans, their clearance and levels (_kernels_surface.c) */
 PyObject *tanktool_open_spans(PyObject *self, PyObject *args);
 PyObject *tanktool_snap_heights(PyObject *self, PyObject *args);
+PyObject *tanktool_scatter_layers(PyObject *self, PyObject *args);
 PyObject *tanktool_level_votes(PyObject *self, PyObject *args);
 PyObject *tanktool_lift_portals(PyObject *self, PyObject *args);
 PyObject *tanktool_chamfer_near(PyObject *self, PyObject *args);

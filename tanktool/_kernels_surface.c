@@ -10,6 +10,10 @@
  *       walkable.snap_heights: floor int32 (m,) the open spans'; walk, flat bool (n,) the
  *       heightfield's spans' (the open spans are its walkable ones, in order); heights
  *       float64 sorted; out float64 (m,) written
+ *   scatter_layers(level, col, height, clear, per, exists, height_out, span_out, clear_out)
+ *       walkable.surface_layers' scatter: level, col int64 (n,); height, clear float64
+ *       (n,) (clear: empty when not asked for); outputs over (L * per) nodes, filled
+ *       beforehand (False, NaN, -1, 0): bool, float64, int32, float64 (or empty)
  *   level_votes(col, keep, link, level, rounds)
  *       col: int64 (n,) sorted; keep: bool (n,); link: int32 (n, 4); level: int64 (n,)
  *       written: each kept span's rank among the kept spans of its column (-1 where not
@@ -112,6 +116,58 @@ done:
     PyBuffer_Release(&flat);
     PyBuffer_Release(&heights);
     PyBuffer_Release(&out);
+    return ret;
+}
+
+/* walkable.surface_layers: every span of a level written into its node, in one pass
+ * where numpy made the node indices a block at a time and scattered four times */
+PyObject *tanktool_scatter_layers(PyObject *self, PyObject *args) {
+    Py_buffer level, col, height, clear, exists, hout, sout, cout;
+    i64 per;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*Lw*w*w*w*", &level, &col, &height, &clear, &per, &exists, &hout, &sout,
+                          &cout))
+        return NULL;
+    const Py_ssize_t n = level.len / 8, nodes = exists.len;
+    const int with_clear = clear.len > 0;
+    PyObject *ret = NULL;
+    if (!need(&col, n, 8, "col") || !need(&height, n, 8, "height") || (with_clear && !need(&clear, n, 8, "clear")) ||
+        !need(&hout, nodes, 8, "height_out") || !need(&sout, nodes, 4, "span_out") ||
+        (with_clear && !need(&cout, nodes, 8, "clear_out")))
+        goto done;
+    {
+        const i64 *Lv = level.buf, *C = col.buf;
+        const double *H = height.buf, *Cl = clear.buf;
+        uint8_t *E = exists.buf;
+        double *Ho = hout.buf, *Co = cout.buf;
+        int32_t *So = sout.buf;
+        int bad = 0;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t m = 0; m < n; ++m) {
+            if (Lv[m] < 0) continue;
+            const i64 at = Lv[m] * per + C[m];
+            if (at < 0 || at >= nodes) { bad = 1; break; }
+            E[at] = 1;
+            Ho[at] = H[m];
+            So[at] = (int32_t)m;
+            if (with_clear) Co[at] = Cl[m];
+        }
+        Py_END_ALLOW_THREADS
+        if (bad) {
+            PyErr_SetString(PyExc_ValueError, "scatter_layers: a span beyond the layers");
+            goto done;
+        }
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&level);
+    PyBuffer_Release(&col);
+    PyBuffer_Release(&height);
+    PyBuffer_Release(&clear);
+    PyBuffer_Release(&exists);
+    PyBuffer_Release(&hout);
+    PyBuffer_Release(&sout);
+    PyBuffer_Release(&cout);
     return ret;
 }
 

@@ -445,6 +445,25 @@ def surface_layers(surface: Surface, clearance: bool = True) -> tuple[np.ndarray
     height = np.full(L * nz * nx, np.nan)
     span = np.full(L * nz * nx, -1, dtype=np.int32 if len(surface.col) < 2**31 else np.int64)
     clear = np.zeros(L * nz * nx) if clearance else None  # 8 bytes a node: only for those who read it
+    kern = active()
+    if (kern is not None and span.dtype == np.int32 and surface.height is not None
+            and (clear is None or surface.clearance is not None)):  # one pass (_kernels_surface.c)
+        empty = np.zeros(0)
+        kern.scatter_layers(i64(surface.level), i64(surface.col), np.ascontiguousarray(surface.height, dtype=float),
+                            empty if clear is None else np.ascontiguousarray(surface.clearance, dtype=float),
+                            nz * nx, exists, height, span, empty if clear is None else clear)
+    else:
+        _scatter_layers(surface, exists, height, span, clear)
+    shape = (L, nz, nx)
+    if clear is not None:
+        clear = clear.reshape(shape)
+    return exists.reshape(shape), height.reshape(shape), clear, span.reshape(shape)
+
+
+def _scatter_layers(surface: Surface, exists: np.ndarray, height: np.ndarray, span: np.ndarray,
+                    clear: np.ndarray | None) -> None:
+    """surface_layers' scatter in numpy: each span of a level into its node's arrays."""
+    nz, nx = surface.shape
     hf = surface.hf
     for a in range(0, len(surface.level), BLOCK):  # the scatter's indices a block at a time
         m = a + np.flatnonzero(surface.level[a:a + BLOCK] >= 0)
@@ -458,10 +477,6 @@ def surface_layers(surface: Surface, clearance: bool = True) -> tuple[np.ndarray
         span[at] = m
         if clear is not None:
             clear[at] = surface.clearance[m]
-    shape = (L, nz, nx)
-    if clear is not None:
-        clear = clear.reshape(shape)
-    return exists.reshape(shape), height.reshape(shape), clear, span.reshape(shape)
 
 
 def level_nodes(surface: Surface, level: int = 0) -> np.ndarray:
