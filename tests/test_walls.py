@@ -295,3 +295,25 @@ def test_triangle_mesh_accepts_whole_float_indices_and_no_faces():
     v, f = triangle_mesh([[0, 0, 0], [1, 0, 0], [0, 0, 1]], np.array([[0.0, 1.0, 2.0]]))
     assert f.dtype == np.int64 and f.tolist() == [[0, 1, 2]] and v.dtype == np.float64
     assert triangle_mesh(v, [])[1].shape == (0, 3)
+
+
+def test_a_floor_modelled_twice_keeps_its_outline_and_its_walls():
+    """Duplicate faces (a floor exported twice over, decals on it) used to cancel every
+    edge of the outline: no floor, no walls, and the import said no tank fits.  An edge
+    is on the outline as many times as its uses one way outnumber the other way."""
+    from tanktool.geometry.walls import floor_region
+    from tanktool.nav.arena_levels import analyse_arena
+    from tanktool.nav.walkable import WalkableParams
+    from tanktool.fleet import Fleet
+
+    v = np.array([[0, 0, 0], [50, 0, 0], [50, 0, 50], [0, 0, 50], [25, 0, 0], [25, 0, 50]], dtype=np.float64)
+    f = np.array([[0, 2, 1], [0, 3, 2]])
+    once = floor_region(v, f, 0.01)
+    assert abs(once.area - 2500) < 1e-6
+    half = np.array([[0, 5, 4], [0, 3, 5]])           # the left half laid again on top, sharing edges with it
+    for faces in (np.vstack([f, f]), np.vstack([f, f[::-1], f]), np.vstack([f, half])):
+        assert shapely.equals(floor_region(v, faces, 0.01), once)
+    params = WalkableParams(cell=0.5, cell_height=0.1, max_slope=35.0, climb=0.9, headroom=2.35)
+    tank = Fleet(radius=3.0, length=6.0, height=2.3)
+    walls = [analyse_arena(v, faces, params, tank).walls.walls.segments for faces in (f, np.vstack([f, f]))]
+    assert len(walls[0]) == 4 and np.allclose(walls[0], walls[1])

@@ -304,10 +304,12 @@ def _merge_positions(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 def floor_region(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
     """The top-view outline of upward faces: a shapely (Multi)Polygon.
 
-    Uses only the faces' boundary edges (edges used by one face), directed so the
-    floor is on their left, and the winding number of the faces of their
-    arrangement; overlapping floor pieces and T-junctions come out right, and no
-    polygon per triangle is ever built.
+    Uses only the faces' boundary edges, directed so the floor is on their left, and
+    the winding number of the faces of their arrangement; overlapping floor pieces and
+    T-junctions come out right, and no polygon per triangle is ever built.  An edge is
+    on the boundary as many times as its uses one way outnumber its uses the other
+    way: two faces side by side cancel, and a floor modelled twice over (duplicate
+    faces, common in exported models) keeps its outline, each edge twice.
     """
     vertices, faces = triangle_mesh(vertices, faces)
     g = _merge_positions(vertices, faces)
@@ -315,9 +317,15 @@ def floor_region(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
     e = np.stack([g[:, [0, 2]], g[:, [2, 1]], g[:, [1, 0]]], axis=1).reshape(-1, 2)
     ev = np.stack([faces[:, [0, 2]], faces[:, [2, 1]], faces[:, [1, 0]]], axis=1).reshape(-1, 2)
     key = np.minimum(e[:, 0], e[:, 1]) * (int(g.max()) + 1) + np.maximum(e[:, 0], e[:, 1])
-    _, inv, count = np.unique(key, return_inverse=True, return_counts=True)
-    boundary = count[inv.reshape(-1)] == 1
-    seg = vertices[ev[boundary]][:, :, [0, 2]]
+    _, inv = np.unique(key, return_inverse=True)
+    inv = inv.reshape(-1)
+    way = np.where(e[:, 0] < e[:, 1], 1, -1)
+    net = np.bincount(inv, weights=way).astype(np.int64)
+    # one use of each edge the way its net count goes, repeated |net| times
+    along = np.flatnonzero((net[inv] != 0) & (way == np.sign(net[inv])))
+    _, first = np.unique(inv[along], return_index=True)
+    pick = np.sort(along[first])   # in the faces' order, as the chains have always been merged
+    seg = vertices[np.repeat(ev[pick], np.abs(net[inv[pick]]), axis=0)][:, :, [0, 2]]
     return winding_region(seg, tolerance)
 
 
