@@ -109,8 +109,8 @@ def _ramp(cnt: np.ndarray) -> np.ndarray:
 def grid_for(vertices: np.ndarray, cs: float, origin_xz=None, shape=None) -> tuple[np.ndarray, tuple[int, int]]:
     """Origin (x, y, z) and (nz, nx) of a grid of ``cs`` cells over the vertices
     (or over ``origin_xz`` / ``shape`` when given)."""
-    lo = vertices.min(axis=0)
-    hi = vertices.max(axis=0)
+    # column by column: numpy's reduction over axis 0 of an (n, 3) array is ~8x slower
+    lo, hi = (np.array([f(vertices[:, k]) for k in range(3)]) for f in (np.min, np.max))
     if origin_xz is None:
         origin = lo.astype(np.float64).copy()
     else:
@@ -585,6 +585,6 @@ def build_heightfield(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: fl
     (col, smin, smax, walk, flat, top_walk), pairs = rasterize(vertices, faces, cs, ch, walk_f, flat_f, origin, shape,
                                                                climb_steps)
     walk2, counts, low = filter_spans(col, smin, smax, walk, shape, head_steps, climb_steps)
-    counts = {"pairs": pairs, "spans": len(col), "walkable_faces": int(walk_f.sum()),
-              "walkable_raw": int(walk.sum()), **counts}
+    counts = {"pairs": pairs, "spans": len(col), "walkable_faces": int(np.count_nonzero(walk_f)),
+              "walkable_raw": int(np.count_nonzero(walk)), **counts}
     return Heightfield(origin, float(cs), float(ch), shape, col, smin, smax, walk2, flat, top_walk, counts, low)

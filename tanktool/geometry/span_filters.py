@@ -58,8 +58,9 @@ def filter_spans(hf_col, smin, smax, walk, shape, headroom: int, climb: int):
     """Recast's three filters (see the module docstring); returns the new walkable flags
     and how many spans each filter took away."""
     w3, lifted, ledge, steep, low = filter_masks(hf_col, smin, smax, walk, shape, headroom, climb)
-    counts = {"lifted": int(lifted.sum()), "ledge": int(ledge.sum()), "steep": int(steep.sum()),
-              "low": int(low.sum())}
+    # count_nonzero: a bool array's sum() casts every flag to int64 first (6% of the filters)
+    counts = {k: int(np.count_nonzero(a)) for k, a in (("lifted", lifted), ("ledge", ledge), ("steep", steep),
+                                                       ("low", low))}
     return w3, counts, low
 
 
