@@ -96,3 +96,21 @@ def test_the_height_and_follow_kernels_are_the_python_ones(ground):
     assert fast == slow
     assert all(type(v) is float for v in fast[0]) and all(type(v) is int for v in fast[1])
     assert sum(v >= 0 for v in fast[1]) > n // 2
+
+
+def test_the_walks_in_bands_and_shared_by_two_grades_are_one_walk(ground, monkeypatch):
+    from tanktool.sim.agents import layers
+
+    g, spawns = ground
+    layers._LAST_WALK.clear()
+    graded = ground_agent_grid(g, 1.0, 1.9, spawns, grade=0.45)
+    plain = ground_agent_grid(g, 1.0, 1.9, spawns)          # the walk above, not cut
+    monkeypatch.setattr(layers, "WALK_BAND", 5)
+    for grade, want in ((0.45, graded), (float("inf"), plain)):
+        layers._LAST_WALK.clear()
+        got = ground_agent_grid(g, 1.0, 1.9, spawns, grade=grade)
+        for a, b in ((got, want), (got.layers, want.layers)):
+            assert np.array_equal(a.valid, b.valid) and np.array_equal(a.reachable, b.reachable)
+            assert a.link is None and b.link is None or np.array_equal(a.link, b.link)
+        assert got.spawn_nodes == want.spawn_nodes
+    assert (plain.layers.link >= 0).sum() >= (graded.layers.link >= 0).sum()

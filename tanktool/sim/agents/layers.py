@@ -133,6 +133,79 @@ def _compact_clearance(ground: "Ground", limit: float) -> np.ndarray:
     return out.reshape(L, nz, nx)
 
 
+#: rows of the agent grid walked at a time: the walks' int32 temporaries are a band's
+WALK_BAND = 256
+#: the last walk of each ground (an agent asks for its grid at two grades: one walk)
+_LAST_WALK: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _walked(ground: "Ground", clearance: float, ok_fine: np.ndarray, ii: np.ndarray, jj: np.ndarray,
+            k: int) -> np.ndarray:
+    """(L, NZ, NX, 4) int8: the level each coarse node (ii, jj) arrives on after ``k``
+    surface steps in each direction, every one on an ``ok_fine`` node (-1: none); the
+    last of each ground kept (read only)."""
+    key = (clearance, k, len(ii), len(jj))
+    try:
+        last = _LAST_WALK.get(ground)
+    except TypeError:   # not weakly referable (a stand-in ground): no cache
+        last = None
+    if last is not None and last[0] == key and last[1] is ground.link:
+        return last[2]
+    L = ok_fine.shape[0]
+    out = np.full((L, len(ii), len(jj), 4), -1, dtype=np.int8)
+    for r0 in range(0, len(ii), WALK_BAND):   # rows are walked independently
+        rows = ii[r0:r0 + WALK_BAND]
+        out[:, r0:r0 + len(rows)] = _walk_band(ground.link, ok_fine, rows, jj, k)
+    out.flags.writeable = False
+    try:
+        _LAST_WALK[ground] = (key, ground.link, out)
+    except TypeError:
+        pass
+    return out
+
+
+def _walk_band(fl: np.ndarray, ok_fine: np.ndarray, rows: np.ndarray, jj: np.ndarray, k: int) -> np.ndarray:
+    """_walked for coarse nodes on surface rows ``rows``: (L, len(rows), len(jj), 4)."""
+    L, nz, nx = ok_fine.shape
+    valid = ok_fine[:, rows][:, :, jj]
+    out = np.empty(valid.shape + (4,), dtype=np.int8)
+    lvl = np.broadcast_to(np.arange(L, dtype=np.int32)[:, None, None], valid.shape)
+    I = np.broadcast_to(rows[None, :, None], valid.shape)
+    J = np.broadcast_to(jj[None, None, :], valid.shape)
+    for d, (di, dj) in enumerate(_STEPS):
+        cur, ci, cj = lvl.copy(), I.copy(), J.copy()
+        alive = valid.copy()
+        for _ in range(k):
+            ni, nj = ci + di, cj + dj
+            inside = (ni >= 0) & (ni < nz) & (nj >= 0) & (nj < nx)
+            alive &= inside
+            nxt = np.where(alive, fl[np.where(alive, cur, 0), np.clip(ci, 0, nz - 1), np.clip(cj, 0, nx - 1), d], -1)
+            alive &= nxt >= 0
+            ci, cj = np.clip(ni, 0, nz - 1), np.clip(nj, 0, nx - 1)
+            cur = np.where(alive, nxt, 0)
+            alive &= ok_fine[cur, ci, cj]
+        out[..., d] = np.where(alive, cur, -1)
+    return out
+
+
+def _cut_grade(link: np.ndarray, heights: np.ndarray, most: float) -> None:
+    """Cut (in place) the coarse links rising or falling more than ``most`` metres,
+    a band of rows at a time."""
+    L, NZ, NX = heights.shape
+    for r0 in range(0, NZ, WALK_BAND):
+        r1 = min(r0 + WALK_BAND, NZ)
+        here = heights[:, r0:r1]
+        for d, (di, dj) in enumerate(_STEPS):
+            to = link[:, r0:r1, :, d]
+            alive = to >= 0
+            cur = np.where(alive, to, 0)
+            ti = np.broadcast_to(np.clip(np.arange(r0, r1)[None, :, None] + di, 0, NZ - 1), cur.shape)
+            tj = np.broadcast_to(np.clip(np.arange(NX)[None, None, :] + dj, 0, NX - 1), cur.shape)
+            rise = np.abs(heights[cur, ti, tj] - here)
+            alive &= ~(rise > most)
+            link[:, r0:r1, :, d] = np.where(alive, cur, -1)
+
+
 def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: list,
                       grade: float = math.inf) -> NavGrid:
     """The projection grid (one level, see the module docstring) of the layered agent grid,
@@ -151,31 +224,11 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
     jj = (off + k * np.arange(NX)).astype(np.int32)
     valid = ok_fine[:, ii][:, :, jj]
     heights = ground.h[:, ii][:, :, jj]
-    link = np.full((L, NZ, NX, 4), -1, dtype=np.int8)
-    lvl = np.broadcast_to(np.arange(L, dtype=np.int32)[:, None, None], valid.shape)
-    I = np.broadcast_to(ii[None, :, None], valid.shape)
-    J = np.broadcast_to(jj[None, None, :], valid.shape)
-    fl = ground.link
-    for d, (di, dj) in enumerate(_STEPS):
-        cur, ci, cj = lvl.copy(), I.copy(), J.copy()
-        alive = valid.copy()
-        for _ in range(k):
-            ni, nj = ci + di, cj + dj
-            inside = (ni >= 0) & (ni < nz) & (nj >= 0) & (nj < nx)
-            alive &= inside
-            nxt = np.where(alive, fl[np.where(alive, cur, 0), np.clip(ci, 0, nz - 1), np.clip(cj, 0, nx - 1), d], -1)
-            alive &= nxt >= 0
-            ci, cj = np.clip(ni, 0, nz - 1), np.clip(nj, 0, nx - 1)
-            cur = np.where(alive, nxt, 0)
-            alive &= ok_fine[cur, ci, cj]
-        if math.isfinite(grade):
-            ti = np.broadcast_to(np.clip(np.arange(NZ)[None, :, None] + di, 0, NZ - 1), cur.shape)
-            tj = np.broadcast_to(np.clip(np.arange(NX)[None, None, :] + dj, 0, NX - 1), cur.shape)
-            rise = np.abs(heights[cur, ti, tj] - heights)
-            # heights come in voxel steps (CELL_HEIGHT): one step of slack, or a ramp
-            # just under the grade is cut where its steps fall unevenly
-            alive &= ~(rise > grade * k * fine + CELL_HEIGHT)
-        link[..., d] = np.where(alive, cur, -1)
+    link = _walked(ground, float(clearance), ok_fine, ii, jj, k).copy()
+    if math.isfinite(grade):
+        # heights come in voxel steps (CELL_HEIGHT): one step of slack, or a ramp just
+        # under the grade is cut where its steps fall unevenly
+        _cut_grade(link, heights, grade * k * fine + CELL_HEIGHT)
     # coarse node (I, J) sits at the centre of surface node (off + k I, off + k J)
     step = k * fine
     origin = np.array([ground.ox + (off + 0.5) * fine - 0.5 * step, ground.oz + (off + 0.5) * fine - 0.5 * step])
