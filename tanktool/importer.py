@@ -22,7 +22,7 @@ import numpy as np
 from . import __version__
 from .arena import MANIFEST, MIN_SPAWNS, NAVGRID_DEFAULTS, walkable_params
 from .errors import ArenaError
-from .formats.limits import check_cells
+from .formats.limits import MAX_COORDINATE, check_cells
 from .formats.walls_txt import WallList
 from .memory import GIVE_BACK_MIN, give_back
 
@@ -218,6 +218,11 @@ def _one_mesh(model: Path, scene: Any, cell: float, max_cells: int | None) -> An
         raise ArenaError(f"{model}: the model has no triangles")
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(meshes)
     lo, hi = mesh.bounds
+    far = float(np.abs(mesh.bounds).max())
+    if far > MAX_COORDINATE:   # walls.txt and the grids could not hold it (not a temporary file's error)
+        raise ArenaError(f"{model}: the model reaches {far:,.0f} m from the origin, and an arena's files hold "
+                         f"coordinates within {MAX_COORDINATE:,.0f} m: move it near the origin in your 3D program "
+                         "(or check --scale and the file's units)")
     check_cells(str(model), float(hi[0] - lo[0]), float(hi[2] - lo[2]), cell, model.stat().st_size,
                 max_cells)  # before the heightfield: its cost follows the cells
     return mesh

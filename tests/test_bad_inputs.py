@@ -421,3 +421,15 @@ def test_no_arguments_still_shows_the_help():
     assert "Usage: tanktool" in res.output and "Commands:" in res.output and "error:" not in res.output
     res = run("import-arena")
     one_error_line(res, "Missing argument 'MODEL'", "tanktool import-arena --help")
+
+
+def test_a_model_far_from_the_origin_is_refused_naming_the_model(tmp_path):
+    """A level 10,000 km out used to be written and then refused while checking its own
+    staged walls.txt, in a temporary folder's name; now the model is refused up front."""
+    model = tmp_path / "far.obj"
+    model.write_text("v 1e7 0 1e7\nv 1.00005e7 0 1e7\nv 1.00005e7 0 1.00005e7\nv 1e7 0 1.00005e7\n"
+                     "f 1 3 2\nf 1 4 3\n")
+    r = run("import-arena", str(model), "-o", str(tmp_path / "far"))
+    assert r.exit_code == 2
+    assert r.output.count("error:") == 1 and "far.obj: the model reaches 10,000,500 m from the origin" in r.output
+    assert ".tanktool-" not in r.output and not (tmp_path / "far").exists()
