@@ -69,7 +69,7 @@ HOOKS = [
     ("report", "tanktool.nav.surface_report:left_out"),
     ("quadtree", "tanktool.nav.quadtree:WallQuadtree.build"),
     ("quadtree", "tanktool.nav.quadtree:WallQuadtree.adaptive"),
-    ("pictures", "tanktool.plots.arena:save_preview"),
+    ("pictures", "tanktool.plots.arena:render_levels"),
     ("pictures", "tanktool.plots.navgrid:render_navgrid"),
     ("model.glb", "tanktool.formats.materials:export_glb"),
     ("writing", "tanktool.formats.walls_txt:write_walls"),

@@ -128,15 +128,18 @@ def import_arena(
     _check_heights(params.climb, height, wall_height)
     scene, mesh = _read_mesh(model, params.cell, max_cells, progress, up=up, scale=scale, warn=remark,
                              wall_height=wall_height, wall_thickness=wall_thickness)
-    result = _analyse(model, mesh, params, fleet, height, tolerance, progress)
+    # with the grid stage, the tank grid is only the spawns' (the bundle's is built anew)
+    result = _analyse(model, mesh, params, fleet, height, tolerance, progress, keep_runs=not grid)
     n_faces, model_left_out = len(mesh.faces), list(scene.metadata.get("left_out", []))
     del mesh   # scene.dump()'s copy: the analysis keeps the arrays it needs (vertices, faces)
+    preview = _preview(name, result)   # drawn while the analysis is whole
+    _before_vehicles(result, grid)
     others = _vehicle_grids(result, fleet, remark)
     fits = _remark_fit(model, result, fleet, remark, others)
     nav["cell"] = float(params.cell)
     companions = _companion_files(model)
     with staged_dir(target, force=force, manifest=MANIFEST) as tmp:
-        textures = _stage_files(tmp, model, companions, scene, target, name, height, result, remark)
+        textures = _stage_files(tmp, model, companions, scene, target, name, height, result, preview, remark)
         if progress:
             progress("files")
         source = {"up": up or default_up(fmt), "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness)}
@@ -152,6 +155,40 @@ def import_arena(
     return ImportResult(target, name, result.walls.walls, result.spawns, result.floor_y, n_faces,
                         result.walls.thin_walls, time.perf_counter() - t0, warnings, result, params, where, built,
                         model_left_out)
+
+
+def _before_vehicles(result: Any, grid: bool) -> None:
+    """Let go of what the smaller vehicles' grids and spawns do not read, once the
+    report and the preview are done: of the surface all but its spans' columns, levels,
+    heights and links (its clearance, regions, floors, ceilings and the heightfield's
+    spans), and the tank grid when the grid stage builds the bundle's own.  On a 2 km
+    terrain ~1 GB, which the smaller vehicle's grid stacked on (the import's peak)."""
+    s = result.surface
+    for k in ("floor", "ceil", "region", "main"):   # the grids read none of these
+        a = getattr(s, k)
+        setattr(s, k, np.zeros(0, dtype=a.dtype))
+    s.clearance = None
+    s.derived.clear()
+    s.hf = s.hf.geometry()
+    if grid:
+        result.grid = None   # ImportResult.grid holds the grid written with the bundle
+    give_back(GIVE_BACK_MIN)
+
+
+def _preview(name: str, result: Any) -> bytes:
+    """preview.png's bytes: the levels, walls, spawns and what was left out (the
+    report's answers, kept with the surface: its clearance and regions go first)."""
+    from .nav.surface_report import asked
+    from .plots.arena import render_levels
+
+    s = result.surface
+    if result.grid is not None and asked(s, result.grid.clearance, (result.vertices, result.faces)):
+        s.clearance, s.region = None, np.zeros(0, dtype=s.region.dtype)
+    walls, spawns, lv = result.walls.walls, result.spawns, result.levels
+    bounds = walls.bounds
+    title = (f"{name}: {len(lv)} level{'s' if len(lv) != 1 else ''}, {len(walls)} walls + 4 auxiliary, "
+             f"{len(spawns)} spawns, {bounds[1, 0] - bounds[0, 0]:.0f} x {bounds[1, 1] - bounds[0, 1]:.0f} m")
+    return render_levels(result, title)
 
 
 def _let_go(result: Any, grid: bool) -> None:
@@ -245,13 +282,13 @@ def _as_placed(scene: Any) -> list[Any] | None:
 
 
 def _analyse(model: Path, mesh: Any, params: Any, fleet: Any, height: float, tolerance: float,
-             progress: Callable[[str], None] | None) -> Any:
-    """analyse_arena on the mesh, its errors naming the file."""
+             progress: Callable[[str], None] | None, keep_runs: bool = True) -> Any:
+    """analyse_arena on the mesh, its errors naming the file (``keep_runs``: see there)."""
     from .nav.arena_levels import analyse_arena
 
     try:
         return analyse_arena(mesh.vertices, mesh.faces, params, fleet, cut_height=height, tolerance=tolerance,
-                             progress=progress)
+                             progress=progress, keep_runs=keep_runs)
     except ArenaError as e:
         # the same kind (a NoFitError keeps the --scale it suggests), the file named
         err = ArenaError(f"{model}: {e}")
@@ -296,14 +333,14 @@ def _vehicle_grids(result: Any, fleet: Any, remark: Callable[[str], None]) -> di
 
 
 def _stage_files(tmp: Path, model: Path, companions: list[Path], scene: Any, target: Path, name: str,
-                 height: float, result: Any, remark: Callable[[str], None]) -> Any:
-    """Copy the model in and write model.glb, walls.txt and preview.png; the textures export_glb copied."""
+                 height: float, result: Any, preview: bytes, remark: Callable[[str], None]) -> Any:
+    """Copy the model in and write model.glb, walls.txt and preview.png (``preview``:
+    its bytes, :func:`_preview`); the textures export_glb copied."""
+    from .formats.bundle import atomic_write_bytes
     from .formats.materials import export_glb
     from .formats.walls_txt import write_walls
-    from .plots.arena import save_preview
 
-    walls, spawns = result.walls.walls, result.spawns
-    bounds = walls.bounds
+    walls = result.walls.walls
     for f in [model, *companions]:  # where the model looks for it: a .gltf's "data/scene.bin" stays there
         (tmp / _beside(f, model)).parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(f, tmp / _beside(f, model))
@@ -313,10 +350,7 @@ def _stage_files(tmp: Path, model: Path, companions: list[Path], scene: Any, tar
               f"(flat floors: cut {height:g} m above them)\n"
               f"made by tanktool {__version__} import-arena; normals point into free space")
     write_walls(tmp / "walls.txt", walls, header=header)
-    lv = result.levels
-    title = (f"{name}: {len(lv)} level{'s' if len(lv) != 1 else ''}, {len(walls)} walls + 4 auxiliary, "
-             f"{len(spawns)} spawns, {bounds[1, 0] - bounds[0, 0]:.0f} x {bounds[1, 1] - bounds[0, 1]:.0f} m")
-    save_preview(tmp / "preview.png", walls, spawns, title, result.free, levels=result)
+    atomic_write_bytes(tmp / "preview.png", preview)
     return textures
 
 

@@ -103,3 +103,38 @@ def test_one_placed_mesh_is_analysed_without_a_copy(tmp_path):
     assert mesh is next(iter(scene.geometry.values()))   # the scene's own mesh, not dump()'s copy
     (dumped,) = scene.dump()
     assert np.array_equal(mesh.vertices, dumped.vertices) and np.array_equal(mesh.faces, dumped.faces)
+
+
+@pytest.mark.parametrize("name", ["two_storeys", "fort", "bridge"])
+def test_the_analysis_after_letting_go_is_the_whole_surfaces(name):
+    """keep_for_analysis (the heightfield's spans and the ceilings let go), the report's
+    answers kept with the surface and the tank grid without its runs: the same walls,
+    report, spawns and grid nodes as from the whole surface."""
+    import copy
+
+    from tanktool.nav import arena_levels
+    from tanktool.nav.level_walls import level_walls
+    from tanktool.nav.walkable import walkable_surface
+    from tests.test_walkable import PARAMS, TANK, mesh_of
+
+    V, F = mesh_of(name)
+    p = PARAMS
+    whole = walkable_surface(V, F, p, TANK.radius)
+    kept = copy.copy(whole)
+    kept.derived = {}
+    arena_levels.keep_for_analysis(kept)
+    assert len(kept.hf.col) == int(whole.hf.low_headroom.sum()) and len(kept.ceil) == 0
+    a = level_walls(whole, V, F, 1.0, p.headroom, p.climb, 0.01, p.max_slope)
+    b = level_walls(kept, V, F, 1.0, p.headroom, p.climb, 0.01, p.max_slope)
+    assert np.array_equal(a.walls.segments, b.walls.segments) and np.array_equal(a.walls.level, b.walls.level)
+    want = surface_report.left_out(whole, V, F, p, TANK.radius)
+    assert surface_report.left_out(kept, V, F, p, TANK.radius) == want
+    assert surface_report.asked(kept, TANK.radius, (V, F))
+    unreach = surface_report.unreachable(kept, TANK.radius, V, F)
+    kept.clearance, kept.region = None, kept.region[:0]   # as the import does before its picture
+    assert np.array_equal(surface_report.unreachable(kept, TANK.radius, V, F), unreach)
+    full = arena_levels.analyse_arena(V, F, p, TANK)
+    lean = arena_levels.analyse_arena(V, F, p, TANK, keep_runs=False)
+    assert np.array_equal(full.spawns, lean.spawns) and full.left_out == lean.left_out
+    assert np.array_equal(full.grid.valid, lean.grid.valid) and lean.grid.row_index.size == 0
+    assert full.grid.row_index.shape == full.grid.valid.shape

@@ -251,8 +251,12 @@ def surface_climb(grid: NavGrid) -> float:
 
 def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParams, fleet: Fleet,
                   cut_height: float = 1.0, tolerance: float = 0.01, spawn_count: int = SPAWN_COUNT,
-                  progress: Callable[[str], None] | None = None) -> ArenaLevels:
-    """Everything ``import-arena`` needs to know about a model's levels (module docstring)."""
+                  progress: Callable[[str], None] | None = None, keep_runs: bool = True) -> ArenaLevels:
+    """Everything ``import-arena`` needs to know about a model's levels (module docstring).
+
+    ``keep_runs`` False: the tank grid's run arrays are let go as soon as it is built
+    (empty; 16 bytes a node): for a caller that reads only its nodes, links and heights
+    (the import that builds the bundle's grid anew)."""
     step = progress or (lambda _s: None)
     vertices = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces, dtype=np.int64)
@@ -263,6 +267,7 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
     t = {}
     t0 = time.perf_counter()
     surface = walkable_surface(vertices, faces, params, fleet.radius)
+    keep_for_analysis(surface)
     t["surface"] = time.perf_counter() - t0
     step("surface")
     if not surface.main.any():
@@ -276,7 +281,7 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
     t["walls"] = time.perf_counter() - t0
     step("walls")
     t0 = time.perf_counter()
-    found, why, problem, tries = _largest_fit(surface, lw, params, fleet, spawn_count, vertices, faces)
+    found, why, problem, tries = _largest_fit(surface, lw, params, fleet, spawn_count, vertices, faces, keep_runs)
     t["grid"] = time.perf_counter() - t0
     step("grid")
     if found is None:
@@ -296,8 +301,37 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
                        fleet, too_big)
 
 
+def keep_for_analysis(surface: Surface) -> None:
+    """Let go of what the analysis does not read of a finished surface: its ceilings
+    and the heightfield's spans, all but those the headroom filter took away (the
+    report's); the walls' flags of the surface's spans (a flat top, the rim of a steep
+    obstacle) are kept as ``derived["span_flat"]``, ``["span_rim"]``.  2 B a span where
+    the spans took ~20 (~0.27 GB on a 2 km terrain, under every later stage's peak)."""
+    from ..geometry.heightfield import Heightfield
+
+    hf = surface.hf
+    w = hf.walkable
+    surface.derived["span_flat"] = hf.flat[w]
+    surface.derived["span_rim"] = ~hf.top_walkable[w]
+    low = hf.low_headroom
+    surface.hf = Heightfield(hf.origin, hf.cs, hf.ch, hf.shape, hf.col[low], hf.smin[low], hf.smax[low],
+                             np.zeros(int(low.sum()), dtype=bool), hf.flat[low], hf.top_walkable[low],
+                             dict(hf.counts), np.ones(int(low.sum()), dtype=bool))
+    surface.ceil = np.zeros(0, dtype=surface.ceil.dtype)
+
+
+def drop_runs(grid: NavGrid) -> NavGrid:
+    """``grid`` without its run arrays (empty): spawns are chosen by its nodes, links
+    and heights alone (choose_spawns); the runs are 16 bytes a node (0.26 GB on a 2 km
+    terrain, where two such grids stacked at the import's peak)."""
+    for k in ("row_index", "row_total", "col_index", "col_total"):
+        setattr(grid, k, np.zeros((0, 0, 0), dtype=getattr(grid, k).dtype))
+    return grid
+
+
 def _largest_fit(surface: Surface, lw: LevelWalls, params: WalkableParams, fleet: Fleet, spawn_count: int,
-                 vertices: np.ndarray, faces: np.ndarray) -> tuple[tuple | None, dict[str, str], str | tuple, list]:
+                 vertices: np.ndarray, faces: np.ndarray,
+                 keep_runs: bool = True) -> tuple[tuple | None, dict[str, str], str | tuple, list]:
     """The largest vehicle that fits: the grid and spawns are made for it (an arena too
     narrow for the heavy tank still plays with the light one; play refuses the others).
     Returns ((grid, spawns, fleet) or None, vehicle -> why the arena is not for it,
@@ -313,6 +347,8 @@ def _largest_fit(surface: Surface, lw: LevelWalls, params: WalkableParams, fleet
         fl = fleet if k == 0 else fleet.down_to(name, radius, length)
         g = tank_grid(surface, lw, radius)
         g.climb = params.climb
+        if not keep_runs:
+            drop_runs(g)
         if not g.valid.any():
             problem = problem or (name, radius)   # the refusal is worked out only if it is needed
             why[name] = f"fits nowhere (it needs a circle of {2 * radius:.2f} m)"
@@ -367,7 +403,7 @@ def smaller_vehicles(result: ArenaLevels, fleet: Fleet,
     for name, radius, length in fleet.sizes:
         if radius >= big.radius - 1e-9 or name in out:
             continue
-        g = tank_grid(result.surface, result.walls, radius)
+        g = drop_runs(tank_grid(result.surface, result.walls, radius))   # only its spawns are kept
         g.climb = result.params.climb
         if not g.valid.any():
             continue

@@ -173,6 +173,14 @@ def unreachable(surface: Surface, radius: float, vertices: np.ndarray | None = N
                        lambda: _unreachable(surface, radius, vertices, faces))
 
 
+def asked(surface: Surface, radius: float, model: tuple) -> bool:
+    """Whether the report's per-span answers for ``radius`` (unreachable given the
+    model's arrays ``(vertices, faces)``, too_small) are kept with the surface: the
+    picture no longer needs its clearance and regions then."""
+    return (("unreachable", float(radius), *(id(a) for a in model)) in surface.derived
+            and ("too_small", float(radius)) in surface.derived)
+
+
 def _unreachable(surface: Surface, radius: float, vertices: np.ndarray | None, faces: np.ndarray | None) -> np.ndarray:
     from ..geometry.segments import faces_above
 
