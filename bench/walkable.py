@@ -123,21 +123,25 @@ STAGE_HOOKS = [
 
 
 def our_stages(V: np.ndarray, F: np.ndarray, repeat: int) -> dict:
-    """Mean exclusive ms per stage over ``repeat`` profiled runs (the grid's own work
-    is what the hooks leave over)."""
+    """Exclusive ms per stage, the fastest of ``repeat`` profiled runs for each stage
+    (the grid's own work is what the hooks leave over): on a shared machine a mean
+    of a few runs moved a stage by 2x between runs."""
     from stage_profile import Profile
 
     s = SETTINGS
     params = WalkableParams(s["cell"], s["cell_height"], s["max_slope"], s["climb"], s["headroom"])
-    with Profile(STAGE_HOOKS) as prof:
-        t0 = time.perf_counter()
-        for _ in range(repeat):
+    best: dict[str, float] = {}
+    for _ in range(repeat):
+        with Profile(STAGE_HOOKS) as prof:
+            t0 = time.perf_counter()
             surface = walkable_surface(V, F, params, s["clearance"])
             grid_from_surface(surface, s["clearance"], surface.hf.origin[[0, 2]])
-        total = time.perf_counter() - t0
-    out = {k: v for k, v in prof.stages.items()}
-    out["grid"] = out.get("grid", 0.0) + total - sum(prof.stages.values())
-    return {k: round(v * 1000 / repeat, 2) for k, v in out.items()}
+            total = time.perf_counter() - t0
+        out = dict(prof.stages)
+        out["grid"] = out.get("grid", 0.0) + total - sum(prof.stages.values())
+        for k, v in out.items():
+            best[k] = min(best.get(k, float("inf")), v)
+    return {k: round(v * 1000, 2) for k, v in best.items()}
 
 
 def match_share(a: np.ndarray, b: np.ndarray, width: int) -> float:
@@ -206,7 +210,8 @@ def run(a: argparse.Namespace, compiled: bool) -> int:
                 print(f"error: {path}: {' '.join(str(e).split())}", file=sys.stderr)
                 return 2
             row = {"mesh": str(path), "tris": int(len(F)), "ms_ours": round(ms_ours, 2), "ms_recast": None,
-                   "cpu_ms_ours": round(cpu_ours, 2), "kernels": compiled, "ours_stages_ms": our_stages(V, F, 2),
+                   "cpu_ms_ours": round(cpu_ours, 2), "kernels": compiled,
+                   "ours_stages_ms": our_stages(V, F, a.repeat),
                    "nodes": int(grid.valid.sum()), "levels": int(grid.levels), "precision": None, "recall": None}
             if exe is not None:
                 rec, spans = run_recast(exe, V, F, a.repeat, work)
