@@ -433,3 +433,15 @@ def test_a_model_far_from_the_origin_is_refused_naming_the_model(tmp_path):
     assert r.exit_code == 2
     assert r.output.count("error:") == 1 and "far.obj: the model reaches 10,000,500 m from the origin" in r.output
     assert ".tanktool-" not in r.output and not (tmp_path / "far").exists()
+
+
+def test_a_floor_wound_the_wrong_way_says_flip_the_normals(tmp_path):
+    """A floor whose faces face down is not walkable (as in Recast); the refusal says
+    so instead of only asking about the up axis and the scale."""
+    model = tmp_path / "flipped.obj"
+    model.write_text("v 0 0 0\nv 50 0 0\nv 50 0 50\nv 0 0 50\nf 1 2 3\nf 1 3 4\n")
+    r = run("import-arena", str(model), "-o", str(tmp_path / "flipped"))
+    assert r.exit_code == 2 and r.output.count("error:") == 1
+    assert "2,500 m^2 of level faces face down and 0 m^2 up" in r.output and "flip the normals" in r.output
+    model.write_text("v 0 0 0\nv 50 0 0\nv 50 0 50\nv 0 0 50\nf 1 3 2\nf 1 4 3\n")
+    assert run("import-arena", str(model), "-o", str(tmp_path / "right")).exit_code == 0

@@ -274,7 +274,7 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
         raise ArenaError(
             f"no surface a tank can stand on: every upward face is steeper than {params.max_slope:g} deg, "
             f"has less than {params.headroom:g} m headroom or is narrower than a cell "
-            f"(is the up axis right? try --up; the scale? try --scale)")
+            f"({_no_surface_hint(vertices, faces, params.max_slope)})")
     t0 = time.perf_counter()
     lw = level_walls(surface, vertices, faces, cut_height, params.headroom, params.climb, tolerance,
                      params.max_slope)
@@ -327,6 +327,21 @@ def drop_runs(grid: NavGrid) -> NavGrid:
     for k in ("row_index", "row_total", "col_index", "col_total"):
         setattr(grid, k, np.zeros((0, 0, 0), dtype=getattr(grid, k).dtype))
     return grid
+
+
+def _no_surface_hint(vertices: np.ndarray, faces: np.ndarray, max_slope: float) -> str:
+    """What to try when nothing is walkable: flip the faces when more of the model's
+    gentle area faces down than up (a floor wound the wrong way faces down, and like
+    Recast we walk only on faces whose front is up), else the up axis and the scale."""
+    tri = vertices[faces]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    length = np.linalg.norm(n, axis=1)
+    gentle = np.abs(n[:, 1]) >= np.cos(np.radians(max_slope)) * length
+    down, up = float(length[gentle & (n[:, 1] < 0)].sum()), float(length[gentle & (n[:, 1] > 0)].sum())
+    if down > up:
+        return (f"{down / 2:,.0f} m^2 of level faces face down and {up / 2:,.0f} m^2 up: are the faces wound the "
+                "wrong way? flip the normals in your 3D program; or is the up axis right? try --up")
+    return "is the up axis right? try --up; the scale? try --scale"
 
 
 def _largest_fit(surface: Surface, lw: LevelWalls, params: WalkableParams, fleet: Fleet, spawn_count: int,
