@@ -40,7 +40,8 @@
  *   lift_portals(col, level, link, steps)   (_kernels_surface.c)
  *   ground_tilt(h, flat, L, nz, nx, ox, oz, cell, climb, reach, level, x, z, c, s, hl, hw)   (_kernels_ground.c)
  *   ground_height(h, L, nz, nx, ox, oz, cell, climb, level, x, z), ground_follow(link, L, nz, nx, level,
- *       i0, j0, i1, j1)   (_kernels_ground.c)
+ *       i0, j0, i1, j1), grid_walk(link, ok, rows, cols, out, L, nz, nx, k), grade_cut(link, heights,
+ *       L, NZ, NX, most)   (_kernels_ground.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -441,6 +442,8 @@ static PyMethodDef methods[] = {
     {"ground_tilt", tanktool_ground_tilt, METH_VARARGS, "Ground.tilt on the ground's arrays (_kernels_ground.c)"},
     {"ground_height", tanktool_ground_height, METH_VARARGS, "Ground.height on the ground's heights (_kernels_ground.c)"},
     {"ground_follow", tanktool_ground_follow, METH_VARARGS, "Ground.follow on the ground's links (_kernels_ground.c)"},
+    {"grid_walk", tanktool_grid_walk, METH_VARARGS, "layers._walked: the agents' coarse links (_kernels_ground.c)"},
+    {"grade_cut", tanktool_grade_cut, METH_VARARGS, "layers._cut_grade in place (_kernels_ground.c)"},
     {NULL, NULL, 0, NULL},
 };
 

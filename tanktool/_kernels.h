@@ -64,5 +64,7 @@ PyObject *tanktool_chamfer_near(PyObject *self, PyObject *args);
 PyObject *tanktool_ground_tilt(PyObject *self, PyObject *args);
 PyObject *tanktool_ground_height(PyObject *self, PyObject *args);
 PyObject *tanktool_ground_follow(PyObject *self, PyObject *args);
+PyObject *tanktool_grid_walk(PyObject *self, PyObject *args);
+PyObject *tanktool_grade_cut(PyObject *self, PyObject *args);
 
 #endif

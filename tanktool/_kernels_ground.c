@@ -7,6 +7,8 @@
  *   ground_height(h, L, nz, nx, ox, oz, cell, climb, level, x, z) -> float, or None
  *   ground_follow(link, L, nz, nx, level, i0, j0, i1, j1) -> level (-1: no way), or None
  *       link: int8 (L, nz, nx, 4), the ground's links
+ *   grid_walk(link, ok, rows, cols, out, L, nz, nx, k)   (layers._walked: the agents' grid)
+ *   grade_cut(link, heights, L, NZ, NX, most)   (layers._cut_grade, in place)
  *
  * Ground.tilt's arithmetic one operation at a time (no fused multiply-adds: built with
  * -ffp-contract=off), Python's float floor division in cell_of, its atan2 (libm's), so
@@ -189,6 +191,9 @@ done:
     return ret;
 }
 
+/* the steps (di, dj) of the links +x, +z, -x, -z */
+static const int DI_G[4] = {0, 1, 0, -1}, DJ_G[4] = {1, 0, -1, 0};
+
 /* the link of node (lv, i, j) in direction d: a level, -1 none */
 static inline int step_link(const int8_t *K, i64 nz, i64 nx, i64 lv, i64 i, i64 j, int d) {
     return K[((lv * nz + i) * nx + j) * 4 + d];
@@ -251,5 +256,104 @@ PyObject *tanktool_ground_follow(PyObject *self, PyObject *args) {
     }
 done:
     PyBuffer_Release(&kb);
+    return ret;
+}
+
+/* layers._walked: from each coarse node (lv, rows[r], cols[c]) k surface steps in each
+ * direction along the links, every node on the way ok; out[lv, r, c, d] the level it
+ * arrives on, -1 where a step has no link, leaves the grid or meets a node not ok.
+ *   link: int8 (L, nz, nx, 4); ok: bool (L, nz, nx); rows, cols: int32; out: int8
+ *   (L, R, C, 4), written */
+PyObject *tanktool_grid_walk(PyObject *self, PyObject *args) {
+    Py_buffer kb, okb, rb, cb, ob;
+    Py_ssize_t L, nz, nx, k;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*w*nnnn", &kb, &okb, &rb, &cb, &ob, &L, &nz, &nx, &k)) return NULL;
+    PyObject *ret = NULL;
+    const i64 R = rb.len / 4, C = cb.len / 4;
+    if (!need(&kb, (i64)L * nz * nx * 4, 1, "link") || !need(&okb, (i64)L * nz * nx, 1, "ok") ||
+        !need(&ob, (i64)L * R * C * 4, 1, "out"))
+        goto done;
+    {
+        const int8_t *K = kb.buf;
+        const uint8_t *ok = okb.buf;
+        const int32_t *rows = rb.buf, *cols = cb.buf;
+        int8_t *out = ob.buf;
+        int bad = 0;
+        for (i64 r = 0; r < R; ++r)
+            if (rows[r] < 0 || rows[r] >= nz) bad = 1;
+        for (i64 c = 0; c < C; ++c)
+            if (cols[c] < 0 || cols[c] >= nx) bad = 1;
+        if (bad) {
+            PyErr_SetString(PyExc_ValueError, "grid_walk: a row or column off the grid");
+            goto done;
+        }
+        Py_BEGIN_ALLOW_THREADS
+        for (i64 lv = 0; lv < L; ++lv)
+            for (i64 r = 0; r < R; ++r)
+                for (i64 c = 0; c < C; ++c) {
+                    int8_t *o = out + ((lv * R + r) * C + c) * 4;
+                    const i64 i0 = rows[r], j0 = cols[c];
+                    const int start = ok[(lv * nz + i0) * nx + j0];
+                    for (int d = 0; d < 4; ++d) {
+                        i64 cur = lv, ci = i0, cj = j0;
+                        int alive = start;
+                        for (i64 s = 0; s < k && alive; ++s) {
+                            const i64 ni = ci + DI_G[d], nj = cj + DJ_G[d];
+                            if (ni < 0 || ni >= nz || nj < 0 || nj >= nx) { alive = 0; break; }
+                            const int nxt = step_link(K, nz, nx, cur, ci, cj, d);
+                            if (nxt < 0) { alive = 0; break; }
+                            cur = nxt, ci = ni, cj = nj;
+                            if (!ok[(cur * nz + ci) * nx + cj]) alive = 0;
+                        }
+                        o[d] = alive ? (int8_t)cur : -1;
+                    }
+                }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&kb);
+    PyBuffer_Release(&okb);
+    PyBuffer_Release(&rb);
+    PyBuffer_Release(&cb);
+    PyBuffer_Release(&ob);
+    return ret;
+}
+
+/* layers._cut_grade: the coarse links rising or falling more than most metres cut (-1),
+ * in place; the rise to the neighbour (clamped into the grid) on the level linked to.
+ *   link: int8 (L, NZ, NX, 4); heights: float64 (L, NZ, NX) */
+PyObject *tanktool_grade_cut(PyObject *self, PyObject *args) {
+    Py_buffer kb, hb;
+    Py_ssize_t L, NZ, NX;
+    double most;
+    if (!PyArg_ParseTuple(args, "w*y*nnnd", &kb, &hb, &L, &NZ, &NX, &most)) return NULL;
+    PyObject *ret = NULL;
+    if (!need(&kb, (i64)L * NZ * NX * 4, 1, "link") || !need(&hb, (i64)L * NZ * NX, 8, "heights")) goto done;
+    {
+        int8_t *K = kb.buf;
+        const double *h = hb.buf;
+        Py_BEGIN_ALLOW_THREADS
+        for (i64 lv = 0; lv < L; ++lv)
+            for (i64 i = 0; i < NZ; ++i)
+                for (i64 j = 0; j < NX; ++j) {
+                    const double here = h[(lv * NZ + i) * NX + j];
+                    for (int d = 0; d < 4; ++d) {
+                        int8_t *to = K + ((lv * NZ + i) * NX + j) * 4 + d;
+                        if (*to < 0) continue;
+                        i64 ti = i + DI_G[d], tj = j + DJ_G[d];
+                        ti = ti < 0 ? 0 : ti >= NZ ? NZ - 1 : ti;
+                        tj = tj < 0 ? 0 : tj >= NX ? NX - 1 : tj;
+                        if (fabs(h[((i64)*to * NZ + ti) * NX + tj] - here) > most) *to = -1;
+                    }
+                }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&kb);
+    PyBuffer_Release(&hb);
     return ret;
 }

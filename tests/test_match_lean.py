@@ -114,3 +114,42 @@ def test_the_walks_in_bands_and_shared_by_two_grades_are_one_walk(ground, monkey
             assert a.link is None and b.link is None or np.array_equal(a.link, b.link)
         assert got.spawn_nodes == want.spawn_nodes
     assert (plain.layers.link >= 0).sum() >= (graded.layers.link >= 0).sum()
+
+
+@pytest.mark.skipif(not __import__("tanktool.geometry.kernels", fromlist=["x"]).available(),
+                    reason="compiled kernels not built")
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_the_walk_kernel_is_the_numpy_walk(ground, k):
+    from tanktool.geometry.kernels import use_kernels
+    from tanktool.sim.agents import layers
+
+    g = ground[0]
+    ok = layers.clear_enough(g, 1.4)
+    ii = (k // 2 + k * np.arange((g.nz - k // 2 - 1) // k + 1)).astype(np.int32)
+    jj = (k // 2 + k * np.arange((g.nx - k // 2 - 1) // k + 1)).astype(np.int32)
+    got = {}
+    for on in (False, True):
+        layers._LAST_WALK.clear()
+        with use_kernels(on):
+            got[on] = layers._walked(g, 1.4, ok, ii, jj, k)
+    assert np.array_equal(got[False], got[True]) and (got[True] >= 0).sum() > 1000
+
+
+@pytest.mark.skipif(not __import__("tanktool.geometry.kernels", fromlist=["x"]).available(),
+                    reason="compiled kernels not built")
+def test_the_grade_cut_kernel_is_the_numpy_cut(ground):
+    from tanktool.geometry.kernels import use_kernels
+    from tanktool.sim.agents import layers
+
+    g, spawns = ground
+    plain = ground_agent_grid(g, 1.0, 1.4, spawns)
+    link0, heights = plain.layers.link, plain.layers.height      # NaN off the valid nodes
+    for most in (2.5, 0.9, 0.3, 0.0):
+        got = {}
+        for on in (False, True):
+            link = link0.copy()
+            with use_kernels(on):
+                layers._cut_grade(link, heights, most)
+            got[on] = link
+        assert np.array_equal(got[False], got[True])
+    assert (got[True] >= 0).sum() < (link0 >= 0).sum()      # 0.0: any rise cut

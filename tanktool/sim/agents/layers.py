@@ -151,11 +151,20 @@ def _walked(ground: "Ground", clearance: float, ok_fine: np.ndarray, ii: np.ndar
         last = None
     if last is not None and last[0] == key and last[1] is ground.link:
         return last[2]
-    L = ok_fine.shape[0]
+    L, nz, nx = ok_fine.shape
     out = np.full((L, len(ii), len(jj), 4), -1, dtype=np.int8)
-    for r0 in range(0, len(ii), WALK_BAND):   # rows are walked independently
-        rows = ii[r0:r0 + WALK_BAND]
-        out[:, r0:r0 + len(rows)] = _walk_band(ground.link, ok_fine, rows, jj, k)
+    from ...geometry.kernels import active
+
+    kern = active()
+    if getattr(kern, "grid_walk", None) is not None:   # one pass, no temporaries (2 km: 3 s -> 0.1 s)
+        kern.grid_walk(np.ascontiguousarray(ground.link, dtype=np.int8),
+                       np.ascontiguousarray(ok_fine, dtype=bool).view(np.uint8),
+                       np.ascontiguousarray(ii, dtype=np.int32), np.ascontiguousarray(jj, dtype=np.int32), out,
+                       L, nz, nx, k)
+    else:
+        for r0 in range(0, len(ii), WALK_BAND):   # rows are walked independently
+            rows = ii[r0:r0 + WALK_BAND]
+            out[:, r0:r0 + len(rows)] = _walk_band(ground.link, ok_fine, rows, jj, k)
     out.flags.writeable = False
     try:
         _LAST_WALK[ground] = (key, ground.link, out)
@@ -190,8 +199,14 @@ def _walk_band(fl: np.ndarray, ok_fine: np.ndarray, rows: np.ndarray, jj: np.nda
 
 def _cut_grade(link: np.ndarray, heights: np.ndarray, most: float) -> None:
     """Cut (in place) the coarse links rising or falling more than ``most`` metres,
-    a band of rows at a time."""
+    a band of rows at a time (in C where it is built: one pass)."""
     L, NZ, NX = heights.shape
+    from ...geometry.kernels import active
+
+    kern = active()
+    if getattr(kern, "grade_cut", None) is not None and link.flags.c_contiguous and link.dtype == np.int8:
+        kern.grade_cut(link, np.ascontiguousarray(heights, dtype=np.float64), L, NZ, NX, float(most))
+        return
     for r0 in range(0, NZ, WALK_BAND):
         r1 = min(r0 + WALK_BAND, NZ)
         here = heights[:, r0:r1]
