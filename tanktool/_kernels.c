@@ -41,7 +41,8 @@
  *   ground_tilt(h, flat, L, nz, nx, ox, oz, cell, climb, reach, level, x, z, c, s, hl, hw)   (_kernels_ground.c)
  *   ground_height(h, L, nz, nx, ox, oz, cell, climb, level, x, z), ground_follow(link, L, nz, nx, level,
  *       i0, j0, i1, j1), grid_walk(link, ok, rows, cols, out, L, nz, nx, k), grade_cut(link, heights,
- *       L, NZ, NX, most)   (_kernels_ground.c)
+ *       L, NZ, NX, most), solid_visible(solid, points, out, nz, nx, ny, ox, oz, y0, cs, ch, margin,
+ *       step, max_range)   (_kernels_ground.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -444,6 +445,7 @@ static PyMethodDef methods[] = {
     {"ground_follow", tanktool_ground_follow, METH_VARARGS, "Ground.follow on the ground's links (_kernels_ground.c)"},
     {"grid_walk", tanktool_grid_walk, METH_VARARGS, "layers._walked: the agents' coarse links (_kernels_ground.c)"},
     {"grade_cut", tanktool_grade_cut, METH_VARARGS, "layers._cut_grade in place (_kernels_ground.c)"},
+    {"solid_visible", tanktool_solid_visible, METH_VARARGS, "SolidField.visible's lines of sight (_kernels_ground.c)"},
     {NULL, NULL, 0, NULL},
 };
 

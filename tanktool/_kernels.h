@@ -66,5 +66,6 @@ PyObject *tanktool_ground_height(PyObject *self, PyObject *args);
 PyObject *tanktool_ground_follow(PyObject *self, PyObject *args);
 PyObject *tanktool_grid_walk(PyObject *self, PyObject *args);
 PyObject *tanktool_grade_cut(PyObject *self, PyObject *args);
+PyObject *tanktool_solid_visible(PyObject *self, PyObject *args);
 
 #endif

@@ -9,6 +9,8 @@
  *       link: int8 (L, nz, nx, 4), the ground's links
  *   grid_walk(link, ok, rows, cols, out, L, nz, nx, k)   (layers._walked: the agents' grid)
  *   grade_cut(link, heights, L, NZ, NX, most)   (layers._cut_grade, in place)
+ *   solid_visible(solid, points, out, nz, nx, ny, ox, oz, y0, cs, ch, margin, step, max_range)
+ *       (SolidField.visible: the agents' sight table)
  *
  * Ground.tilt's arithmetic one operation at a time (no fused multiply-adds: built with
  * -ffp-contract=off), Python's float floor division in cell_of, its atan2 (libm's), so
@@ -355,5 +357,65 @@ PyObject *tanktool_grade_cut(PyObject *self, PyObject *args) {
 done:
     PyBuffer_Release(&kb);
     PyBuffer_Release(&hb);
+    return ret;
+}
+
+/* SolidField.visible: out[a, b] = 1 when the segment between points a and b keeps out
+ * of the solid, sampled at m / k of the way (m = 1 .. k - 1, k = ceil(length / step) at
+ * least 1) as SolidField.inside samples a point (MARGIN up, its voxel), to the bit;
+ * pairs farther apart than max_range in (x, z) 0, a point 1 with itself.
+ *   solid: bool (nz, nx, ny); points: float64 (n, 3); out: uint8 (n, n), written */
+PyObject *tanktool_solid_visible(PyObject *self, PyObject *args) {
+    Py_buffer sb, pb, ob;
+    Py_ssize_t nz, nx, ny;
+    double ox, oz, y0, cs, ch, margin, step, max_range;
+    if (!PyArg_ParseTuple(args, "y*y*w*nnndddddddd", &sb, &pb, &ob, &nz, &nx, &ny, &ox, &oz, &y0, &cs, &ch, &margin,
+                          &step, &max_range))
+        return NULL;
+    PyObject *ret = NULL;
+    const i64 n = pb.len / 24;
+    if (!need(&sb, (i64)nz * nx * ny, 1, "solid") || !need(&pb, 3 * n, 8, "points") || !need(&ob, n * n, 1, "out"))
+        goto done;
+    {
+        const uint8_t *S = sb.buf;
+        const double *P = pb.buf;
+        uint8_t *V = ob.buf;
+        const double ytop = y0 + (double)(ny - 1) * ch, r2 = max_range * max_range;
+        Py_BEGIN_ALLOW_THREADS
+        for (i64 a = 0; a < n; ++a) {
+            V[a * n + a] = 1;
+            const double ax = P[3 * a], ay = P[3 * a + 1], az = P[3 * a + 2];
+            for (i64 b = a + 1; b < n; ++b) {
+                const double dx = P[3 * b] - ax, dy = P[3 * b + 1] - ay, dz = P[3 * b + 2] - az;
+                uint8_t vis = 0;
+                if (dx * dx + dz * dz <= r2) {
+                    double kf = ceil(sqrt(dx * dx + dy * dy + dz * dz) / step);
+                    if (!(kf >= 1.0)) kf = 1.0;
+                    const i64 k = (i64)kf;
+                    vis = 1;
+                    for (i64 m = 1; m < k; ++m) {
+                        const double t = (double)m / (double)k;
+                        const double x = ax + dx * t, y = (ay + dy * t) + margin, z = az + dz * t;
+                        const double fj = floor((x - ox) / cs), fi = floor((z - oz) / cs);
+                        if (!(fi >= 0.0 && fi < (double)nz && fj >= 0.0 && fj < (double)nx && y < ytop)) continue;
+                        double fk = floor((y - y0) / ch);
+                        fk = fk < 0.0 ? 0.0 : fk > (double)(ny - 1) ? (double)(ny - 1) : fk;
+                        if (S[((i64)fi * nx + (i64)fj) * ny + (i64)fk]) {
+                            vis = 0;
+                            break;
+                        }
+                    }
+                }
+                V[a * n + b] = V[b * n + a] = vis;
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&sb);
+    PyBuffer_Release(&pb);
+    PyBuffer_Release(&ob);
     return ret;
 }

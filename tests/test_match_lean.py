@@ -153,3 +153,24 @@ def test_the_grade_cut_kernel_is_the_numpy_cut(ground):
             got[on] = link
         assert np.array_equal(got[False], got[True])
     assert (got[True] >= 0).sum() < (link0 >= 0).sum()      # 0.0: any rise cut
+
+
+@pytest.mark.skipif(not __import__("tanktool.geometry.kernels", fromlist=["x"]).available(),
+                    reason="compiled kernels not built")
+def test_the_lines_of_sight_kernel_is_the_numpy_sampling(ground):
+    from tanktool.geometry.kernels import use_kernels
+
+    g = ground[0]
+    sf = g.solids
+    rng = np.random.default_rng(3)
+    lv, i, j = np.nonzero(g.exists)
+    pick = rng.integers(0, len(lv), 120)
+    x, z = g.ox + (j[pick] + 0.5) * g.cell, g.oz + (i[pick] + 0.5) * g.cell
+    pts = np.column_stack([x, g.h[lv[pick], i[pick], j[pick]] + rng.choice([0.2, 1.2, 3.0], len(pick)), z])
+    for rng_m in (float("inf"), 40.0):
+        with use_kernels(False):
+            slow = sf.visible(pts, rng_m)
+        with use_kernels(True):
+            fast = sf.visible(pts, rng_m)
+        assert fast.dtype == bool and np.array_equal(fast, slow)
+    assert 0 < fast.sum() < fast.size

@@ -192,6 +192,15 @@ class SolidField:
         p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         n = len(p)
         step = 0.5 * self.cs
+        from ..geometry.kernels import active
+
+        kern = active()
+        if getattr(kern, "solid_visible", None) is not None:   # the same samples in C, a line left at its first hit
+            out = np.zeros((n, n), dtype=np.uint8)
+            nz, nx = self.shape
+            kern.solid_visible(self._bytes, np.ascontiguousarray(p), out, nz, nx, self.ny, self.ox, self.oz, self.y0,
+                               self.cs, self.ch, self.MARGIN, step, float(max_range))
+            return out.view(bool)
         vis = np.eye(n, dtype=bool)
         for a in range(n - 1):
             b = np.arange(a + 1, n)
