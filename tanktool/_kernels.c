@@ -1,8 +1,8 @@
 /* tanktool._kernels: the walkable-surface loops numpy cannot make fast, in C.
  *
- * Five files (the rasteriser in _kernels_raster.c, the grid's loops in _kernels_grid.c,
- * the open spans' passes in _kernels_surface.c, the ground under a tank in
- * _kernels_ground.c, shared definitions in _kernels.h).
+ * Six files (the rasteriser in _kernels_raster.c, the faces' normals in _kernels_faces.c,
+ * the grid's loops in _kernels_grid.c, the open spans' passes in _kernels_surface.c,
+ * the ground under a tank in _kernels_ground.c, shared definitions in _kernels.h).
  * Optional: setup.py builds it when a C compiler is there; tanktool/nav/kernels.py
  * falls back to numpy otherwise, with identical results (tests/test_kernels.py
  * compares the two).  No numpy headers: arrays come in through the buffer protocol
@@ -21,6 +21,8 @@
  *       int64 spans, bool walk; the five bool outputs of span_filters.filter_masks
  *   components(link, label)
  *       link: int32 (n, 4); label: int64 (n,) written: the smallest span of each component
+ *   walkable_faces(X, Y, Z, f0, f1, f2, cos_slope, flat_ny, walk, flat) -> ok   (_kernels_faces.c)
+ *   flat_faces(X, Y, Z, f0, f1, f2, up_min2, flat_ny, height, area) -> k   (_kernels_faces.c)
  *   raster_merge(tri, abc, steep, walk, flat, nz, nx, ch, max_steps, row_lo, row_hi, thr)
  *       -> (pieces, col, smin, smax, walk, flat, top_walk)   (_kernels_raster.c)
  *       the pieces of every triangle (of rows row_lo .. row_hi - 1 only): steep ones by
@@ -430,6 +432,8 @@ static PyMethodDef methods[] = {
     {"reach", reach, METH_VARARGS, "straight-step distance from the sources relaxed to its fixed point, in place"},
     {"filters", filters, METH_VARARGS, "Recast's three span filters, as span_filters.filter_masks"},
     {"components", components, METH_VARARGS, "component labels (smallest span index), in place"},
+    {"walkable_faces", tanktool_walkable_faces, METH_VARARGS, "heightfield.walkable_faces' flags (_kernels_faces.c)"},
+    {"flat_faces", tanktool_flat_faces, METH_VARARGS, "the upward flat faces' heights and areas (_kernels_faces.c)"},
     {"raster_merge", tanktool_raster_merge, METH_VARARGS, "every triangle's pieces merged into spans (_kernels_raster.c)"},
     {"grid_labels", tanktool_grid_labels, METH_VARARGS, "component labels of the grid's valid nodes (_kernels_grid.c)"},
     {"grid_links", tanktool_grid_links, METH_VARARGS, "the layered grid's links from the surface's (_kernels_grid.c)"},
@@ -453,7 +457,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 14
+#define TANKTOOL_KERNELS_ABI 16
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

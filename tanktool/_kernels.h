@@ -47,6 +47,10 @@ static inline int32_t relax(const int32_t *L, const int32_t *dist, Py_ssize_t s,
 /* the rasteriser (_kernels_raster.c) */
 PyObject *tanktool_raster_merge(PyObject *self, PyObject *args);
 
+/* the faces (_kernels_faces.c) */
+PyObject *tanktool_walkable_faces(PyObject *self, PyObject *args);
+PyObject *tanktool_flat_faces(PyObject *self, PyObject *args);
+
 /* the grid (_kernels_grid.c) */
 PyObject *tanktool_grid_labels(PyObject *self, PyObject *args);
 PyObject *tanktool_grid_links(PyObject *self, PyObject *args);

@@ -121,3 +121,33 @@ def test_generated_levels_stack_the_same(name):
     assert np.array_equal(a.level, b.level) and a.levels == b.levels
     for key in ("col", "floor", "ceil", "link", "clearance", "height"):  # open spans, snapped heights
         assert np.array_equal(getattr(a, key), getattr(b, key)), key
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(4))
+def test_random_faces_have_the_same_flags_and_flat_heights(seed):
+    """Faces of every slope, flat ones at a few heights (some just off flat), degenerate
+    ones (repeated corners, a NaN vertex): walkable_faces and flat_heights alike."""
+    from tanktool.geometry.heightfield import flat_heights, walkable_faces
+
+    rng = np.random.default_rng(seed)
+    n = 3000
+    V = rng.normal(0, 5, (3 * n, 3))
+    flat = rng.random(n) < 0.4
+    for k in range(3):  # flat faces: three corners at one of a few heights, a hair off for some
+        V[3 * np.flatnonzero(flat) + k, 1] = rng.choice([0.0, 1.25, 4.0], flat.sum()) + rng.normal(0, 1e-4) * (k == 2)
+    V[7] = np.nan
+    F = np.arange(3 * n).reshape(n, 3)
+    F[5] = [4, 4, 9]  # a repeated corner: no normal
+    for slope in (30.0, 45.0, 89.0):
+        with use_kernels(True):
+            a = walkable_faces(V, F, slope)
+        with use_kernels(False):
+            b = walkable_faces(V, F, slope)
+        assert all(np.array_equal(x, y) for x, y in zip(a, b)) and a[0].any() and not a[0].all()
+    with use_kernels(True):
+        a = flat_heights(V, F), flat_heights(V, F, 0.9)
+    with use_kernels(False):
+        b = flat_heights(V, F), flat_heights(V, F, 0.9)
+    for x, y in zip(a, b):
+        assert np.array_equal(x[0], y[0]) and np.array_equal(x[1], y[1]) and len(x[0]) >= 3

@@ -37,7 +37,7 @@ import numpy as np
 
 from ..errors import ArenaError
 from .kernels import active
-from .raster_merge import raster_merge
+from . import triangle_passes
 from .span_filters import OPEN, _next_in_column, column_starts, filter_spans, neighbour_columns  # noqa: F401
 
 #: refuse heightfields larger than this (columns) or spans beyond this many cells high
@@ -139,12 +139,16 @@ def flat_heights(vertices: np.ndarray, faces: np.ndarray, flat_ny: float = 0.999
     (cluster height, cluster area) sorted by height."""
     from .walls import _upward_faces, triangle_mesh
 
+    from .walls import UP_NORMAL_MIN
+
     vertices, faces = triangle_mesh(vertices, faces)
-    hs, areas = [], []
+    kern = active()
+    got = triangle_passes.flat_faces(kern, vertices, faces, UP_NORMAL_MIN ** 2, flat_ny) if kern is not None else None
+    hs, areas = ([got[0]], [got[1]]) if got is not None else ([], [])
     # a block of faces at a time: _upward_faces and the normals take ~190 bytes a face
     # of temporaries (~0.4 GB on 2 million faces), and every value is the face's own
     # (the same heights and areas, in the same order)
-    for b in range(0, len(faces), FACE_BLOCK):
+    for b in range(0, len(faces) if got is None else 0, FACE_BLOCK):
         fb = faces[b:b + FACE_BLOCK]
         up, height, area, _ = _upward_faces(vertices, fb)
         if len(up) == 0:
@@ -169,6 +173,11 @@ def flat_heights(vertices: np.ndarray, faces: np.ndarray, flat_ny: float = 0.999
 def walkable_faces(vertices: np.ndarray, faces: np.ndarray, max_slope_deg: float) -> tuple[np.ndarray, np.ndarray]:
     """(walkable, flat) per face: the normal's y within the slope of +y (Recast's
     rcMarkWalkableTriangles: n_y > cos(slope)), and within FLAT_NY of +y."""
+    kern = active()
+    if kern is not None and np.asarray(vertices).dtype == np.float64:  # one pass (geometry/triangle_passes.py)
+        got = triangle_passes.walkable_faces(kern, vertices, faces, math.cos(math.radians(max_slope_deg)), FLAT_NY)
+        if got is not None:
+            return got
     X, Y, Z = (np.ascontiguousarray(vertices[:, k], dtype=np.float64) for k in range(3))
     f0, f1, f2 = (np.ascontiguousarray(faces[:, k]) for k in range(3))
     e1x, e1y, e1z = X[f1] - X[f0], Y[f1] - Y[f0], Z[f1] - Z[f0]
@@ -488,8 +497,8 @@ def rasterize(vertices: np.ndarray, faces: np.ndarray, cs: float, ch: float, wal
     # (a zero-area triangle, n = 0, is not gentle: its plane would divide 0 by 0)
     gentle = (n_y != 0) & (np.abs(n_y) >= GENTLE_NY * np.sqrt((n_x * cs) ** 2 + (n_z * cs) ** 2 + n_y * n_y))
     kern = active()
-    if kern is not None:  # every triangle's pieces, merged, in one call (geometry/raster_merge.py)
-        return raster_merge(kern, X, Z, Y, (n_x, n_z, n_y), gentle, walkable, flat, shape, ch, rows,
+    if kern is not None:  # every triangle's pieces, merged, in one call (geometry/triangle_passes.py)
+        return triangle_passes.raster_merge(kern, X, Z, Y, (n_x, n_z, n_y), gentle, walkable, flat, shape, ch, rows,
                             (merge_steps, MAX_HEIGHT_STEPS))
     out = []
     for group in (np.flatnonzero(gentle), np.flatnonzero(~gentle)):
