@@ -1,6 +1,6 @@
 """The top of a ramp onto a deck over walkable ground, lifted to the deck's level.
 
-:func:`tanktool.nav.walkable.stack_levels` gives a span the level of the spans below
+:func:`tanktool.nav.level_stack.stack_levels` gives a span the level of the spans below
 it in its column, then of most of its neighbours.  A ramp coming up to a deck that
 stands on pillars over walkable ground (tools/make_levels.py's stacked_floors and
 two_storeys) is then on the ground's level up to its top, where it ends beside the
