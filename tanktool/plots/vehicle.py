@@ -90,12 +90,17 @@ def _level_panel(ax, tree, lev: int, axes: tuple[int, int], label: str) -> None:
     ax.set_title(f"level {lev}: {len(idx)} sphere{'s' if len(idx) != 1 else ''} — {label}", fontsize=9)
 
 
+#: the picture's layout in inches: panel width, the margins around and between panels
+PANEL_W, LEFT, GAP_X, RIGHT, TITLE, TICKS, BOTTOM, SUPTITLE = 3.6, 0.6, 0.45, 0.15, 0.3, 0.25, 0.5, 0.45
+DPI = 100
+
+
 def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: str = "") -> None:
     """Write the preview PNG for a vehicle-frame ``mesh`` with its hull and sphere tree."""
     import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     from ..formats.bundle import atomic_write_bytes
 
@@ -114,23 +119,29 @@ def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: s
     pad = 0.05 * float((hi - lo).max())
     lo, hi = lo - pad, hi + pad
     width_x, width_z, height_y = hi[0] - lo[0], hi[2] - lo[2], hi[1] - lo[1]
-    panel_w = 3.6
-    fig, axs = plt.subplots(
-        2, ncol, figsize=(panel_w * ncol, panel_w * (width_z + height_y) / width_x + 1.2),
-        gridspec_kw={"height_ratios": [width_z, height_y]}, squeeze=False,
-    )
+    # laid out by hand: each panel as tall as its view at the panel's width (no
+    # tight_layout, which draws the whole figure once more to measure it)
+    rows_h = [PANEL_W * width_z / width_x, PANEL_W * height_y / width_x]
+    fig_w = LEFT + ncol * PANEL_W + (ncol - 1) * GAP_X + RIGHT
+    top = SUPTITLE if title else 0.1
+    fig_h = top + 2 * TITLE + rows_h[0] + TICKS + rows_h[1] + BOTTOM
+    fig = Figure(figsize=(fig_w, fig_h), dpi=DPI)
+    bottoms = [fig_h - top - TITLE - rows_h[0], BOTTOM]
+    axs = np.array([[fig.add_axes(((LEFT + c * (PANEL_W + GAP_X)) / fig_w, bottoms[r] / fig_h, PANEL_W / fig_w,
+                                   rows_h[r] / fig_h)) for c in range(ncol)] for r in range(2)])
     views = [((0, 2), 1, True, "top (from +y)", "z (m, right side down)"),
              ((0, 1), 2, True, "side (from the right, +z)", "y (m)")]
     for row, (axes, depth, toward, label, ylabel) in enumerate(views):
         xlim = (lo[axes[0]], hi[axes[0]])
         # top view: z grows downwards (looking down from +y); side view: y up
         ylim = (hi[2], lo[2]) if row == 0 else (lo[1], hi[1])
-        image = _render_view(v, f, colours, axes, depth, xlim, ylim, width_px=720)
+        # at the panels' own resolution, so drawing it is a copy, not a filtered resampling
+        image = _render_view(v, f, colours, axes, depth, xlim, ylim, width_px=int(round(PANEL_W * DPI)))
         for col in range(ncol):
             ax = axs[row, col]
             # extent is (left, right, bottom, top) in data units, matching ylim's order
             ax.imshow(image, extent=(xlim[0], xlim[1], ylim[0], ylim[1]), origin="upper",
-                      interpolation="antialiased", zorder=1)
+                      interpolation="nearest", zorder=1)
             ax.set_aspect("equal")
             ax.set_xlim(*xlim)
             ax.set_ylim(*ylim)
@@ -145,12 +156,10 @@ def plot_vehicle(path: str | os.PathLike, mesh, hull: np.ndarray, tree, title: s
             else:
                 _level_panel(ax, tree, col, axes, label)
     if title:
-        fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
+        fig.suptitle(title, fontsize=11, y=1 - 0.12 / fig_h, va="top")
     import io
 
     buf = io.BytesIO()
     # no timestamps in the PNG so that rebuilding gives the same bytes
-    fig.savefig(buf, format="png", dpi=100, metadata={"Software": None})
-    plt.close(fig)
+    fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
     atomic_write_bytes(path, buf.getvalue())
