@@ -9,7 +9,8 @@
   40 degrees, its gun on the sky;
 * fighting with the gun loaded and no shot fired for ``combat.QUIET`` s, it closes in
   along the A* way to the enemy (two tanks at 40 m on different heights, neither shot
-  carrying, stared at each other for 100 s: a 0-0 draw);
+  carrying, stared at each other for 100 s: a 0-0 draw); an enemy lost and seen again
+  within ``combat.REGAIN`` s does not start that count again;
 * pitched or rolled more than ``agent.WEDGED`` (up on a rock, not on a slope), it
   does not drive "up the slope" into the rock but leaves it to the pilot's unstick.
 """
@@ -25,7 +26,7 @@ from bot_helpers import view_of
 from tanktool.bots import BotDriver
 from tanktool.sim.agents import Agent
 from tanktool.sim.agents.agent import GRADE, WEDGED
-from tanktool.sim.agents.combat import QUIET
+from tanktool.sim.agents.combat import QUIET, REGAIN, Attack
 from tanktool.sim.agents.navigation import agent_grid
 from tanktool.sim.match import load_match_arena, load_tank_spec
 from tanktool.sim.rules import GRAVITY
@@ -131,6 +132,23 @@ def test_a_quiet_fight_closes_in_along_the_way(bridge):
     assert seen_attack and t.shots == 0
     assert low > 4.5                                    # never down the ramp
     assert far > 35.0 and math.hypot(o.x - t.x, o.z - t.z) < 20.0
+
+
+def test_a_fight_regained_soon_keeps_its_quiet_count():
+    """An enemy strafing in and out of sight over a crest: the time without a shot
+    counts on through a loss of sight shorter than REGAIN s, and starts again after a
+    longer one (it had reset at every loss, and the agent stared for 50 s unfired)."""
+    from types import SimpleNamespace
+
+    a = Attack()
+    a.enter(None, SimpleNamespace(t=10.0), None, None)
+    assert a.quiet_since == 10.0
+    a.exit(None, SimpleNamespace(t=14.0))
+    a.enter(None, SimpleNamespace(t=14.0 + 0.5 * REGAIN), None, None)
+    assert a.quiet_since == 10.0
+    a.exit(None, SimpleNamespace(t=20.0))
+    a.enter(None, SimpleNamespace(t=20.0 + 2.0 * REGAIN), None, None)
+    assert a.quiet_since == 20.0 + 2.0 * REGAIN
 
 
 def test_at_the_top_of_a_ramp_too_steep_it_drives_up_first(bridge):

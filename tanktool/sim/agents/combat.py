@@ -76,6 +76,13 @@ SPOT_AGAIN = 1.0
 #: the way is planned again every CLOSE_REPLAN s
 QUIET = 6.0
 CLOSE_REPLAN = 1.0
+#: the enemy back in sight within this long [s] of losing it, the fight goes on: the
+#: time without a shot is not counted again (an enemy strafing in and out of sight
+#: over a crest reset it every few seconds, and the agent stared for 50 s unfired)
+REGAIN = 3.0
+#: ... and after CHASED times as long even with a place to shoot from that it has not
+#: fired from (an enemy moving on moves the place on: one chased for 40 s)
+CHASED = 2.0
 #: a shot on relief may pass this far over or under the enemy's body [m] (its
 #: sphere tree is rounder than the box the test assumes)
 HEIGHT_TOLERANCE = 0.25
@@ -102,11 +109,16 @@ class Attack(State["Agent"]):
         self.quiet_since = 0.0
         self.way: list[tuple[float, float]] = []
         self.way_at = -math.inf
+        self.left_at = -math.inf
+
+    def exit(self, agent: "Agent", view: "View") -> None:
+        self.left_at = view.t
 
     def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
         self.spot, self.spot_at = None, -math.inf
         self.blind_since: float | None = None     # on relief: since when no shot carries from here
-        self.quiet_since = view.t                 # since when loaded and not firing
+        if view.t - self.left_at > REGAIN:
+            self.quiet_since = view.t             # since when loaded and not firing
         self.way, self.way_at = [], -math.inf
 
     def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
@@ -128,7 +140,8 @@ class Attack(State["Agent"]):
             self.blind_since = None
         elif self.blind_since is None:
             self.blind_since = view.t
-        if spot is None and view.t - self.quiet_since > QUIET:
+        quiet = view.t - self.quiet_since
+        if spot is None and quiet > QUIET or quiet > CHASED * QUIET:
             cmd = self.close_in(agent, view, s)
             if cmd is not None:
                 return Command(cmd.advance, rotate, cmd.strafe, fire)
