@@ -174,3 +174,14 @@ def test_the_lines_of_sight_kernel_is_the_numpy_sampling(ground):
             fast = sf.visible(pts, rng_m)
         assert fast.dtype == bool and np.array_equal(fast, slow)
     assert 0 < fast.sum() < fast.size
+
+
+def test_a_navgrid_read_without_its_runs_is_the_rest_of_it():
+    from tanktool.nav.navgrid import NavGrid
+
+    path = ROOT / "arenas" / "fort" / "navgrid.npz"
+    whole, lean = NavGrid.load(path), NavGrid.load(path, runs=False)
+    assert lean.row_index is None and lean.col_total is None
+    for k in ("valid", "reachable", "height", "link"):
+        assert np.array_equal(getattr(whole, k), getattr(lean, k), equal_nan=True)
+    assert np.array_equal(whole.origin, lean.origin) and whole.cell == lean.cell and whole.shape == lean.shape

@@ -26,8 +26,10 @@ from .limits import MAX_NPZ_BYTES
 MAX_MEMBERS = 64
 
 
-def read_npz(path: str | os.PathLike, what: str = "an .npz file", limit: int = MAX_NPZ_BYTES) -> dict[str, np.ndarray]:
-    """The arrays of an ``.npz`` file by name (without the ``.npy``)."""
+def read_npz(path: str | os.PathLike, what: str = "an .npz file", limit: int = MAX_NPZ_BYTES,
+             skip: tuple[str, ...] = ()) -> dict[str, np.ndarray]:
+    """The arrays of an ``.npz`` file by name (without the ``.npy``); the members named
+    in ``skip`` are not read (a reader that needs few of a large file's arrays)."""
     from .bundle import read_input
 
     label = str(path)
@@ -47,6 +49,8 @@ def read_npz(path: str | os.PathLike, what: str = "an .npz file", limit: int = M
         name = info.filename
         if not name.endswith(".npy") or info.is_dir():
             raise FormatError(f"{label}: member {name[:60]!r} is not an array (.npy)")
+        if name[:-4] in skip:
+            continue
         try:
             with zf.open(info) as f:
                 version = np.lib.format.read_magic(f)

@@ -29,6 +29,7 @@ MAX_NODES = 25_000_000
 #: refuse grids of more levels than this
 MAX_LEVELS = 64
 _FIELDS = ("valid", "row_index", "row_total", "col_index", "col_total", "reachable")
+_RUN_FIELDS = _FIELDS[1:5]
 
 Node = tuple[int, int]
 #: the four grid directions as (di, dj): +x (east, j+1), +z (i+1), -x, -z
@@ -188,16 +189,20 @@ class NavGrid:
         return buf.getvalue()
 
     @classmethod
-    def load(cls, path: str | os.PathLike) -> "NavGrid":
-        """Read a ``navgrid.npz``; anything malformed raises FormatError naming the file."""
+    def load(cls, path: str | os.PathLike, runs: bool = True) -> "NavGrid":
+        """Read a ``navgrid.npz``; anything malformed raises FormatError naming the file.
+        ``runs=False``: without the four run arrays (None; the simulation's ground reads
+        heights and links only: 256 MB of a 2 km terrain's file not read)."""
         import zipfile
         import zlib
 
         from ..formats.npz import read_npz
 
         try:
-            z = read_npz(path, "a navgrid file")  # bounded, no pickles, a damaged zip one clear error
-            missing = [k for k in ("origin", "cell", "shape", *_FIELDS[:-1]) if k not in z]
+            skip = () if runs else _RUN_FIELDS
+            # bounded, no pickles, a damaged zip one clear error
+            z = read_npz(path, "a navgrid file", skip=skip)
+            missing = [k for k in ("origin", "cell", "shape", *_FIELDS[:-1]) if k not in z and k not in skip]
             if missing:
                 raise FormatError(f"{path}: not a navgrid file (missing {', '.join(missing)})")
             raw_shape = z["shape"]
@@ -245,7 +250,7 @@ class NavGrid:
         # grid was read twice over at once: the load's peak of a match on it)
         return cls(
             origin, cell, shape, arrays.pop("valid").astype(bool, copy=False),
-            *(arrays.pop(k).astype(np.int32, copy=False) for k in ("row_index", "row_total", "col_index", "col_total")),
+            *(arrays.pop(k).astype(np.int32, copy=False) if runs else None for k in _RUN_FIELDS),
             arrays.pop("reachable").astype(bool, copy=False),
             height=None if height is None else height.astype(np.float64, copy=False),
             link=None if link is None else link.astype(np.int8, copy=False),

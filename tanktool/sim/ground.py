@@ -50,7 +50,10 @@ class MeshIndex:
 
     def __init__(self, vertices: np.ndarray, faces: np.ndarray, bucket: float = 4.0) -> None:
         v = np.asarray(vertices, dtype=np.float64)
-        f = np.asarray(faces, dtype=np.int64)
+        # int32 corner indices and bucket lists where they fit (24 + 18 bytes a face
+        # less than int64 on a 2 km terrain's 2 M faces; the same faces, the same hits)
+        small = len(v) < 2**31 and len(faces) < 2**31
+        f = np.asarray(faces, dtype=np.int32 if small else np.int64)
         self.vertices, self.faces = v, f
         # the triangles' corners and edges are gathered per query (_edges): kept for every
         # face they took 72 bytes a face (+144 MB on a 2 km terrain), and as much again
@@ -80,7 +83,7 @@ class MeshIndex:
         key = bj.astype(np.int64) * self.width + bi
         del bi, bj
         order = np.argsort(key, kind="stable")
-        self._faces = owner[order].astype(np.int64)
+        self._faces = owner[order]   # int32 where the faces' count fits (owner's type)
         del owner, order
         self._start = np.zeros(self.width * self.height + 1, dtype=np.int64)
         np.cumsum(np.bincount(key, minlength=self.width * self.height), out=self._start[1:])
