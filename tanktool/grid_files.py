@@ -9,6 +9,7 @@ files byte for byte.
 
 from __future__ import annotations
 
+import gc
 import math
 import time
 import dataclasses
@@ -17,6 +18,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .errors import ArenaError
+from .memory import GIVE_BACK_MIN, give_back
 # the smaller vehicles' grids: formats/vehicle_grids.py reads [grids] (the simulation needs it too)
 from .formats.vehicle_grids import is_grid_file, vehicle_file, vehicle_grids  # noqa: F401
 
@@ -242,6 +244,10 @@ def _smaller_vehicles(target: Target, built: BuiltGrid, shared: dict[str, Any]) 
     if not vehicles:
         return
     surface = shared["surface"]
+    # the larger grid's levels, a byte a span: a reseed that finds them again gives a
+    # grid of the same nodes, heights and links (_layered shares them)
+    shared["levels"] = surface.level.astype(np.int8) if surface.levels < 127 else None
+    shared["grid"] = built.grid
     surface.main, surface.level = np.zeros(0, dtype=bool), np.zeros(0, dtype=surface.level.dtype)
     del surface
     for k, (name, (c, spawns)) in enumerate(vehicles):
@@ -255,13 +261,13 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
              base: Any = None) -> tuple[Any, Any, Any]:
     """The layered grid of a bundle: its model's walkable surface on the grid over the
     bounds, valid where a node keeps ``clearance`` from the walls of its level (``base``:
-    {"surface": a surface of the same model and settings, "last": ...}, reseeded when
-    it lies on the same grid; see :func:`_smaller_vehicles`).
-    Returns (grid, mask of nodes that exist, for the picture, the surface)."""
+    {"surface": a surface of the same model and settings, "last": ..., "levels", "grid"},
+    reseeded when it lies on the same grid; see :func:`_smaller_vehicles`).
+    Returns (grid, mask of nodes that exist, for the picture, the surface or None)."""
     import numpy as np
 
     from .nav.arena_levels import walls_too_close
-    from .nav.walkable import grid_from_surface, level_nodes, reseed, walkable_surface
+    from .nav.walkable import grid_from_layers, grid_from_surface, level_nodes, reseed, walkable_surface
 
     origin = np.asarray(bounds, dtype=np.float64)[0]
     seeds = None
@@ -279,6 +285,7 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
     else:
         del old
         vertices, faces = _model_triangles(target.model)
+        gc.collect()   # the scene read is cyclic garbage (~0.2 GB on a 2 km terrain) the surface would stack on
         surface = walkable_surface(vertices, faces, params, clearance, origin_xz=origin, shape=shape,
                                    seeds=seeds, lean=True)   # its grid reads the walls' distance (too_close)
         del vertices, faces
@@ -287,6 +294,17 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
                          f"headroom {params.headroom:g} m)")
     levels = max(surface.levels, 1)
     tc = walls_too_close(target.walls, origin, params.cell, shape, levels, clearance)
+    if base is not None and base.get("levels") is not None and np.array_equal(surface.level, base["levels"]):
+        # the larger grid's levels again: its nodes (a finite height), heights and links
+        # are this grid's; the surface (~0.75 GB on a 2 km terrain) goes before it is built
+        g0, cell = base["grid"], surface.hf.cs
+        del surface
+        if base.get("last"):
+            base["surface"] = None
+            give_back(GIVE_BACK_MIN)
+        nodes = np.isfinite(g0.height)
+        grid = grid_from_layers(nodes & ~tc, g0.height, g0.link, clearance, origin, cell, seeds=target.spawns)
+        return grid, (nodes[0] if grid.levels == 1 else None), None
     grid = grid_from_surface(surface, clearance, origin, seeds=target.spawns, too_close=tc)
     return grid, (level_nodes(surface) if grid.levels == 1 else None), surface
 

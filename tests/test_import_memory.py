@@ -138,3 +138,28 @@ def test_the_analysis_after_letting_go_is_the_whole_surfaces(name):
     assert np.array_equal(full.spawns, lean.spawns) and full.left_out == lean.left_out
     assert np.array_equal(full.grid.valid, lean.grid.valid) and lean.grid.row_index.size == 0
     assert full.grid.row_index.shape == full.grid.valid.shape
+
+
+def test_a_smaller_vehicles_grid_of_the_same_levels_shares_and_equals_its_own(tmp_path):
+    """The grid stage's smaller vehicle, whose reseed finds the larger grid's levels
+    again, shares that grid's heights and links (the surface let go before it is built):
+    the same grid as build-navgrid builds for it alone from the model."""
+    import dataclasses
+
+    from tanktool.grid_files import build_grid, open_target
+    from tanktool.formats.vehicle_grids import vehicle_grids
+    from tests.level_helpers import import_level
+
+    bundle = import_level(tmp_path, "fort")
+    target = open_target(bundle)
+    built = build_grid(target)
+    (name, (c, spawns)), = vehicle_grids(target.toml, target.manifest).items()
+    shared, big = built.vehicles[name].grid, built.grid
+    assert shared.height is big.height and shared.link is big.link
+    own = build_grid(dataclasses.replace(target, spawns=spawns, toml={**target.toml, "grids": {}}),
+                     cell=built.cell, clearance=c)
+    assert not own.vehicles   # built from the model, by grid_from_surface
+    alone = own.grid
+    for k in ("valid", "row_index", "row_total", "col_index", "col_total", "reachable", "height", "link"):
+        assert np.array_equal(getattr(shared, k), getattr(alone, k), equal_nan=k == "height"), k
+    assert shared.spawn_nodes == alone.spawn_nodes

@@ -27,6 +27,7 @@ import shapely
 
 from ..errors import ArenaError
 from ..fleet import Fleet
+from ..memory import give_back
 from ..geometry.spawns import SPAWN_CLEARANCE, SPAWN_COUNT, facing_centre, spawn_candidates, spread
 from .level_walls import LevelWalls, level_walls
 from .navgrid import NavGrid, on_wall_tolerance, too_close
@@ -318,6 +319,7 @@ def keep_for_analysis(surface: Surface) -> None:
                              np.zeros(int(low.sum()), dtype=bool), hf.flat[low], hf.top_walkable[low],
                              dict(hf.counts), np.ones(int(low.sum()), dtype=bool))
     surface.ceil = np.zeros(0, dtype=surface.ceil.dtype)
+    give_back(20 * len(surface.col))   # their pages lie between live arrays: the heap keeps them else
 
 
 def drop_runs(grid: NavGrid) -> NavGrid:

@@ -43,7 +43,7 @@ from ..geometry import walls as cut
 from ..geometry.wall_pairs import Repairs, pair_tolerance, repair_walls
 from ..geometry.heightfield import FACE_BLOCK, FLAT_GAP, flat_heights
 from .inner_walls import inner_walls
-from .walkable import DIRS, Surface, surface_layers
+from .walkable import BLOCK, DIRS, Surface, surface_layers
 
 #: simplification of cell outlines as Recast does: the maximum edge error (cells) and
 #: the maximum edge length (m) of :func:`tanktool.geometry.contours.simplify_contour`
@@ -352,7 +352,9 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
     # the cluster whose height the span's top rounds up from (within a cell height)
     pos = np.searchsorted(flat_h, hy + 1e-6, side="right") - 1
     okc = (pos >= 0) & (hy - flat_h[np.maximum(pos, 0)] <= c.cell_h + 1e-6)
-    fi, fj = np.nonzero(flat_cells)
+    del hy
+    fidx = np.flatnonzero(flat_cells)   # one index a flat cell where (i, j) took two
+    del flat_cells
     # the rims' cells and heights, once: per floor over the whole level they took two
     # float temporaries of 8 bytes a cell (and isin below ~25 sorting the labels)
     ri, rj = np.nonzero(cells & c.span_rim[level])
@@ -360,7 +362,7 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
     for k in np.unique(pos[okc]):
         sel = okc & (pos == k)
         mask = np.zeros_like(cells)
-        mask[fi[sel], fj[sel]] = True
+        mask.ravel()[fidx[sel]] = True
         # small patches (stair treads, bumps) keep the cells' outline
         lab, nlab = ndimage.label(mask)
         big = np.bincount(lab.ravel(), minlength=nlab + 1)[1:] * cell * cell >= MIN_EXACT_AREA
@@ -453,6 +455,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
     c = _prepare(surface, vertices, faces, cut_height, headroom, climb_m, tolerance, max_slope, edge_error,
                  edge_max_len, smooth_margin)
     L, nz, nx = c.exists.shape
+    give_back(40 * c.exists.size)   # _prepare's temporaries, before the regions' masks
     origin, cell = c.origin, c.cell
     out_seg, out_lev, out_reg = [], [], []
     regions: list[RegionWalls] = []
@@ -519,12 +522,22 @@ def _same_level_links(surface: Surface, span_of: np.ndarray, exists: np.ndarray)
     level.  Each span's four linked levels are looked up once as a small table (int8
     while the levels fit, -1 for none) and gathered per node in one pass: four gathers
     of int64 span links per node took a third of the walls' time on a 2 km terrain."""
-    L = exists.shape[0]
+    L, nz, nx = exists.shape
     small = np.int8 if L < 127 else np.int32
-    lv = np.append(surface.level, -1).astype(small)
+    lv = np.empty(len(surface.level) + 1, dtype=small)   # not np.append's copy of the levels as they are
+    lv[:-1] = surface.level
+    lv[-1] = -1
     linked = lv[surface.link]  # (n, 4); a missing link (-1) reads the appended -1
+    del lv
     lev = np.arange(L, dtype=small)[:, None, None, None]
-    return (linked[np.maximum(span_of, 0)] == lev) & exists[..., None]
+    # a block of rows at a time: the whole grid's gathered levels, compare and mask
+    # were four temporaries of 4 bytes a node (~0.25 GB on a 2 km terrain, the walls' peak)
+    out = np.empty((L, nz, nx, 4), dtype=bool)
+    rows = max(1, BLOCK // max(L * nx, 1))
+    for a in range(0, nz, rows):
+        sp = span_of[:, a:a + rows]
+        out[:, a:a + rows] = (linked[np.maximum(sp, 0)] == lev) & exists[:, a:a + rows][..., None]
+    return out
 
 
 def surface_link_level(surface: Surface, span_of: np.ndarray, d: int) -> np.ndarray:

@@ -526,8 +526,6 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
     least ``clearance``.  ``seeds`` (k, 2+) spawn points
     ``[x, z, ...]`` mark the reachable nodes (all valid nodes when None).
     """
-    from .navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3
-
     exists, height, clear, span = surface_layers(surface, clearance=too_close is None)
     if too_close is None:
         valid = exists & (clear >= clearance)
@@ -539,9 +537,19 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
     # and heights are kept for every node of the surface, valid (a tank fits) or not:
     # the simulation drives on all of it; runs, reachability and paths use valid nodes.
     link = _grid_links(surface, exists, span).reshape(L, nz, nx, 4)
-    del span
+    del span, exists
+    return grid_from_layers(valid, height, link, clearance, origin_xz, surface.hf.cs, seeds)
+
+
+def grid_from_layers(valid: np.ndarray, height: np.ndarray, link: np.ndarray, clearance: float,
+                     origin_xz: np.ndarray, cell: float, seeds: np.ndarray | None = None):
+    """The layered grid of its nodes' layers (:func:`grid_from_surface`'s valid,
+    heights and links, kept as they are): runs and the nodes reachable from ``seeds``.
+    Two vehicles' grids of one surface with the same levels share heights and links."""
+    from .navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3
+
+    L, nz, nx = valid.shape
     ri, rt, ci, ct = layered_runs(valid, link)
-    cell = surface.hf.cs
     seeds_n: list = []
     if seeds is not None and len(seeds):
         reach = int(math.ceil(clearance / cell)) + 2
