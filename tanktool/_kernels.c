@@ -374,11 +374,29 @@ static inline int32_t grid_relax(const int8_t *K, const uint8_t *E, const int32_
     return v;
 }
 
+/* the nodes whose relaxation reads node s (lv, i, j): the 3 x 3 cells around it on
+ * every level, marked dirty */
+static inline void mark_around(uint8_t *dirty, const uint8_t *E, i64 L, i64 per, i64 nz, i64 nx, i64 i, i64 j) {
+    for (i64 lv = 0; lv < L; ++lv)
+        for (i64 a = i - 1; a <= i + 1; ++a) {
+            if (a < 0 || a >= nz) continue;
+            for (i64 b = j - 1; b <= j + 1; ++b) {
+                if (b < 0 || b >= nx) continue;
+                const i64 t = lv * per + a * nx + b;
+                if (E[t]) dirty[t] = 1;
+            }
+        }
+}
+
 /* layers.surface_clearance on the ground's own arrays: the chamfer distance of
  * chamfer() over the graph its compact (n, 4) table describes, without that table
  * (16 bytes a node, and its int64 temporaries: +556 MB on a 1 km terrain).  The
  * fixed point is unique, so the values are chamfer()'s.  dist: int32 (L, nz, nx),
- * written (0 where no node). */
+ * written (0 where no node).  Only dirty nodes are relaxed: those around a node below
+ * the limit at the start (an edge) or lowered since (a node's relaxation reads the
+ * 3 x 3 cells around it; one with all of them at the limit stays there): on a terrain
+ * about 1 % of the nodes come below the limit, and the sweeps over every node took
+ * 3.8 s on 2 km. */
 static PyObject *chamfer_grid(PyObject *self, PyObject *args) {
     Py_buffer link, exists, dist;
     Py_ssize_t L, nz, nx;
@@ -386,7 +404,13 @@ static PyObject *chamfer_grid(PyObject *self, PyObject *args) {
     if (!PyArg_ParseTuple(args, "y*y*w*nnni", &link, &exists, &dist, &L, &nz, &nx, &limit)) return NULL;
     const i64 per = (i64)nz * nx, n = (i64)L * per;
     PyObject *ret = NULL;
+    uint8_t *dirty = NULL;
     if (!need(&link, 4 * n, 1, "link") || !need(&exists, n, 1, "exists") || !need(&dist, n, 4, "dist")) goto done;
+    dirty = calloc(n > 0 ? n : 1, 1);
+    if (dirty == NULL) {
+        PyErr_NoMemory();
+        goto done;
+    }
     {
         const int8_t *K = link.buf;
         const uint8_t *E = exists.buf;
@@ -400,8 +424,10 @@ static PyObject *chamfer_grid(PyObject *self, PyObject *args) {
             for (int d = 0; d < 4; ++d)
                 if (grid_nb(K, E, s, i, j, d, per, nz, nx) < 0) { D[s] = 1; break; }
         }
+        for (i64 s = 0; s < n; ++s)
+            if (E[s] && D[s] < limit) mark_around(dirty, E, L, per, nz, nx, (s % per) / nx, s % nx);
         int changed = 1;
-        while (changed) {   /* forward and back sweeps, as chamfer() */
+        while (changed) {   /* forward and back sweeps, as chamfer(), over the dirty nodes */
             changed = 0;
             for (int back = 0; back < 2; ++back)
                 for (i64 lv = 0; lv < L; ++lv)
@@ -409,9 +435,15 @@ static PyObject *chamfer_grid(PyObject *self, PyObject *args) {
                         for (i64 jj = 0; jj < nx; ++jj) {
                             const i64 l = back ? L - 1 - lv : lv, r = back ? nz - 1 - i : i;
                             const i64 j = back ? nx - 1 - jj : jj, s = l * per + r * nx + j;
+                            if (!dirty[s]) continue;
+                            dirty[s] = 0;
                             if (!E[s] || D[s] <= 1) continue;   /* 1: on the edge, no lower */
                             const int32_t v = grid_relax(K, E, D, s, r, j, per, nz, nx, D[s]);
-                            if (v < D[s]) { D[s] = v; changed = 1; }
+                            if (v < D[s]) {
+                                D[s] = v;
+                                changed = 1;
+                                mark_around(dirty, E, L, per, nz, nx, r, j);
+                            }
                         }
         }
         Py_END_ALLOW_THREADS
@@ -419,6 +451,7 @@ static PyObject *chamfer_grid(PyObject *self, PyObject *args) {
     ret = Py_None;
     Py_INCREF(ret);
 done:
+    free(dirty);
     PyBuffer_Release(&link);
     PyBuffer_Release(&exists);
     PyBuffer_Release(&dist);
