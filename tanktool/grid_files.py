@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .errors import ArenaError
-from .memory import GIVE_BACK_MIN, give_back
+from .memory import GIVE_BACK_MIN, frozen_heap, give_back
 # the smaller vehicles' grids: formats/vehicle_grids.py reads [grids] (the simulation needs it too)
 from .formats.vehicle_grids import is_grid_file, vehicle_file, vehicle_grids  # noqa: F401
 
@@ -163,6 +163,7 @@ def settings(target: Target, cell: float | None, quadtree_depth: int | None) -> 
     return float(cell), int(quadtree_depth)
 
 
+@frozen_heap
 def build_grid(target: Target, cell: float | None = None, clearance: float | None = None,
                max_slope: float | None = None, climb: float | None = None, headroom: float | None = None,
                quadtree_depth: int | None = None, warn: Callable[[str], None] | None = None,

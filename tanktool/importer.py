@@ -25,7 +25,7 @@ from .arena import MANIFEST, MIN_SPAWNS, NAVGRID_DEFAULTS, walkable_params
 from .errors import ArenaError
 from .formats.limits import MAX_COORDINATE, check_cells
 from .formats.walls_txt import WallList
-from .memory import GIVE_BACK_MIN, give_back
+from .memory import GIVE_BACK_MIN, frozen_heap, give_back
 
 
 # ---------------------------------------------------------------------------
@@ -71,6 +71,7 @@ def _beside(f: Path, model: Path) -> str:
         return f.name
 
 
+@frozen_heap
 def import_arena(
     model: str | os.PathLike,
     out: str | os.PathLike | None = None,

@@ -13,6 +13,11 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import functools
+import gc
+from typing import Any, Callable, TypeVar
+
+T = TypeVar("T")
 
 #: glibc's mallopt parameters
 M_TRIM_THRESHOLD = -1
@@ -66,3 +71,24 @@ def give_back(nbytes: int) -> bool:
         return False
     _trim(0)
     return True
+
+
+def frozen_heap(fn: Callable[..., T]) -> Callable[..., T]:
+    """``fn`` with the objects alive before it frozen (gc.freeze) while it runs: a full
+    collection (the import's, after the scene read and the preview's figure) then scans
+    only what the build made, not the ~120,000 objects of the modules loaded before it
+    (matplotlib, scipy, trimesh, shapely: ~85 ms a collection on hix's import).  What
+    was garbage before the call is collected after it.  Nothing is done when the caller
+    froze objects itself (unfreezing would undo its freeze) or in a nested call."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> T:
+        if gc.get_freeze_count():
+            return fn(*args, **kwargs)
+        gc.freeze()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            gc.unfreeze()
+
+    return wrapper

@@ -359,7 +359,11 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
     # float temporaries of 8 bytes a cell (and isin below ~25 sorting the labels)
     ri, rj = np.nonzero(cells & c.span_rim[level])
     rh = c.height[level][ri, rj]
-    for k in np.unique(pos[okc]):
+    # the floors present, sorted: np.unique(pos[okc]) without sorting a value a flat cell
+    # (the floors are few; on hix ~0.1 s of sorting twice over)
+    floors = np.flatnonzero(np.bincount(pos[okc], minlength=len(flat_h)))
+    present = flat_h[floors]
+    for k in floors:
         sel = okc & (pos == k)
         mask = np.zeros_like(cells)
         mask.ravel()[fidx[sel]] = True
@@ -372,7 +376,6 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
         table[1:] = big
         mask = table[lab]
         del lab
-        present = flat_h[np.unique(pos[okc])]
         base = float(present[present >= flat_h[k] - c.climb_m - 1e-9].min())
         # the rims of steep obstacles standing on this floor (walkable only
         # because they rise less than the climb) belong to it too
