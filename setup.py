@@ -29,7 +29,8 @@ setup(
     # -ffp-contract=off: no fused multiply-adds, the rasteriser's sums are numpy's
     ext_modules=[Extension("tanktool._kernels", ["tanktool/_kernels.c", "tanktool/_kernels_raster.c",
                                                       "tanktool/_kernels_grid.c", "tanktool/_kernels_surface.c",
-                                                      "tanktool/_kernels_ground.c", "tanktool/_kernels_faces.c"],
+                                                      "tanktool/_kernels_ground.c", "tanktool/_kernels_faces.c",
+                                                      "tanktool/_kernels_path.c"],
                            depends=["tanktool/_kernels.h"], extra_compile_args=["-O2", "-ffp-contract=off"],
                            optional=True)],
     cmdclass={"build_ext": OptionalBuildExt},

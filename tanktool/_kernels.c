@@ -45,6 +45,7 @@
  *       i0, j0, i1, j1), grid_walk(link, ok, rows, cols, out, L, nz, nx, k), grade_cut(link, heights,
  *       L, NZ, NX, most), solid_visible(solid, points, out, nz, nx, ny, ox, oz, y0, cs, ch, margin,
  *       step, max_range)   (_kernels_ground.c)
+ *   astar_layered(valid, link, L, nz, nx, start, goal) -> [flat node, ...]   (_kernels_path.c)
  *
  * Built with -ffp-contract=off: no fused multiply-adds, so the floating-point results
  * are those of numpy's one operation at a time.
@@ -483,6 +484,7 @@ static PyMethodDef methods[] = {
     {"grid_walk", tanktool_grid_walk, METH_VARARGS, "layers._walked: the agents' coarse links (_kernels_ground.c)"},
     {"grade_cut", tanktool_grade_cut, METH_VARARGS, "layers._cut_grade in place (_kernels_ground.c)"},
     {"solid_visible", tanktool_solid_visible, METH_VARARGS, "SolidField.visible's lines of sight (_kernels_ground.c)"},
+    {"astar_layered", tanktool_astar_layered, METH_VARARGS, "nav.path.astar_layered's search (_kernels_path.c)"},
     {NULL, NULL, 0, NULL},
 };
 

@@ -72,4 +72,7 @@ PyObject *tanktool_grid_walk(PyObject *self, PyObject *args);
 PyObject *tanktool_grade_cut(PyObject *self, PyObject *args);
 PyObject *tanktool_solid_visible(PyObject *self, PyObject *args);
 
+/* the agents' paths (_kernels_path.c) */
+PyObject *tanktool_astar_layered(PyObject *self, PyObject *args);
+
 #endif

@@ -185,3 +185,22 @@ def test_a_navgrid_read_without_its_runs_is_the_rest_of_it():
     for k in ("valid", "reachable", "height", "link"):
         assert np.array_equal(getattr(whole, k), getattr(lean, k), equal_nan=True)
     assert np.array_equal(whole.origin, lean.origin) and whole.cell == lean.cell and whole.shape == lean.shape
+
+
+@pytest.mark.skipif(not __import__("tanktool.geometry.kernels", fromlist=["x"]).available(),
+                    reason="compiled kernels not built")
+def test_the_path_kernel_finds_the_python_paths(ground):
+    from tanktool.geometry.kernels import use_kernels
+    from tanktool.nav.path import astar_layered
+
+    g, spawns = ground
+    lay = ground_agent_grid(g, 1.0, 1.9, spawns, grade=0.45).layers
+    rng = np.random.default_rng(2)
+    nodes = [tuple(map(int, n)) for n in np.argwhere(lay.valid)]
+    pairs = [(nodes[a], nodes[b]) for a, b in rng.integers(0, len(nodes), (40, 2))] + [(nodes[0], nodes[0])]
+    with use_kernels(False):
+        slow = [astar_layered(lay, s, e) for s, e in pairs]
+    with use_kernels(True):
+        fast = [astar_layered(lay, s, e) for s, e in pairs]
+    assert fast == slow and fast[-1] == [nodes[0]]
+    assert all(type(v) is int for p in fast for n in p for v in n) and sum(len(p) > 2 for p in fast) > 20

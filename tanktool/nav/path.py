@@ -315,6 +315,24 @@ def _move_table(grid: NavGrid) -> tuple[Any, list[float]]:
     return cached
 
 
+def _path_kernel():
+    """The compiled kernels when built, in use and holding ``astar_layered``, else None."""
+    from ..geometry.kernels import active
+
+    kern = active()
+    return kern if getattr(kern, "astar_layered", None) is not None else None
+
+
+def _kernel_arrays(grid: NavGrid) -> tuple[np.ndarray, np.ndarray]:
+    """(valid as bytes, links as int8), C-ordered, kept on the grid (not changed once built)."""
+    cached = grid.__dict__.get("_kernel_arrays")
+    if cached is None:
+        cached = grid.__dict__["_kernel_arrays"] = (
+            np.ascontiguousarray(grid.valid, dtype=bool).view(np.uint8),
+            np.ascontiguousarray(grid.links(), dtype=np.int8))
+    return cached
+
+
 def astar_layered(grid: NavGrid, start: Node3, goal: Node3) -> list[Node3]:
     """Shortest path of valid nodes ``(level, i, j)`` across levels (ramps, steps,
     decks), 8-connected along the grid's links; ``[]`` when there is none.  The octile
@@ -327,8 +345,13 @@ def astar_layered(grid: NavGrid, start: Node3, goal: Node3) -> list[Node3]:
             raise ValueError(f"node {n} is outside the {L} x {nz} x {nx} grid")
     if not (valid[start] and valid[goal]):
         return []
-    table, cost = _move_table(grid)
     per = nz * nx
+    kern = _path_kernel()
+    if kern is not None:   # the same search in C (_kernels_path.c): 16 ms a path on 2 km in Python
+        flat = kern.astar_layered(*_kernel_arrays(grid), L, nz, nx, start[0] * per + start[1] * nx + start[2],
+                                  goal[0] * per + goal[1] * nx + goal[2])
+        return [(v // per, (v % per) // nx, v % nx) for v in flat]
+    table, cost = _move_table(grid)
     s = start[0] * per + start[1] * nx + start[2]
     g = goal[0] * per + goal[1] * nx + goal[2]
     gi, gj = goal[1], goal[2]
