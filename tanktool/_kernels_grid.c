@@ -44,20 +44,26 @@ PyObject *tanktool_grid_labels(PyObject *self, PyObject *args) {
         const i64 per = nz * nx;
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t s = 0; s < n; ++s) P[s] = (int32_t)s;
-        for (Py_ssize_t s = 0; s < n; ++s) {
-            if (!V[s]) continue;
-            const i64 ij = s % per, i = ij / nx, j = ij % nx;
-            for (int d = 0; d < 4; ++d) {
-                const int tl = K[4 * s + d];
-                const i64 ii = i + GDI[d], jj = j + GDJ[d];
-                if (tl < 0 || tl >= L || ii < 0 || ii >= nz || jj < 0 || jj >= nx) continue;
-                const i64 t = tl * per + ii * nx + jj;
-                if (!V[t]) continue;
-                int32_t a = root32(P, (int32_t)s), b = root32(P, (int32_t)t);
-                if (a == b) continue;
-                if (a < b) P[b] = a; else P[a] = b;  /* a root is its set's first node */
-            }
-        }
+        /* the node's (l, i, j) by the loops, not by three divisions a node; its root
+           found once and kept while its steps join it to others (any order of the
+           unions gives the same sets, so the same labels): hix 44 -> 30 ms a call */
+        for (i64 l = 0, s = 0; l < L; ++l)
+            for (i64 i = 0; i < nz; ++i)
+                for (i64 j = 0; j < nx; ++j, ++s) {
+                    if (!V[s]) continue;
+                    int32_t a = -1;
+                    for (int d = 0; d < 4; ++d) {
+                        const int tl = K[4 * s + d];
+                        const i64 ii = i + GDI[d], jj = j + GDJ[d];
+                        if (tl < 0 || tl >= L || ii < 0 || ii >= nz || jj < 0 || jj >= nx) continue;
+                        const i64 t = tl * per + ii * nx + jj;
+                        if (!V[t]) continue;
+                        if (a < 0) a = root32(P, (int32_t)s);
+                        const int32_t b = root32(P, (int32_t)t);
+                        if (a == b) continue;
+                        if (a < b) P[b] = a; else { P[a] = b; a = b; }  /* a root is its set's first node */
+                    }
+                }
         /* in node order (a parent always comes before its child: a root is its set's
            first node, and path halving only moves a parent earlier): a root takes the
            next label, any other node its parent's, which is labelled already; kept
@@ -151,6 +157,29 @@ static void runs_line(const uint8_t *V, const int8_t *K, i64 first, i64 step, i6
     }
 }
 
+/* the column runs of level l (along +z, d = 1), as runs_line gives them column by
+ * column, but row by row: a column's nodes are nx apart, and walking them one column at
+ * a time touched a new cache line at every node (hix's 1604 x 1604 grid: 52 -> 12 ms of CPU
+ * a call).  Down the rows, a node's place is one more than the node's below when that
+ * one continues into it; back up the rows, a run's length comes down from its last node. */
+static void cols_rowwise(const uint8_t *V, const int8_t *K, i64 base, i64 nz, i64 nx, int l, int32_t *index,
+                         int32_t *total) {
+    for (i64 i = 0; i < nz; ++i) {
+        const i64 row = base + i * nx;
+        for (i64 j = 0; j < nx; ++j) {
+            const i64 a = row + j, b = a - nx;
+            index[a] = !V[a] ? 0 : (i > 0 && V[b] && K[4 * b + 1] == l) ? index[b] + 1 : 1;
+        }
+    }
+    for (i64 i = nz - 1; i >= 0; --i) {
+        const i64 row = base + i * nx;
+        for (i64 j = 0; j < nx; ++j) {
+            const i64 a = row + j, c = a + nx;
+            total[a] = !V[a] ? 0 : (i + 1 < nz && V[c] && K[4 * a + 1] == l) ? total[c] : index[a];
+        }
+    }
+}
+
 /* navgrid.layered_runs: grid_runs(valid bool (L, nz, nx), link int8 (L, nz, nx, 4), L, nz,
  * nx, row_index, row_total, col_index, col_total int32 (L, nz, nx)) */
 PyObject *tanktool_grid_runs(PyObject *self, PyObject *args) {
@@ -174,8 +203,7 @@ PyObject *tanktool_grid_runs(PyObject *self, PyObject *args) {
             const i64 base = l * nz * nx;
             for (i64 i = 0; i < nz; ++i)
                 runs_line(V, K, base + i * nx, 1, nx, 0, (int)l, ri.buf, rt.buf);
-            for (i64 j = 0; j < nx; ++j)
-                runs_line(V, K, base + j, nx, nz, 1, (int)l, ci.buf, ct.buf);
+            cols_rowwise(V, K, base, nz, nx, (int)l, ci.buf, ct.buf);
         }
         Py_END_ALLOW_THREADS
     }
