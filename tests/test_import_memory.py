@@ -163,3 +163,31 @@ def test_a_smaller_vehicles_grid_of_the_same_levels_shares_and_equals_its_own(tm
     for k in ("valid", "row_index", "row_total", "col_index", "col_total", "reachable", "height", "link"):
         assert np.array_equal(getattr(shared, k), getattr(alone, k), equal_nan=k == "height"), k
     assert shared.spawn_nodes == alone.spawn_nodes
+
+
+def test_label_sizes_in_blocks_are_bincounts(monkeypatch):
+    from tanktool.nav import level_walls
+
+    rng = np.random.default_rng(3)
+    lab = rng.integers(0, 50, size=(37, 41)).astype(np.int32)
+    monkeypatch.setattr(level_walls, "BLOCK", 97)   # blocks that do not divide the cells
+    got = level_walls._label_sizes(lab, 60)
+    assert np.array_equal(got, np.bincount(lab.ravel(), minlength=61))
+
+
+@pytest.mark.parametrize("name", ["two_storeys", "fort"])
+def test_walls_in_small_blocks_are_the_walls(monkeypatch, name):
+    """level_walls' blocked passes (_same_level_links' rows, _exact_floors' flat cells,
+    _label_sizes) with blocks far smaller than the level: the same walls."""
+    from tanktool.nav import level_walls as lw
+    from tanktool.nav.walkable import walkable_surface
+    from tests.test_walkable import PARAMS, TANK, mesh_of
+
+    V, F = mesh_of(name)
+    s = walkable_surface(V, F, PARAMS, TANK.radius)
+    args = (V, F, 1.0, PARAMS.headroom, PARAMS.climb, 0.01, PARAMS.max_slope)
+    want = lw.level_walls(s, *args)
+    monkeypatch.setattr(lw, "BLOCK", 61)
+    got = lw.level_walls(s, *args)
+    assert np.array_equal(got.walls.segments, want.walls.segments)
+    assert [r.flat_heights for r in got.regions] == [r.flat_heights for r in want.regions]

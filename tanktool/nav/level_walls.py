@@ -348,28 +348,33 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
     if not (flat_cells.any() and len(c.flat_h)):
         return fl
     flat_h, cell = c.flat_h, c.cell
-    hy = c.height[level][flat_cells]
-    # the cluster whose height the span's top rounds up from (within a cell height)
-    pos = np.searchsorted(flat_h, hy + 1e-6, side="right") - 1
-    okc = (pos >= 0) & (hy - flat_h[np.maximum(pos, 0)] <= c.cell_h + 1e-6)
-    del hy
-    fidx = np.flatnonzero(flat_cells)   # one index a flat cell where (i, j) took two
+    # each flat cell as one int32 index, and the cluster whose height its span's top
+    # rounds up from (within a cell height; -1: none), a block of cells at a time: the
+    # heights, indices and their temporaries took ~60 bytes a flat cell (+0.25 GB on 2 km)
+    fidx = np.flatnonzero(flat_cells).astype(np.int32 if cells.size < 2**31 else np.int64)
     del flat_cells
+    heights = c.height[level].ravel()
+    pos = np.empty(len(fidx), dtype=np.int32)
+    for a in range(0, len(fidx), BLOCK):
+        hy = heights[fidx[a:a + BLOCK]]
+        p = np.searchsorted(flat_h, hy + 1e-6, side="right") - 1
+        ok = (p >= 0) & (hy - flat_h[np.maximum(p, 0)] <= c.cell_h + 1e-6)
+        pos[a:a + BLOCK] = np.where(ok, p, -1)
+    # the floors present, sorted: np.unique(pos[okc]) without sorting a value a flat cell
+    # (the floors are few; on hix ~0.1 s of sorting twice over)
+    floors = np.flatnonzero(np.bincount(pos[pos >= 0], minlength=len(flat_h)))
+    present = flat_h[floors]
     # the rims' cells and heights, once: per floor over the whole level they took two
     # float temporaries of 8 bytes a cell (and isin below ~25 sorting the labels)
     ri, rj = np.nonzero(cells & c.span_rim[level])
     rh = c.height[level][ri, rj]
-    # the floors present, sorted: np.unique(pos[okc]) without sorting a value a flat cell
-    # (the floors are few; on hix ~0.1 s of sorting twice over)
-    floors = np.flatnonzero(np.bincount(pos[okc], minlength=len(flat_h)))
-    present = flat_h[floors]
     for k in floors:
-        sel = okc & (pos == k)
+        sel = pos == k
         mask = np.zeros_like(cells)
         mask.ravel()[fidx[sel]] = True
         # small patches (stair treads, bumps) keep the cells' outline
         lab, nlab = ndimage.label(mask)
-        big = np.bincount(lab.ravel(), minlength=nlab + 1)[1:] * cell * cell >= MIN_EXACT_AREA
+        big = _label_sizes(lab, nlab)[1:] * cell * cell >= MIN_EXACT_AREA
         if not big.any():
             continue
         table = np.zeros(nlab + 1, dtype=bool)   # np.isin(lab, the big labels), a byte a label
@@ -385,6 +390,16 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
         _cut_floor(c, cells, mask, float(flat_h[k]), base, fl)
         fl.heights.append((float(flat_h[k]), float(mask.sum() * cell * cell)))
     return fl
+
+
+def _label_sizes(lab: np.ndarray, n: int) -> np.ndarray:
+    """``np.bincount(lab.ravel(), minlength=n + 1)`` a block of cells at a time: bincount
+    copies int32 labels as int64 (+0.13 GB on a 2 km terrain's level, the walls' peak)."""
+    sizes = np.zeros(n + 1, dtype=np.int64)
+    flat = lab.ravel()
+    for a in range(0, len(flat), BLOCK):
+        sizes += np.bincount(flat[a:a + BLOCK], minlength=n + 1)
+    return sizes
 
 
 def _cut_floor(c: _Cut, cells: np.ndarray, mask: np.ndarray, h: float, base: float, fl: _Floors) -> None:
