@@ -46,13 +46,27 @@ class Profile:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._stack: list[float] = []
+        self._local = threading.local()
         self._undo: list[tuple[Any, str, Any]] = []
         self.missing: list[str] = []
 
+    def _frames(self) -> tuple[list[float], list[str]]:
+        """This thread's stack of inner times and of stage names: a hooked call in a
+        worker thread (the grids compressed while the picture is drawn) is charged to
+        its own stage without taking it off the stage the main thread is in (the
+        stages then add up to more than the wall time; the sampler follows the main
+        thread's names)."""
+        loc = self._local
+        if not hasattr(loc, "stack"):
+            main = threading.current_thread() is threading.main_thread()
+            loc.stack, loc.names = (self._stack, self._names) if main else ([], ["other"])
+        return loc.stack, loc.names
+
     def _wrap(self, stage: str, fn: Callable) -> Callable:
-        stack, stages, calls, names = self._stack, self.stages, self.calls, self._names
+        stages, calls, frames = self.stages, self.calls, self._frames
 
         def timed(*args, **kwargs):
+            stack, names = frames()
             t0 = time.perf_counter()
             stack.append(0.0)
             names.append(stage)

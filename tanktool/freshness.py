@@ -103,7 +103,7 @@ def rebuild_grid(folder: Path, doc: dict[str, Any]) -> None:
     """The navigation files again, with the manifest's settings, swapped in atomically."""
     from .formats.bundle import atomic_write_text, dumps_toml
     from .formats.bundle_swap import bundle_update
-    from .grid_files import build_grid, open_target, render_picture, stage_grid_files
+    from .grid_files import build_grid, open_target, picture_and_grids, stage_grid_files
 
     nav = doc.get("navgrid") if isinstance(doc.get("navgrid"), dict) else {}
     derived = doc.get("derived") if isinstance(doc.get("derived"), dict) else {}
@@ -111,9 +111,9 @@ def rebuild_grid(folder: Path, doc: dict[str, Any]) -> None:
     clearance = _number(nav.get("clearance")) if "navgrid.npz" in derived else None
     target = open_target(folder)
     built = build_grid(target, clearance=clearance)
-    picture = render_picture(built, target)
+    picture, packed = picture_and_grids(built, target)
     with bundle_update(folder) as stage:
-        atomic_write_text(stage / "arena.toml", dumps_toml(stage_grid_files(stage, target, built, picture)))
+        atomic_write_text(stage / "arena.toml", dumps_toml(stage_grid_files(stage, target, built, picture, packed)))
 
 
 def reimport(folder: Path, doc: dict[str, Any]) -> None:

@@ -391,11 +391,11 @@ def _stage_grid(tmp: Path, fits: Any, remark: Callable[[str], None],
                 progress: Callable[[str], None] | None) -> Any:
     """navgrid.npz, quadtree.npz and navgrid.png as build-navgrid writes them, recorded in the manifest."""
     from .formats.bundle import write_toml
-    from .grid_files import build_grid, open_target, render_picture, stage_grid_files
+    from .grid_files import build_grid, open_target, picture_and_grids, stage_grid_files
 
     staged = open_target(tmp)
     built = build_grid(staged, warn=remark, fleet=fits)
-    write_toml(tmp / MANIFEST, stage_grid_files(tmp, staged, built, render_picture(built, staged)))
+    write_toml(tmp / MANIFEST, stage_grid_files(tmp, staged, built, *picture_and_grids(built, staged)))
     if progress:
         progress("navgrid")
     return built
