@@ -188,14 +188,21 @@ def _unreachable(surface: Surface, radius: float, vertices: np.ndarray | None, f
     if not other.any():
         return other
     fits = other & (surface.clearance >= radius)
-    good = np.unique(surface.region[fits])
+    idx = np.flatnonzero(fits)
+    regs = surface.region[idx]
+    good = np.unique(regs)
     if vertices is not None and len(good):
         nz, nx = surface.shape
         hf = surface.hf
+        # each surface's spans in span order, once: a pass over every span per surface
+        # took 0.15 s on hix (74 surfaces)
+        order = np.argsort(regs, kind="stable")
+        idx, regs = idx[order], regs[order]
+        bounds = zip(np.searchsorted(regs, good), np.searchsorted(regs, good, side="right"))
         # one point per surface: its span farthest from the edge
         pts = []
-        for r in good:
-            m = np.flatnonzero((surface.region == r) & fits)
+        for a, b in bounds:
+            m = idx[a:b]
             k = m[int(np.argmax(surface.clearance[m]))]
             i, j = divmod(int(surface.col[k]), nx)
             pts.append([hf.origin[0] + (j + 0.5) * hf.cs, surface.y[k] + 0.5 * hf.ch, hf.origin[2] + (i + 0.5) * hf.cs])
