@@ -152,11 +152,14 @@ def link_spans(col: np.ndarray, floor: np.ndarray, ceil: np.ndarray, shape: tupl
     nz, nx = shape
     n = len(col)
     start = column_starts(col, nz * nx)
-    link = np.full((n, 4), -1, dtype=link_dtype(n))
     kern = active()
-    if kern is not None and link.dtype == np.int32:
-        kern.link_spans(i64(col), i64(floor), i64(ceil), start, nz, nx, int(headroom), int(climb), link)
+    if kern is not None and link_dtype(n) == np.int32:   # the kernel writes every link: no fill first
+        link = np.empty((n, 4), dtype=np.int32)
+        narrow = floor.dtype == ceil.dtype == np.int32   # the kernel reads them as they are
+        fc = [np.ascontiguousarray(a) if narrow else i64(a) for a in (floor, ceil)]
+        kern.link_spans(i64(col), *fc, start, nz, nx, int(headroom), int(climb), link)
         return link
+    link = np.full((n, 4), -1, dtype=link_dtype(n))
     count = np.diff(start)
     for d, ncol in enumerate(neighbour_columns(col, shape)):
         off = ncol < 0
