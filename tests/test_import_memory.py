@@ -191,3 +191,15 @@ def test_walls_in_small_blocks_are_the_walls(monkeypatch, name):
     got = lw.level_walls(s, *args)
     assert np.array_equal(got.walls.segments, want.walls.segments)
     assert [r.flat_heights for r in got.regions] == [r.flat_heights for r in want.regions]
+
+
+def test_a_read_obj_keeps_no_copy_of_its_file(tmp_path):
+    """trimesh's LoadSource kept the file's bytes (file_obj) with the scene through the
+    import; the scene is let go of it, and reads the same."""
+    from tanktool.formats.models import load_scene
+
+    model = write_room(tmp_path / "room.obj")
+    scene = load_scene(model)
+    assert getattr(scene.source, "file_obj", None) is None
+    (mesh,) = scene.geometry.values()
+    assert len(mesh.faces) == 12 * 6 and getattr(mesh.source, "file_obj", None) is None
