@@ -288,7 +288,8 @@ class _Cut:
     cell: float
     cell_h: float               # the height field's cell height (m)
     exists: np.ndarray          # (L, nz, nx): a cell of the level
-    height: np.ndarray          # (L, nz, nx): its surface's height
+    span_y: np.ndarray          # (n,): each surface span's height (Surface.y; the layer of
+    #                             them took 8 bytes a node of every level through the walls)
     span_of: np.ndarray         # (L, nz, nx): its surface span, -1 for none
     span_flat: np.ndarray       # (L, nz, nx): its surface is a horizontal face
     span_rim: np.ndarray        # (L, nz, nx): the rim of a steep obstacle, walkable below the climb
@@ -321,7 +322,7 @@ def _prepare(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_heig
              climb_m: float, tolerance: float, max_slope: float, edge_error: float, edge_max_len: float | None,
              smooth_margin: bool) -> _Cut:
     hf = surface.hf
-    exists, height, _, span_of = surface_layers(surface, clearance=False)
+    exists, _, _, span_of = surface_layers(surface, clearance=False)   # heights: per span, below
     L, nz, nx = exists.shape
     cuts = ExactCuts(vertices, faces, cut_height, headroom, tolerance, math.cos(math.radians(max_slope)), climb_m)
     span_flat = np.zeros((L, nz, nx), dtype=bool)
@@ -337,7 +338,7 @@ def _prepare(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_heig
     del sm
     lev = np.arange(L)[:, None, None]
     same = _same_level_links(surface, span_of, exists)
-    return _Cut(surface, hf.origin[[0, 2]], hf.cs, hf.ch, exists, height, span_of, span_flat, span_rim, same, cuts,
+    return _Cut(surface, hf.origin[[0, 2]], hf.cs, hf.ch, exists, surface.y, span_of, span_flat, span_rim, same, cuts,
                 modelled_floors(vertices, faces), tolerance, climb_m, edge_error, edge_max_len, smooth_margin)
 
 
@@ -356,10 +357,10 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
     # heights, indices and their temporaries took ~60 bytes a flat cell (+0.25 GB on 2 km)
     fidx = np.flatnonzero(flat_cells).astype(np.int32 if cells.size < 2**31 else np.int64)
     del flat_cells
-    heights = c.height[level].ravel()
+    spans = c.span_of[level].ravel()
     pos = np.empty(len(fidx), dtype=np.int32)
     for a in range(0, len(fidx), BLOCK):
-        hy = heights[fidx[a:a + BLOCK]]
+        hy = c.span_y[spans[fidx[a:a + BLOCK]]]
         p = np.searchsorted(flat_h, hy + 1e-6, side="right") - 1
         ok = (p >= 0) & (hy - flat_h[np.maximum(p, 0)] <= c.cell_h + 1e-6)
         pos[a:a + BLOCK] = np.where(ok, p, -1)
@@ -369,7 +370,7 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
     # the rims' cells and heights, once: per floor over the whole level they took two
     # float temporaries of 8 bytes a cell (and isin below ~25 sorting the labels)
     ri, rj = np.nonzero(cells & c.span_rim[level])
-    rh = c.height[level][ri, rj]
+    rh = c.span_y[c.span_of[level][ri, rj]]
     for k in floors:
         sel = pos == k
         mask = np.zeros_like(cells)
@@ -502,7 +503,7 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
             out_seg.append(segs)
             out_lev.append(np.full(len(segs), level))
             out_reg.append(np.full(len(segs), rid))
-            ys = c.height[level][cells]
+            ys = c.span_y[c.span_of[level][cells]]
             regions.append(RegionWalls(level, rid, R, float(np.nanmin(ys)), float(np.nanmax(ys)),
                                        float(cells.sum() * cell * cell), fl.heights))
     seg = np.concatenate(out_seg) if out_seg else np.zeros((0, 2, 2))
