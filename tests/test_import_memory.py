@@ -203,3 +203,22 @@ def test_a_read_obj_keeps_no_copy_of_its_file(tmp_path):
     assert getattr(scene.source, "file_obj", None) is None
     (mesh,) = scene.geometry.values()
     assert len(mesh.faces) == 12 * 6 and getattr(mesh.source, "file_obj", None) is None
+
+
+def test_walls_too_close_in_bands_is_the_whole_grids(monkeypatch):
+    from tanktool.nav import arena_levels
+    from tanktool.nav.navgrid import on_wall_tolerance, too_close
+
+    rng = np.random.default_rng(9)
+    a = rng.uniform(0, 40, size=(30, 2))
+    seg = np.stack([a, a + rng.uniform(-6, 6, size=(30, 2))], axis=1)
+
+    class Walls:
+        segments, level, bounds = seg, np.arange(30) % 2, np.array([[0.0, 0.0], [40.0, 40.0]])
+
+    origin, shape = np.array([-1.0, -2.0]), (83, 79)
+    monkeypatch.setattr(arena_levels, "BAND_NODES", 500)   # bands of 6 rows, the last shorter
+    got = arena_levels.walls_too_close(Walls, origin, 0.5, shape, 2, 1.3)
+    for lv in range(2):
+        want = too_close(seg[Walls.level == lv], origin, 0.5, shape, 1.3, tol=on_wall_tolerance(Walls.bounds))
+        assert np.array_equal(got[lv], want) and want.any() and not want.all()

@@ -76,10 +76,18 @@ def walls_too_close(walls, origin: np.ndarray, cell: float, shape: tuple[int, in
     """(L, nz, nx): nodes closer than ``clearance`` to a wall of their own level."""
     tol = on_wall_tolerance(walls.bounds)
     out = np.zeros((levels, *shape), dtype=bool)
+    # a band of rows at a time (each row's nodes are decided alone): too_close's running
+    # sums over the whole grid were three int64 arrays of a node each (+0.26 GB on 2 km)
+    rows = max(1, BAND_NODES // max(shape[1], 1))
     for lv in range(levels):
         seg = walls.segments[walls.level == lv]
-        out[lv] = too_close(seg, origin, cell, shape, clearance, tol=tol)
+        for a in range(0, shape[0], rows):
+            out[lv, a:a + rows] = too_close(seg, origin, cell, shape, clearance, rows=slice(a, a + rows), tol=tol)
     return out
+
+
+#: nodes of a band of rows of walls_too_close
+BAND_NODES = 1 << 20
 
 
 def tank_grid(surface: Surface, lw: LevelWalls, radius: float) -> NavGrid:

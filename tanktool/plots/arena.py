@@ -234,7 +234,7 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     L = max(len(result.levels), 1)
     w = max(xmax - xmin, 1e-6)
     h = max(zmax - zmin, 1e-6)
-    exists, height, _, _ = surface_layers(surface, clearance=False)
+    exists, height = surface_layers(surface, clearance=False)[:2]   # not the span indices (bound to _)
     nz, nx = hf.shape
     step, extent = image_step((nz, nx), hf.origin[[0, 2]], hf.cs)
     ys = height[exists]
