@@ -94,8 +94,7 @@ def cells_polygon(mask: np.ndarray, origin: np.ndarray, cell: float, tolerance: 
     m = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), dtype=bool)
     m[1:-1, 1:-1] = mask
     segs = []
-    # horizontal edges at z line i (between rows i - 1 and i): free above -> +x (found
-    # once, split by side in nonzero's order: one pass over the mask a direction, not two)
+    # horizontal edges at z line i (rows i - 1, i): free above -> +x (split by side in nonzero's order)
     hi = m[1:, 1:-1]
     i, j = np.nonzero(hi != m[:-1, 1:-1])
     rise = hi[i, j]
@@ -519,10 +518,10 @@ def level_walls(surface: Surface, vertices: np.ndarray, faces: np.ndarray, cut_h
 
 
 def _mask_box(mask: np.ndarray, origin: np.ndarray, cell: float, grow: float) -> tuple[float, float, float, float]:
-    """World box of a mask's cells, grown by ``grow`` cells."""
-    i, j = np.nonzero(mask)
-    return (origin[0] + (j.min() - grow) * cell, origin[1] + (i.min() - grow) * cell,
-            origin[0] + (j.max() + 1 + grow) * cell, origin[1] + (i.max() + 1 + grow) * cell)
+    """World box of a mask's cells, grown by ``grow`` cells (by its rows and columns, not every cell's index)."""
+    i, j = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    return (origin[0] + (j[0] - grow) * cell, origin[1] + (i[0] - grow) * cell,
+            origin[0] + (j[-1] + 1 + grow) * cell, origin[1] + (i[-1] + 1 + grow) * cell)
 
 
 def _crop(mask: np.ndarray, box, origin: np.ndarray, cell: float):
