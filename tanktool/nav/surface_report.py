@@ -129,7 +129,7 @@ def low_headroom(surface: Surface, vertices: np.ndarray | None = None, faces: np
 
 
 def _low_headroom(surface: Surface, vertices: np.ndarray | None, faces: np.ndarray | None) -> np.ndarray:
-    from ..geometry.heightfield import column_starts, neighbour_columns
+    from ..geometry.heightfield import neighbour_columns
 
     hf = surface.hf
     low = np.flatnonzero(hf.low_headroom)
@@ -138,13 +138,14 @@ def _low_headroom(surface: Surface, vertices: np.ndarray | None, faces: np.ndarr
         return out
     nz, nx = hf.shape
     mcol, mfloor = surface.col[surface.main], surface.floor[surface.main]
-    start = column_starts(mcol, nz * nx)
     climb = int(math.floor(surface.stats.get("climb_steps", 0))) if surface.stats else 0
     near = np.zeros(len(low), dtype=bool)
     for ncol in neighbour_columns(hf.col[low], hf.shape):
         ok = ncol >= 0
         c = np.where(ok, ncol, 0)
-        a, b = start[c], start[c + 1]
+        # column_starts(mcol)[c] and [c + 1] of the few columns asked (mcol is sorted),
+        # not counted over every column (0.07 s on hix for ~6,000 low spans)
+        a, b = np.searchsorted(mcol, c), np.searchsorted(mcol, c, side="right")
         has = ok & (b > a)
         # the first main span of that column (a column rarely holds two)
         k = np.minimum(a, max(len(mfloor) - 1, 0))
