@@ -121,7 +121,8 @@ class Surface:
 
     @property
     def levels(self) -> int:
-        return int(self.level.max()) + 1 if (self.level >= 0).any() else 0
+        top = int(self.level.max()) if len(self.level) else -1   # one pass (asked ~11 times an import)
+        return top + 1 if top >= 0 else 0
 
     @property
     def y(self) -> np.ndarray:
