@@ -61,3 +61,23 @@ def test_more_bots_than_the_arena_holds_is_refused_naming_it(tmp_path, peers):  
         NetMatch(host, _room(tmp_path), load_tank_spec("light"), seed=1, bots=4)
     with pytest.raises(NetError, match=r"holds 1 tank of heavy at once: a network match needs 2"):
         NetMatch(host, _room(tmp_path), load_tank_spec("heavy"), seed=1)
+
+
+@pytest.mark.parametrize("arena", ["box", "fort", "hills", "maze"])
+def test_the_capacity_shortcut_counts_what_the_picks_find(arena, tmp_path):
+    """capacity() skips the farthest-point picks when no set of discs of a tank's length
+    round the spawns and picks could cover the candidates; it must say what picking
+    them says, with the shortcut taken (limit 64) and not (a limit of hundreds)."""
+    from tanktool.sim import extra_spawns
+    from tanktool.sim.world import World
+
+    info = load_match_arena(arena)
+    for name in ("light", "heavy"):
+        spec = load_tank_spec(name)
+        own = info.spawns_for(spec)
+        w = World(info.walls, [spec], own[:1], bounds=info.bounds, ground=info.ground)
+        w.spawns = [tuple(map(float, r[:3])) for r in np.asarray(own, dtype=np.float64).reshape(len(own), -1)]
+        length = spec.box[2] - spec.box[0]
+        for limit in (16, 64, 400):
+            picked = len(w.spawns) + len(extra_spawns.places(w, limit - len(w.spawns), spec.radius, length))
+            assert extra_spawns.capacity(w, spec.radius, length, limit) == picked

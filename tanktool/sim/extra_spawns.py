@@ -80,7 +80,30 @@ def places(world: "World", count: int, radius: float, length: float) -> list[tup
 def capacity(world: "World", radius: float, length: float, limit: int = 64) -> int:
     """How many tanks of this size the arena holds at once (its spawn points and the
     free places a tank's length apart), up to ``limit``."""
-    return len(world.spawns) + len(places(world, max(limit - len(world.spawns), 0), radius, length))
+    more = max(limit - len(world.spawns), 0)
+    pts, _ = _candidates(world, radius)
+    if _places_count(pts) > (len(world.spawns) + more) * _nodes_within(length):
+        # the picking stops early only once every candidate lies within ``length`` of a
+        # spawn or a pick, and that many discs cannot cover this many places: all
+        # ``more`` are found (the picks themselves: 0.3 s on an 800 m level)
+        return len(world.spawns) + more
+    taken = np.array([s[:2] for s in world.spawns], dtype=np.float64).reshape(-1, 2)
+    return len(world.spawns) + len(_pick(pts, taken, more, length))
+
+
+def _places_count(pts: np.ndarray) -> int:
+    """How many distinct places (cells of CELL) ``pts`` holds: nodes of two levels can share one."""
+    if len(pts) == 0:
+        return 0
+    cells = np.floor(pts / CELL).astype(np.int64)
+    cells -= cells.min(axis=0)
+    return len(np.unique(cells[:, 0] * (int(cells[:, 1].max()) + 1) + cells[:, 1]))
+
+
+def _nodes_within(r: float) -> float:
+    """At most this many nodes (cell centres CELL apart) lie closer than ``r`` to any
+    point: each one's cell lies inside the disc of radius r + CELL / sqrt 2."""
+    return math.pi * (r / CELL + math.sqrt(0.5)) ** 2
 
 
 def extend(world: "World", tanks: int, radius: float, length: float, vehicle: str) -> None:
