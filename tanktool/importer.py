@@ -116,13 +116,7 @@ def import_arena(
     model = Path(model)
     fmt = detect_format(model)
     name, target = _check_options(model, out, name, force, height, tolerance)
-    warnings: list[str] = []
-
-    def remark(message: str) -> None:
-        warnings.append(message)
-        if warn is not None:
-            warn(message)
-
+    warnings, remark = _collector(warn)
     fleet = bundled_fleet(warn=remark)
     nav = {**NAVGRID_DEFAULTS, **(navgrid or {})}
     params, where = walkable_params(cell if cell is not None else nav.get("cell"), max_slope, climb, headroom,
@@ -147,9 +141,8 @@ def import_arena(
         source = {"up": up or default_up(fmt), "scale": float(scale), **_plan_source(fmt, wall_height, wall_thickness)}
         doc = _manifest(tmp, model, companions, name, source, textures, height, tolerance, params, fits,
                         result, nav)
-        if others:   # one grid per smaller vehicle: grid_files builds navgrid.<vehicle>.npz from these
-            doc["grids"] = others
-        write_toml(tmp / MANIFEST, doc)
+        # one grid per smaller vehicle: grid_files builds navgrid.<vehicle>.npz from these
+        write_toml(tmp / MANIFEST, {**doc, **({"grids": others} if others else {})})
         scene = None
         _let_go(result, grid)
         # the same files, built the same way, as build-navgrid on the bundle
@@ -157,6 +150,17 @@ def import_arena(
     return ImportResult(target, name, result.walls.walls, result.spawns, result.floor_y, n_faces,
                         result.walls.thin_walls, time.perf_counter() - t0, warnings, result, params, where, built,
                         model_left_out)
+
+
+def _collector(warn: Callable[[str], None] | None) -> tuple[list[str], Callable[[str], None]]:
+    """(the remarks so far, a function that records one and passes it to ``warn``)."""
+    remarks: list[str] = []
+
+    def remark(message: str) -> None:
+        remarks.append(message)
+        if warn is not None:
+            warn(message)
+    return remarks, remark
 
 
 def _before_vehicles(result: Any, grid: bool) -> None:
