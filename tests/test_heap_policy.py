@@ -20,11 +20,14 @@ def test_frozen_heap_freezes_while_running_and_unfreezes_after():
     @memory.frozen_heap
     def outer() -> int:
         seen.append(("outer", gc.get_freeze_count()))
-        return inner() + 1   # nested: left frozen, not unfrozen by the inner call
+        total = inner() + 1
+        seen.append(("after inner", gc.get_freeze_count()))   # nested: not unfrozen by the inner call
+        return total
 
     assert gc.get_freeze_count() == 0
     assert outer() == 3
-    assert seen[0][1] > 0 and seen[1][1] == seen[0][1]
+    # counts, not equalities: a frozen object freed by its refcount leaves the permanent generation
+    assert [n for n, _ in seen] == ["outer", "inner", "after inner"] and all(c > 0 for _, c in seen)
     assert gc.get_freeze_count() == 0
 
 
@@ -38,10 +41,11 @@ def test_frozen_heap_unfreezes_on_error_and_leaves_a_callers_freeze_alone():
     assert gc.get_freeze_count() == 0
     gc.freeze()   # the caller's own freeze is not undone
     try:
-        before = gc.get_freeze_count()
         with pytest.raises(ValueError):
             boom()
-        assert gc.get_freeze_count() == before
+        # still frozen (an unfreeze empties the permanent generation; its count may drop a
+        # little meanwhile as frozen objects are freed by their refcount)
+        assert gc.get_freeze_count() > 0
     finally:
         gc.unfreeze()
 
