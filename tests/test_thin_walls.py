@@ -59,3 +59,24 @@ def test_chains_outside_free_space_or_on_its_outline_give_no_wall():
     assert _key(seg) == _key(np.array([[[5, 0.01], [5, 9.99]]]))
     assert _key(tw.thin_walls_reference(chains, free, 0.01)) == _key(seg)
     assert tw.thin_walls([], free, 0.01).shape == (0, 2, 2)
+
+
+def test_thin_walls_on_a_free_space_with_its_precision_grid_do_not_raise():
+    """A random level's chains and free space (tests/data/thin_walls_topology.json) on
+    which GEOS raised a topology exception clipping the chains off the free space's
+    outline: the overlay is then done on the walls' precision grid."""
+    import json
+    from pathlib import Path
+
+    import shapely
+
+    from tanktool.geometry.thin_walls import thin_walls, thin_walls_reference
+
+    doc = json.loads((Path(__file__).parent / "data" / "thin_walls_topology.json").read_text())
+    tol = doc["tolerance"]
+    free = shapely.set_precision(shapely.from_wkt(doc["free"]), tol)
+    chains = [shapely.from_wkt(c) for c in doc["chains"]]
+    walls = thin_walls(chains, free, tol)
+    assert len(walls) > 0 and np.isfinite(walls).all()
+    ref = thin_walls_reference(chains, free, tol)
+    assert abs(np.hypot(*(walls[:, 1] - walls[:, 0]).T).sum() - np.hypot(*(ref[:, 1] - ref[:, 0]).T).sum()) < 0.5
