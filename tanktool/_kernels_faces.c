@@ -38,22 +38,53 @@ static inline int face_of(const double *X, const double *Y, const double *Z, i64
     return 1;
 }
 
+/* the arguments both passes take: the vertices' X, Y, Z, the faces' corners f0, f1, f2,
+ * two numbers, and two output buffers of m items of out_size bytes */
+typedef struct {
+    Py_buffer X, Y, Z, f0, f1, f2, out1, out2;
+    double p1, p2;
+    i64 nv;
+    Py_ssize_t m;
+} FacePass;
+
+static void face_pass_release(FacePass *p) {
+    PyBuffer_Release(&p->X);
+    PyBuffer_Release(&p->Y);
+    PyBuffer_Release(&p->Z);
+    PyBuffer_Release(&p->f0);
+    PyBuffer_Release(&p->f1);
+    PyBuffer_Release(&p->f2);
+    PyBuffer_Release(&p->out1);
+    PyBuffer_Release(&p->out2);
+}
+
+/* 1 with every buffer held and its size checked; 0 with an exception set and none held */
+static int face_pass_args(PyObject *args, FacePass *p, Py_ssize_t out_size, const char *out1, const char *out2) {
+    if (!PyArg_ParseTuple(args, "y*y*y*y*y*y*ddw*w*", &p->X, &p->Y, &p->Z, &p->f0, &p->f1, &p->f2, &p->p1, &p->p2,
+                          &p->out1, &p->out2))
+        return 0;
+    p->nv = p->X.len / 8;
+    p->m = p->f0.len / 8;
+    if (!need(&p->Y, p->nv, 8, "Y") || !need(&p->Z, p->nv, 8, "Z") || !need(&p->f1, p->m, 8, "f1") ||
+        !need(&p->f2, p->m, 8, "f2") || !need(&p->out1, p->m, out_size, out1) || !need(&p->out2, p->m, out_size, out2)) {
+        face_pass_release(p);
+        return 0;
+    }
+    return 1;
+}
+
 PyObject *tanktool_walkable_faces(PyObject *self, PyObject *args) {
-    Py_buffer X, Y, Z, f0, f1, f2, walk, flat;
-    double cos_slope, flat_ny;
-    if (!PyArg_ParseTuple(args, "y*y*y*y*y*y*ddw*w*", &X, &Y, &Z, &f0, &f1, &f2, &cos_slope, &flat_ny, &walk, &flat))
+    FacePass p;
+    if (!face_pass_args(args, &p, 1, "walk", "flat"))
         return NULL;
-    const i64 nv = X.len / 8;
-    const Py_ssize_t m = f0.len / 8;
-    PyObject *ret = NULL;
+    const double cos_slope = p.p1, flat_ny = p.p2;
+    const i64 nv = p.nv;
+    const Py_ssize_t m = p.m;
     int ok = 1;
-    if (!need(&Y, nv, 8, "Y") || !need(&Z, nv, 8, "Z") || !need(&f1, m, 8, "f1") || !need(&f2, m, 8, "f2") ||
-        !need(&walk, m, 1, "walk") || !need(&flat, m, 1, "flat"))
-        goto done;
     {
-        const double *x = X.buf, *y = Y.buf, *z = Z.buf;
-        const i64 *a = f0.buf, *b = f1.buf, *c = f2.buf;
-        char *W = walk.buf, *F = flat.buf;
+        const double *x = p.X.buf, *y = p.Y.buf, *z = p.Z.buf;
+        const i64 *a = p.f0.buf, *b = p.f1.buf, *c = p.f2.buf;
+        char *W = p.out1.buf, *F = p.out2.buf;
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t t = 0; t < m && ok; ++t) {
             Face f;
@@ -65,35 +96,22 @@ PyObject *tanktool_walkable_faces(PyObject *self, PyObject *args) {
         }
         Py_END_ALLOW_THREADS
     }
-    ret = PyBool_FromLong(ok);
-done:
-    PyBuffer_Release(&X);
-    PyBuffer_Release(&Y);
-    PyBuffer_Release(&Z);
-    PyBuffer_Release(&f0);
-    PyBuffer_Release(&f1);
-    PyBuffer_Release(&f2);
-    PyBuffer_Release(&walk);
-    PyBuffer_Release(&flat);
-    return ret;
+    face_pass_release(&p);
+    return PyBool_FromLong(ok);
 }
 
 PyObject *tanktool_flat_faces(PyObject *self, PyObject *args) {
-    Py_buffer X, Y, Z, f0, f1, f2, height, area;
-    double up_min2, flat_ny;
-    if (!PyArg_ParseTuple(args, "y*y*y*y*y*y*ddw*w*", &X, &Y, &Z, &f0, &f1, &f2, &up_min2, &flat_ny, &height, &area))
+    FacePass p;
+    if (!face_pass_args(args, &p, 8, "height", "area"))
         return NULL;
-    const i64 nv = X.len / 8;
-    const Py_ssize_t m = f0.len / 8;
-    PyObject *ret = NULL;
+    const double up_min2 = p.p1, flat_ny = p.p2;
+    const i64 nv = p.nv;
+    const Py_ssize_t m = p.m;
     Py_ssize_t k = 0;
-    if (!need(&Y, nv, 8, "Y") || !need(&Z, nv, 8, "Z") || !need(&f1, m, 8, "f1") || !need(&f2, m, 8, "f2") ||
-        !need(&height, m, 8, "height") || !need(&area, m, 8, "area"))
-        goto done;
     {
-        const double *x = X.buf, *y = Y.buf, *z = Z.buf;
-        const i64 *a = f0.buf, *b = f1.buf, *c = f2.buf;
-        double *H = height.buf, *A = area.buf;
+        const double *x = p.X.buf, *y = p.Y.buf, *z = p.Z.buf;
+        const i64 *a = p.f0.buf, *b = p.f1.buf, *c = p.f2.buf;
+        double *H = p.out1.buf, *A = p.out2.buf;
         Py_BEGIN_ALLOW_THREADS
         for (Py_ssize_t t = 0; t < m; ++t) {
             Face f;
@@ -113,15 +131,6 @@ PyObject *tanktool_flat_faces(PyObject *self, PyObject *args) {
         }
         Py_END_ALLOW_THREADS
     }
-    ret = PyLong_FromSsize_t(k);
-done:
-    PyBuffer_Release(&X);
-    PyBuffer_Release(&Y);
-    PyBuffer_Release(&Z);
-    PyBuffer_Release(&f0);
-    PyBuffer_Release(&f1);
-    PyBuffer_Release(&f2);
-    PyBuffer_Release(&height);
-    PyBuffer_Release(&area);
-    return ret;
+    face_pass_release(&p);
+    return PyLong_FromSsize_t(k);
 }
