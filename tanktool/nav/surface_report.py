@@ -113,10 +113,15 @@ def _remembered(surface: Surface, key: tuple, model: tuple, work: Callable[[], n
     """``work()`` once per surface, key and model (the report and the picture both ask,
     with the same arrays): a copy of the remembered mask.  The model's arrays are kept
     with it, so their ids in the key cannot be taken by other arrays meanwhile."""
-    key = (*key, *(id(a) for a in model))
+    key = _key(key, model)
     if key not in surface.derived:
         surface.derived[key] = (work(), model)
     return surface.derived[key][0].copy()
+
+
+def _key(key: tuple, model: tuple) -> tuple:
+    """Where :func:`_remembered` keeps ``key``'s answer for the model's arrays."""
+    return (*key, *(id(a) for a in model))
 
 
 def low_headroom(surface: Surface, vertices: np.ndarray | None = None, faces: np.ndarray | None = None) -> np.ndarray:
@@ -178,8 +183,8 @@ def asked(surface: Surface, radius: float, model: tuple) -> bool:
     """Whether the report's per-span answers for ``radius`` (unreachable given the
     model's arrays ``(vertices, faces)``, too_small) are kept with the surface: the
     picture no longer needs its clearance and regions then."""
-    return (("unreachable", float(radius), *(id(a) for a in model)) in surface.derived
-            and ("too_small", float(radius)) in surface.derived)
+    return (_key(("unreachable", float(radius)), model) in surface.derived
+            and _key(("too_small", float(radius)), ()) in surface.derived)
 
 
 def _unreachable(surface: Surface, radius: float, vertices: np.ndarray | None, faces: np.ndarray | None) -> np.ndarray:
@@ -230,10 +235,7 @@ def too_small(surface: Surface, radius: float) -> np.ndarray:
     than the radius (along the links) from every span where a tank fits, in patches of
     at least MIN_SMALL_AREA radius-squared (a room's corners are not "too small").
     Worked out once per surface and radius (the report and the picture both ask)."""
-    key = ("too_small", float(radius))
-    if key not in surface.derived:
-        surface.derived[key] = _too_small(surface, radius)
-    return surface.derived[key].copy()
+    return _remembered(surface, ("too_small", float(radius)), (), lambda: _too_small(surface, radius))
 
 
 def _too_small(surface: Surface, radius: float) -> np.ndarray:
