@@ -144,7 +144,7 @@ def import_arena(
         # one grid per smaller vehicle: grid_files builds navgrid.<vehicle>.npz from these
         write_toml(tmp / MANIFEST, {**doc, **({"grids": others} if others else {})})
         scene = None
-        _let_go(result, grid)
+        _let_go(result)
         # the same files, built the same way, as build-navgrid on the bundle
         built = _stage_grid(tmp, fits, remark, progress) if grid else None
     return ImportResult(target, name, result.walls.walls, result.spawns, result.floor_y, n_faces,
@@ -198,15 +198,13 @@ def _preview(name: str, result: Any) -> bytes:
     return render_levels(result, title)
 
 
-def _let_go(result: Any, grid: bool) -> None:
-    """Drop the analysis' large arrays once the pictures are drawn: its surface (~100
-    bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m), the model it holds and (when
-    the grid stage builds the bundle's own from the staged files) its tank grid; let go
-    before that stage (2 km terrain: ~0.9 GB)."""
+def _let_go(result: Any) -> None:
+    """Drop the analysis' large arrays once the files are staged: its surface (~100
+    bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m) and the model it holds; let
+    go before the grid stage (2 km terrain: ~0.9 GB).  The tank grid went already
+    (:func:`_before_vehicles`)."""
     result.surface = None
     result.vertices = result.faces = None
-    if grid:
-        result.grid = None   # ImportResult.grid holds the grid written with the bundle
     give_back(GIVE_BACK_MIN)
 
 
