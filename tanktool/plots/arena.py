@@ -185,8 +185,13 @@ class _LevelsLayout:
         return cls(cols, (levels + cols - 1) // cols, panel_w, float(np.clip(panel_w * aspect, 1.2, 12.0)), bar)
 
     @property
+    def panels_right(self) -> float:
+        """The right edge of the last column of panels."""
+        return self.LEFT + self.cols * self.panel_w + (self.cols - 1) * self.GAP_X
+
+    @property
     def width(self) -> float:
-        return self.LEFT + self.cols * self.panel_w + (self.cols - 1) * self.GAP_X + (self.RIGHT if self.bar else 0.3)
+        return self.panels_right + (self.RIGHT if self.bar else 0.3)
 
     @property
     def top(self) -> float:
@@ -206,7 +211,7 @@ class _LevelsLayout:
 
     def colour_bar(self) -> tuple[float, float, float, float]:
         """The colour bar's axes beside the panels, as a figure fraction."""
-        x = self.LEFT + self.cols * self.panel_w + (self.cols - 1) * self.GAP_X + 0.3
+        x = self.panels_right + 0.3
         return (x / self.width, self.BELOW / self.height, 0.22 / self.width,
                 (self.height - self.BELOW - self.top) / self.height)
 
