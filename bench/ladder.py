@@ -10,14 +10,17 @@ seed k, and the first player of the pair is tank 0 when k is even and tank 1 whe
 it is odd, so neither gets the better spawn points.  A win is more kills; equal
 kills is a draw.  Printed: win / loss / draw per pair and arena, then Elo ratings
 over all duels (a Bradley-Terry fit, draws counting half, with one virtual draw per
-pair so that a clean sweep stays finite; the players' mean is 1500) with 95 %
+pair played so that a clean sweep stays finite; the players' mean is 1500) with 95 %
 bootstrap intervals (duels resampled within each pair and arena), and the goals
 (issue 28's, and issue 30's for the novice).  The round robin and the Elo fit are
 ``tanktool tournament``'s (tanktool/tournament/), run on ``--workers`` local processes.
+``--pairs`` plays only the pairings named (the Elo fit over them alone, which needs
+them to link every player): a long measurement of what matters, affordable.
 
     python bench/ladder.py [--duels N] [--json] [--arenas a,b] (default: every bundled arena)
                            [--generated LEVEL[:SEED]] (default bridge; 'none': no generated arena)
                            [--players scripted,robot,camper,duellist,novice,easy,normal,hard]
+                           [--pairs A-B,C-D] (only those pairings, A first; default every pair of --players)
                            [--seconds S] [--vehicle light] [--boot B] [--workers N]
 """
 
@@ -37,8 +40,12 @@ sys.path.insert(0, str(ROOT))
 
 from tanktool.content import bundled_names  # noqa: E402
 from tanktool.sim.match import load_match_arena, load_tank_spec  # noqa: E402
-from tanktool.tournament import TournamentConfig, default_workers, run_tournament  # noqa: E402
+import numpy as np  # noqa: E402
+
+from tanktool.tournament import (MatchTask, TournamentConfig, default_workers, make_report,  # noqa: E402
+                                 resolve_players)
 from tanktool.tournament.elo import fit_elo as tournament_elo  # noqa: E402
+from tanktool.tournament.runners import runner  # noqa: E402
 
 PLAYERS = ("scripted", "robot", "camper", "duellist", "novice", "easy", "normal", "hard")
 #: every bundled arena (box, fort, hills, maze, paper2002 at the time of writing)
@@ -79,7 +86,8 @@ def fit_elo(players: list[str], games: list[tuple[int, int, float]], prior: floa
     return tournament_elo(len(players), games, prior)
 
 
-def main(argv: list[str] | None = None) -> int:
+def _parse(argv: list[str] | None) -> tuple[argparse.Namespace, list[str], list[tuple[str, str]]]:
+    """The options, the players and the pairings (first player first) to play."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--duels", type=int, default=10, help="duels per pair and arena (default 10)")
     ap.add_argument("--seconds", type=float, default=120.0, help="simulated seconds per duel (default 120)")
@@ -87,18 +95,65 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--generated", default=GENERATED,
                     help=f"a tools/make_levels.py level NAME[:SEED] played too (default {GENERATED}; none: only --arenas)")
     ap.add_argument("--players", default=",".join(PLAYERS))
+    ap.add_argument("--pairs", default="", help="only these pairings, A-B,C-D (A plays first); overrides --players")
     ap.add_argument("--vehicle", default="light")
     ap.add_argument("--boot", type=int, default=300, help="bootstrap resamples for the Elo intervals")
     ap.add_argument("--first-seed", type=int, default=0, help="duel k uses seed first_seed + k")
     ap.add_argument("--workers", type=int, default=default_workers(), help="processes (default: the local cores)")
     ap.add_argument("--json", action="store_true", help="print one JSON object instead of the tables")
     args = ap.parse_args(argv)
-    players = [p for p in args.players.split(",") if p]
+    if args.pairs:
+        pairs = []
+        for text in (t for t in args.pairs.split(",") if t):
+            a, sep, b = text.partition("-")
+            if not sep or a == b:
+                ap.error(f"--pairs: {text!r} is not two different players A-B")
+            pairs.append((a, b))
+        players = list(dict.fromkeys(p for pair in pairs for p in pair))
+    else:
+        players = [p for p in args.players.split(",") if p]
+        pairs = list(itertools.combinations(players, 2))
     for p in players:
         if p not in PLAYERS:
-            ap.error(f"--players: {p!r} is not one of {', '.join(PLAYERS)}")
-    if len(players) < 2 or args.duels < 1:
+            ap.error(f"--players/--pairs: {p!r} is not one of {', '.join(PLAYERS)}")
+    if len(players) < 2 or args.duels < 1 or not pairs:
         ap.error("need at least two players and one duel")
+    if len(set(pairs) | {(b, a) for a, b in pairs}) < 2 * len(pairs):
+        ap.error("--pairs: a pairing named twice")
+    if not _linked(players, pairs):
+        ap.error("--pairs: the pairings must link every player (else no Elo scale joins them)")
+    return args, players, pairs
+
+
+def _linked(players: list[str], pairs: list[tuple[str, str]]) -> bool:
+    """Whether the pairings join every player into one graph."""
+    reached, todo = {players[0]}, [players[0]]
+    while todo:
+        p = todo.pop()
+        for a, b in pairs:
+            for x, y in ((a, b), (b, a)):
+                if x == p and y not in reached:
+                    reached.add(y)
+                    todo.append(y)
+    return reached == set(players)
+
+
+def _tasks(config: TournamentConfig, pairs: list[tuple[str, str]]) -> tuple[list, list[MatchTask]]:
+    """The players and one task per duel, as the tournament's round robin (seed
+    first_seed + k, the first player tank 0 on even k) but over ``pairs`` only."""
+    players = resolve_players(config.bots)
+    index = {name: i for i, name in enumerate(config.bots)}
+    tasks: list[MatchTask] = []
+    for arena in config.arenas:
+        for a, b in ((index[a], index[b]) for a, b in pairs):
+            for k in range(config.matches):
+                tasks.append(MatchTask(len(tasks), a, b, arena, config.vehicles[0], k, config.first_seed + k, k % 2,
+                                       float(config.seconds), (players[a], players[b]), config.budget, False))
+    return players, tasks
+
+
+def main(argv: list[str] | None = None) -> int:
+    args, players, pairs = _parse(argv)
     spec = load_tank_spec(args.vehicle)
     refs: list = [a for a in args.arenas.split(",") if a]
     if args.generated and args.generated != "none":
@@ -112,20 +167,19 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(ref, Path):
             a.name = f"gen-{args.generated.replace(':', '-')}"
     t0 = time.perf_counter()
-    # the round robin and the Elo fit are the tournament's (tanktool.tournament): the
-    # duels run on every local core, seeds and sides fixed as there
+    # the duels are the tournament's (tanktool.tournament: its players, match tasks,
+    # runners and report), over the pairings asked for; seeds and sides fixed as there
     config = TournamentConfig(bots=tuple(players), arenas=tuple(str(r) for r in refs), vehicles=(args.vehicle,),
                               matches=args.duels, seconds=args.seconds, first_seed=args.first_seed,
-                              boot=args.boot)
-    done = [0]
-
-    def progress(r: dict) -> None:
-        done[0] += 1
-        if not args.json and done[0] % max(args.duels, 1) == 0:
-            print(f"  {done[0]} duels ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
-
-    report = run_tournament(config, run="serial" if args.workers == 1 else "pool", workers=args.workers,
-                            record=False, on_match=progress).report
+                              boot=0)
+    config.check()
+    resolved, tasks = _tasks(config, pairs)
+    results = []
+    for r in runner("serial" if args.workers == 1 else "pool")(tasks, max(args.workers, 1)):
+        results.append(r)
+        if not args.json and len(results) % max(args.duels, 1) == 0:
+            print(f"  {len(results)} duels ({time.perf_counter() - t0:.0f} s)", file=sys.stderr)
+    report = make_report(config, resolved, tasks, results)
     names = {a_info.name: a_info.name for a_info in arenas}
     for a_info, ref in zip(arenas, refs):
         if isinstance(ref, Path):
@@ -138,19 +192,47 @@ def main(argv: list[str] | None = None) -> int:
                       "losses": p["losses"], "draws": p["draws"], "kills": p["kills"],
                       "scored": [sum(m["kills"][0] > 0 for m in rows), sum(m["kills"][1] > 0 for m in rows)],
                       "win_rate": p["wins"] / n, "draw_rate": p["draws"] / n})
-    ratings = [{"player": r["bot"], "elo": r["elo"], "lo": r["lo"], "hi": r["hi"]} for r in report["elo"]]
+    ratings = _elo(players, tasks, results, args.boot)
     goals = _goals(cells, ratings, players, [a.name for a in arenas])
     out = {"vehicle": spec.name, "seconds_per_duel": args.seconds, "duels_per_cell": args.duels,
-           "arenas": [a.name for a in arenas], "players": players, "rules": "sim.rules.DEFAULT",
-           "cells": cells, "elo": ratings, "goals": goals, "wall_clock_s": round(time.perf_counter() - t0, 1)}
+           "arenas": [a.name for a in arenas], "players": players, "pairs": [f"{a}-{b}" for a, b in pairs],
+           "rules": "sim.rules.DEFAULT", "cells": cells, "elo": ratings, "goals": goals,
+           "wall_clock_s": round(time.perf_counter() - t0, 1)}
     if args.json:
         print(json.dumps(out))
         return 0
-    _print_tables(out, players)
+    _print_tables(out, pairs)
     return 0
 
 
-def _print_tables(out: dict, players: list[str]) -> None:
+def _elo(players: list[str], tasks: list[MatchTask], results: list[dict], boot: int) -> list[dict]:
+    """Elo with 95 % bootstrap intervals (duels resampled within each pair and arena,
+    a seeded generator): the Bradley-Terry fit with one virtual draw per pairing
+    played (the tournament's fit puts one on every pair, the same when all play)."""
+    score = {r["index"]: r["score"] for r in results}
+    by_cell: dict[tuple, list[tuple[int, int, float]]] = {}
+    for t in tasks:
+        by_cell.setdefault(t.cell, []).append((t.a, t.b, score[t.index]))
+    virtual = [(a, b, 0.5) for a, b in dict.fromkeys((t.a, t.b) for t in tasks)]
+    games = [g for gs in by_cell.values() for g in gs]
+    elo = tournament_elo(len(players), games + virtual, 0.0)
+    rng = np.random.default_rng(1)
+    boots = []
+    for _ in range(max(boot, 0)):
+        sample = []
+        for c in sorted(by_cell):
+            gs = by_cell[c]
+            sample.extend(gs[k] for k in rng.integers(0, len(gs), len(gs)))
+        boots.append(tournament_elo(len(players), sample + virtual, 0.0))
+    rows = []
+    for k, name in enumerate(players):
+        lo, hi = np.percentile([b[k] for b in boots], [2.5, 97.5]) if boots else (elo[k], elo[k])
+        rows.append({"player": name, "elo": round(float(elo[k]), 1), "lo": round(float(lo), 1),
+                     "hi": round(float(hi), 1)})
+    return rows
+
+
+def _print_tables(out: dict, pairs: list[tuple[str, str]]) -> None:
     """W-L-D per pair and arena, the Elo table and the goals."""
     cells, ratings, goals = out["cells"], out["elo"], out["goals"]
     print(f"ladder: {out['vehicle']} tanks, duels of {out['seconds_per_duel']:g} s, {out['duels_per_cell']} per "
@@ -159,7 +241,7 @@ def _print_tables(out: dict, players: list[str]) -> None:
     head = f"{'pair':<18}" + "".join(f"{n:>16}" for n in names) + f"{'all':>16}"
     print(head)
     print("-" * len(head))
-    for a, b in itertools.combinations(players, 2):
+    for a, b in pairs:
         row = f"{a + '-' + b:<18}"
         tw = tl = td = 0
         for n in names:
@@ -198,6 +280,8 @@ def _goals(cells: list[dict], ratings: list[dict], players: list[str], arenas: l
 
     def every_arena(goal: str, a: str, b: str, need: float, of=rate) -> None:
         if a in players and b in players:
+            if any(cell(a, b, n) is None for n in arenas):
+                return      # a pairing --pairs left out
             rates = {n: of(a, b, n) for n in arenas}
             out.append({"goal": goal, "value": ", ".join(f"{n} {100 * v:.0f} %" for n, v in rates.items()),
                         "met": min(rates.values()) >= need})
