@@ -77,3 +77,32 @@ def read_npz(path: str | os.PathLike, what: str = "an .npz file", limit: int = M
             raise FormatError(f"{label}: member {name[:60]!r} cannot be read: {e}") from None
         out[name[:-4]] = arr
     return out
+
+
+#: deflate level of :func:`write_npz`: zlib's fast strategy (levels 1-3).  On hix's
+#: grids (2.6 M nodes) level 3 took 74 ms a grid where savez_compressed's 6 took 275,
+#: and with the column arrays stored column by column (``fortran``) the file was smaller
+LEVEL = 3
+#: arrays of fewer values than this in all are deflated at zlib's default (6) instead:
+#: milliseconds either way, and the bundled arenas' grids were up to 28 % larger at 3
+SMALL = 1 << 20
+
+
+def write_npz(arrays: dict[str, np.ndarray], level: int | None = None, fortran: tuple[str, ...] = ()) -> bytes:
+    """The ``.npz`` bytes of ``arrays`` as ``numpy.savez_compressed`` writes them, at
+    deflate ``level`` (None: :data:`LEVEL`, or 6 below :data:`SMALL` values).  The
+    arrays named in ``fortran`` are stored column-major, which ``numpy.load`` and
+    :func:`read_npz` read back as the same array: a column run's numbers then lie one
+    after the other, as a row run's do, and deflate finds them (hix's col_index:
+    349 -> 112 KB)."""
+    if level is None:
+        level = LEVEL if sum(np.size(a) for a in arrays.values()) >= SMALL else 6
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED, compresslevel=level) as zf:
+        for name, a in arrays.items():
+            a = np.asarray(a)   # (ascontiguousarray would make a 0-d array 1-d)
+            if name in fortran and a.ndim > 1:
+                a = np.asfortranarray(a)
+            with zf.open(f"{name}.npy", "w", force_zip64=True) as f:
+                np.lib.format.write_array(f, a, allow_pickle=False)
+    return buf.getvalue()

@@ -10,7 +10,6 @@ is a line of constant z, a column (index j) one of constant x.
 
 from __future__ import annotations
 
-import io
 import math
 import os
 from dataclasses import dataclass, field
@@ -174,19 +173,21 @@ class NavGrid:
 
     def to_bytes(self) -> bytes:
         """The npz bytes; a one-level grid's arrays are written as ``(nz, nx)`` (the
-        2002 grids' format, unchanged since before levels existed)."""
-        buf = io.BytesIO()
-        arrays = {k: getattr(self, k) for k in _FIELDS}
+        2002 grids' format, unchanged since before levels existed).  The run numbers
+        are int16 when the grid's sides allow (a run is at most a side long) and the
+        column runs are stored column-major: the loader reads them back as int32."""
+        from ..formats.npz import write_npz
+
+        runs = np.int16 if max(self.shape) <= np.iinfo(np.int16).max else np.int32
+        arrays = {k: getattr(self, k) if k not in _RUN_FIELDS else getattr(self, k).astype(runs) for k in _FIELDS}
         arrays["height"] = np.asarray(self.heights(), dtype=np.float32)
         if self.link is not None:
             arrays["link"] = np.asarray(self.link, dtype=np.int8)
         if self.levels == 1:
             arrays = {k: a[0] for k, a in arrays.items()}
-        np.savez_compressed(
-            buf, origin=np.asarray(self.origin, dtype=np.float64),
-            cell=np.array(float(self.cell)), shape=np.array(self.shape, dtype=np.int64), **arrays,
-        )
-        return buf.getvalue()
+        return write_npz({"origin": np.asarray(self.origin, dtype=np.float64), "cell": np.array(float(self.cell)),
+                          "shape": np.array(self.shape, dtype=np.int64), **arrays},
+                         fortran=("col_index", "col_total"))
 
     @classmethod
     def load(cls, path: str | os.PathLike, runs: bool = True) -> "NavGrid":
@@ -247,10 +248,11 @@ class NavGrid:
         if link is not None and ((link < -1) | (link >= levels)).any():
             raise FormatError(f"{path}: link holds levels outside -1 .. {levels - 1}")
         # copy=False: arrays already of their type are kept, not copied (a 2 km terrain's
-        # grid was read twice over at once: the load's peak of a match on it)
+        # grid was read twice over at once: the load's peak of a match on it); runs
+        # written int16 and column-major (to_bytes) come back int32 and C-ordered
         return cls(
             origin, cell, shape, arrays.pop("valid").astype(bool, copy=False),
-            *(arrays.pop(k).astype(np.int32, copy=False) if runs else None for k in _RUN_FIELDS),
+            *(np.ascontiguousarray(arrays.pop(k), dtype=np.int32) if runs else None for k in _RUN_FIELDS),
             arrays.pop("reachable").astype(bool, copy=False),
             height=None if height is None else height.astype(np.float64, copy=False),
             link=None if link is None else link.astype(np.int8, copy=False),
