@@ -120,13 +120,16 @@ def _draw_nodes(ax, grid: Any, states: np.ndarray, fr: _Frame, labelling: bool) 
     if k > 1:  # a grid of more cells than the picture has pixels: every k-th node
         extent = sampled
     shown = states[::k, ::k]
-    rgba = to_rgba_array(list(STATE_COLOURS.values()))[shown]
+    colours = to_rgba_array(list(STATE_COLOURS.values()))
+    # bytes, as matplotlib turns a float image into (x * 255 truncated): a float RGBA
+    # image of hix's 1604 x 1604 nodes was 82 MB to fill, resample and convert
+    rgba = (colours * 255).astype(np.uint8)[shown]
     relief = fr.relief
     if relief is not None:  # reachable nodes shaded by their height, over their state's colour
         reach = shown == 2
         lo, hi = relief[0], max(relief[1], relief[0] + 1e-6)
         shade = colormaps[HEIGHT_CMAP]((grid.heights()[0, ::k, ::k][reach] - lo) / (hi - lo))
-        rgba[reach] = 0.85 * shade + 0.15 * rgba[reach]
+        rgba[reach] = ((0.85 * shade + 0.15 * colours[2]) * 255).astype(np.uint8)
     # one image, composed here: two (states, then the heights at alpha 0.85) cost
     # matplotlib a second resampling and colour mapping of the whole grid
     ax.imshow(rgba, origin="lower", interpolation="nearest", extent=extent, zorder=0)
