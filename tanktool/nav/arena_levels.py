@@ -90,13 +90,16 @@ def walls_too_close(walls, origin: np.ndarray, cell: float, shape: tuple[int, in
 BAND_NODES = 1 << 20
 
 
-def tank_grid(surface: Surface, lw: LevelWalls, radius: float) -> NavGrid:
-    """The grid of nodes where a tank of ``radius`` fits (exact distance to the walls)."""
+def tank_grid(surface: Surface, lw: LevelWalls, radius: float, runs: bool = True) -> NavGrid:
+    """The grid of nodes where a tank of ``radius`` fits (exact distance to the walls).
+    ``runs`` False: its run arrays empty, never worked out: spawns are chosen by its
+    nodes, links and heights alone (choose_spawns); the runs are 16 bytes a node (0.26
+    GB on a 2 km terrain, where two such grids stacked at the import's peak)."""
     from .walkable import grid_from_surface
 
     origin = surface.hf.origin[[0, 2]]
     tc = walls_too_close(lw.walls, origin, surface.hf.cs, surface.shape, max(surface.levels, 1), radius)
-    return grid_from_surface(surface, radius, origin, too_close=tc)
+    return grid_from_surface(surface, radius, origin, too_close=tc, runs=runs)
 
 
 def grid_components(grid: NavGrid) -> tuple[np.ndarray, int]:
@@ -263,8 +266,8 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
                   progress: Callable[[str], None] | None = None, keep_runs: bool = True) -> ArenaLevels:
     """Everything ``import-arena`` needs to know about a model's levels (module docstring).
 
-    ``keep_runs`` False: the tank grid's run arrays are let go as soon as it is built
-    (empty; 16 bytes a node): for a caller that reads only its nodes, links and heights
+    ``keep_runs`` False: the tank grid is built without its run arrays (empty; 16 bytes
+    a node): for a caller that reads only its nodes, links and heights
     (the import that builds the bundle's grid anew)."""
     step = progress or (lambda _s: None)
     vertices = np.asarray(vertices, dtype=np.float64)
@@ -330,15 +333,6 @@ def keep_for_analysis(surface: Surface) -> None:
     give_back(20 * len(surface.col))   # their pages lie between live arrays: the heap keeps them else
 
 
-def drop_runs(grid: NavGrid) -> NavGrid:
-    """``grid`` without its run arrays (empty): spawns are chosen by its nodes, links
-    and heights alone (choose_spawns); the runs are 16 bytes a node (0.26 GB on a 2 km
-    terrain, where two such grids stacked at the import's peak)."""
-    for k in ("row_index", "row_total", "col_index", "col_total"):
-        setattr(grid, k, np.zeros((0, 0, 0), dtype=getattr(grid, k).dtype))
-    return grid
-
-
 def _no_surface_hint(vertices: np.ndarray, faces: np.ndarray, max_slope: float) -> str:
     """What to try when nothing is walkable: flip the faces when more of the model's
     gentle area faces down than up (a floor wound the wrong way faces down, and like
@@ -370,10 +364,8 @@ def _largest_fit(surface: Surface, lw: LevelWalls, params: WalkableParams, fleet
         if k and radius >= tries[k - 1][1]:
             continue
         fl = fleet if k == 0 else fleet.down_to(name, radius, length)
-        g = tank_grid(surface, lw, radius)
+        g = tank_grid(surface, lw, radius, runs=keep_runs)
         g.climb = params.climb
-        if not keep_runs:
-            drop_runs(g)
         if not g.valid.any():
             problem = problem or (name, radius)   # the refusal is worked out only if it is needed
             why[name] = f"fits nowhere (it needs a circle of {2 * radius:.2f} m)"
@@ -428,7 +420,7 @@ def smaller_vehicles(result: ArenaLevels, fleet: Fleet,
     for name, radius, length in fleet.sizes:
         if radius >= big.radius - 1e-9 or name in out:
             continue
-        g = drop_runs(tank_grid(result.surface, result.walls, radius))   # only its spawns are kept
+        g = tank_grid(result.surface, result.walls, radius, runs=False)   # only its spawns are kept
         g.climb = result.params.climb
         if not g.valid.any():
             continue

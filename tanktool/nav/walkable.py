@@ -434,7 +434,9 @@ def _main_region(hf: Heightfield, col, floor, region, seeds) -> np.ndarray:
             else:
                 pick = near[int(np.argmax(sizes[region[near]]))]
             picked.append(region[pick])
-        return np.isin(region, picked)
+        # the seeds' few regions a compare each: isin's table pass took ~10 of them (hix)
+        picked = np.unique(picked)
+        return np.isin(region, picked) if len(picked) > 4 else np.logical_or.reduce([region == p for p in picked])
     return region == int(np.argmax(sizes))
 
 
@@ -521,14 +523,15 @@ def _grid_links(surface: Surface, exists: np.ndarray, span: np.ndarray) -> np.nd
 
 
 def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray, seeds: np.ndarray | None = None,
-                      too_close: np.ndarray | None = None):
+                      too_close: np.ndarray | None = None, runs: bool = True):
     """The layered navigation grid of a surface (cell = the heightfield's cell).
 
     There is a node wherever the main region has a span (its height and links are
     kept); it is valid where that span's clearance (the voxel chamfer distance, or, when
     ``too_close`` (L, nz, nx) is given, the exact distance to the level's walls) is at
     least ``clearance``.  ``seeds`` (k, 2+) spawn points
-    ``[x, z, ...]`` mark the reachable nodes (all valid nodes when None).
+    ``[x, z, ...]`` mark the reachable nodes (all valid nodes when None); ``runs``:
+    see :func:`grid_from_layers`.
     """
     exists, height, clear, span = surface_layers(surface, clearance=too_close is None)
     if too_close is None:
@@ -542,18 +545,22 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
     # the simulation drives on all of it; runs, reachability and paths use valid nodes.
     link = _grid_links(surface, exists, span).reshape(L, nz, nx, 4)
     del span, exists
-    return grid_from_layers(valid, height, link, clearance, origin_xz, surface.hf.cs, seeds)
+    return grid_from_layers(valid, height, link, clearance, origin_xz, surface.hf.cs, seeds, runs)
 
 
 def grid_from_layers(valid: np.ndarray, height: np.ndarray, link: np.ndarray, clearance: float,
-                     origin_xz: np.ndarray, cell: float, seeds: np.ndarray | None = None):
+                     origin_xz: np.ndarray, cell: float, seeds: np.ndarray | None = None, runs: bool = True):
     """The layered grid of its nodes' layers (:func:`grid_from_surface`'s valid,
     heights and links, kept as they are): runs and the nodes reachable from ``seeds``.
-    Two vehicles' grids of one surface with the same levels share heights and links."""
+    Two vehicles' grids of one surface with the same levels share heights and links.
+    ``runs`` False: the run arrays are left empty, for a caller that reads only the
+    nodes, links and heights (the analysis' spawns: ``arena_levels.tank_grid``)."""
     from .navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3
 
     L, nz, nx = valid.shape
-    ri, rt, ci, ct = layered_runs(valid, link)
+    ri = rt = ci = ct = np.zeros((0, 0, 0), dtype=np.int32)
+    if runs:
+        ri, rt, ci, ct = layered_runs(valid, link)
     seeds_n: list = []
     if seeds is not None and len(seeds):
         reach = int(math.ceil(clearance / cell)) + 2

@@ -128,8 +128,12 @@ def _draw_nodes(ax, grid: Any, states: np.ndarray, fr: _Frame, labelling: bool) 
     if relief is not None:  # reachable nodes shaded by their height, over their state's colour
         reach = shown == 2
         lo, hi = relief[0], max(relief[1], relief[0] + 1e-6)
-        shade = colormaps[HEIGHT_CMAP]((grid.heights()[0, ::k, ::k][reach] - lo) / (hi - lo))
-        rgba[reach] = ((0.85 * shade + 0.15 * colours[2]) * 255).astype(np.uint8)
+        # the colour map's own lookup (a value x is entry int(x * N), 1.0 the last),
+        # blended once per entry and not once per node
+        cmap = colormaps[HEIGHT_CMAP]
+        lut = ((0.85 * cmap(np.arange(cmap.N)) + 0.15 * colours[2]) * 255).astype(np.uint8)
+        x = (grid.heights()[0, ::k, ::k][reach] - lo) / (hi - lo)
+        rgba[reach] = lut[np.clip((x * cmap.N).astype(np.intp), 0, cmap.N - 1)]
     # one image, composed here: two (states, then the heights at alpha 0.85) cost
     # matplotlib a second resampling and colour mapping of the whole grid
     ax.imshow(rgba, origin="lower", interpolation="nearest", extent=extent, zorder=0)
