@@ -73,7 +73,8 @@ def test_the_agent_uses_the_graded_grid_and_the_map_keeps_its_own(bridge):
     drv(w, w.tanks[0])
     agent = drv.bot
     spec = w.tanks[0].spec
-    assert agent.nav.grid is agent_grid(w, 1.0, spec.radius + 0.5, _grade(spec))
+    half = 0.5 * (spec.box[3] - spec.box[1])
+    assert agent.nav.grid is agent_grid(w, 1.0, spec.radius + 0.5, _grade(spec), narrow=half + 0.5)
     assert drv.perceiver.map.grid.layers.valid[:, 6:14, 6:10].sum() > 0
 
 

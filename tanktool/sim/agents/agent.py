@@ -135,7 +135,9 @@ class Nav:
 
         # on relief, no link steeper than the vehicle climbs at a useful speed
         grade = GRADE * vehicle.engine_force / (vehicle.mass * GRAVITY)
-        grid = agent_grid(map, cell, vehicle.radius + margin, grade)
+        # and a deck or ramp joining parts apart driven straight at the hull's half width
+        half = 0.5 * (vehicle.box[3] - vehicle.box[1])
+        grid = agent_grid(map, cell, vehicle.radius + margin, grade, narrow=half + margin)
         plain = agent_grid(map, cell, vehicle.radius + margin)
         views = map.sight_table(grid)
         return grade, grid, plain, views, vantages_for(views, half_angle, vision_range)

@@ -140,13 +140,13 @@ _LAST_WALK: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 def _walked(ground: "Ground", clearance: float, ok_fine: np.ndarray, ii: np.ndarray, jj: np.ndarray,
-            k: int) -> np.ndarray:
+            k: int, remember: bool = True) -> np.ndarray:
     """(L, NZ, NX, 4) int8: the level each coarse node (ii, jj) arrives on after ``k``
     surface steps in each direction, every one on an ``ok_fine`` node (-1: none); the
-    last of each ground kept (read only)."""
+    last of each ground kept (read only; ``remember`` False: neither read nor kept)."""
     key = (clearance, k, len(ii), len(jj))
     try:
-        last = _LAST_WALK.get(ground)
+        last = _LAST_WALK.get(ground) if remember else None
     except TypeError:   # not weakly referable (a stand-in ground): no cache
         last = None
     if last is not None and last[0] == key and last[1] is ground.link:
@@ -166,6 +166,8 @@ def _walked(ground: "Ground", clearance: float, ok_fine: np.ndarray, ii: np.ndar
             rows = ii[r0:r0 + WALK_BAND]
             out[:, r0:r0 + len(rows)] = _walk_band(ground.link, ok_fine, rows, jj, k)
     out.flags.writeable = False
+    if not remember:
+        return out
     try:
         _LAST_WALK[ground] = (key, ground.link, out)
     except TypeError:
@@ -197,14 +199,16 @@ def _walk_band(fl: np.ndarray, ok_fine: np.ndarray, rows: np.ndarray, jj: np.nda
     return out
 
 
-def _cut_grade(link: np.ndarray, heights: np.ndarray, most: float) -> None:
+def _cut_grade(link: np.ndarray, heights: np.ndarray, most: float, uphill_only: bool = False) -> None:
     """Cut (in place) the coarse links rising or falling more than ``most`` metres,
-    a band of rows at a time (in C where it is built: one pass)."""
+    a band of rows at a time (in C where it is built: one pass); ``uphill_only``: only
+    those rising more (a way down a slope it cannot drive back up is kept one way)."""
     L, NZ, NX = heights.shape
     from ...geometry.kernels import active
 
     kern = active()
-    if getattr(kern, "grade_cut", None) is not None and link.flags.c_contiguous and link.dtype == np.int8:
+    if not uphill_only and getattr(kern, "grade_cut", None) is not None and link.flags.c_contiguous \
+            and link.dtype == np.int8:
         kern.grade_cut(link, np.ascontiguousarray(heights, dtype=np.float64), L, NZ, NX, float(most))
         return
     for r0 in range(0, NZ, WALK_BAND):
@@ -216,18 +220,23 @@ def _cut_grade(link: np.ndarray, heights: np.ndarray, most: float) -> None:
             cur = np.where(alive, to, 0)
             ti = np.broadcast_to(np.clip(np.arange(r0, r1)[None, :, None] + di, 0, NZ - 1), cur.shape)
             tj = np.broadcast_to(np.clip(np.arange(NX)[None, None, :] + dj, 0, NX - 1), cur.shape)
-            rise = np.abs(heights[cur, ti, tj] - here)
-            alive &= ~(rise > most)
+            rise = heights[cur, ti, tj] - here
+            alive &= ~((rise if uphill_only else np.abs(rise)) > most)
             link[:, r0:r1, :, d] = np.where(alive, cur, -1)
 
 
 def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: list,
-                      grade: float = math.inf) -> NavGrid:
+                      grade: float = math.inf, narrow: float | None = None, one_way: bool = False) -> NavGrid:
     """The projection grid (one level, see the module docstring) of the layered agent grid,
     which it carries as ``.layers``; ``spawns`` are (x, z, y or None).  ``grade``: a
     link rising or falling more than this per metre is cut both ways (a slope the
     vehicle cannot drive back up: the light tank climbs an 18 degree ramp at 0.25 m/s,
-    and a tank gone down one stays down for the rest of a duel)."""
+    and a tank gone down one stays down for the rest of a duel); ``one_way``: only
+    rising (the way down kept, one way).  ``narrow``: the clearance of a tank driven
+    straight (its half width plus a margin): where the grid at ``clearance`` leaves the
+    spawns in parts apart, straight runs at least ``narrow`` from the edges that join
+    two parts are added (``_narrow_joins``: a deck or ramp narrower than the tank's
+    footprint circle but wider than its hull)."""
     fine = ground.cell
     k = max(int(round(cell / fine)), 1)
     ok_fine = clear_enough(ground, clearance)
@@ -240,10 +249,12 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
     valid = ok_fine[:, ii][:, :, jj]
     heights = ground.h[:, ii][:, :, jj]
     link = _walked(ground, float(clearance), ok_fine, ii, jj, k).copy()
+    walked = link.copy() if one_way and math.isfinite(grade) else None
+    # heights come in voxel steps (CELL_HEIGHT): one step of slack, or a ramp just
+    # under the grade is cut where its steps fall unevenly
+    most = grade * k * fine + CELL_HEIGHT
     if math.isfinite(grade):
-        # heights come in voxel steps (CELL_HEIGHT): one step of slack, or a ramp just
-        # under the grade is cut where its steps fall unevenly
-        _cut_grade(link, heights, grade * k * fine + CELL_HEIGHT)
+        _cut_grade(link, heights, most)
     # coarse node (I, J) sits at the centre of surface node (off + k I, off + k J)
     step = k * fine
     origin = np.array([ground.ox + (off + 0.5) * fine - 0.5 * step, ground.oz + (off + 0.5) * fine - 0.5 * step])
@@ -253,6 +264,16 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
         n = nearest_valid_node3(valid, heights, node, y, int(math.ceil(clearance / step)) + 2)
         if n is not None:
             seeds.append(n)
+    if narrow is not None and narrow < clearance and len(seeds) > 1:
+        joins = _narrow_joins(ground, valid, link, heights, (ii, jj, k), float(clearance), float(narrow), seeds, most)
+        if joins is not None:
+            valid = valid | joins[0]
+            link = np.where(link >= 0, link, joins[1])
+            if walked is not None:
+                walked = np.where(walked >= 0, walked, joins[1])
+    if walked is not None:
+        link = walked
+        _cut_grade(link, heights, most, uphill_only=True)
     reach = layered_reachable(valid, link, seeds) if seeds else valid.copy()
     valid = valid & reach
     link = np.where(valid[..., None], link, -1).astype(np.int8)
@@ -264,6 +285,102 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
                       spawn_nodes=[(0, *n[1:]) for n in seeds])
     grid.layers = layered
     return grid
+
+
+def _labels(valid: np.ndarray, link: np.ndarray) -> np.ndarray:
+    """Components of a layered grid's valid nodes over its links (either way): int32
+    labels, 0 off the valid nodes."""
+    from ...nav.navgrid import compiled_labels
+
+    got = compiled_labels(valid, np.ascontiguousarray(link, dtype=np.int8))
+    if got is not None:
+        return got[0]
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    L, nz, nx = valid.shape
+    base = np.arange(valid.size).reshape(L, nz, nx)
+    src, dst = [base[valid]], [base[valid]]
+    for d in range(4):
+        ok = valid & _target(valid, link, d)
+        src.append(base[ok])
+        dst.append(_target_index(base, link, d)[ok])
+    a, b = np.concatenate(src), np.concatenate(dst)
+    g = coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(valid.size, valid.size))
+    _, lab = connected_components(g, directed=True, connection="weak")
+    return np.where(valid, lab.reshape(L, nz, nx) + 1, 0).astype(np.int32)
+
+
+def _target_index(values: np.ndarray, link: np.ndarray, d: int) -> np.ndarray:
+    """``values`` at the node each link of direction ``d`` reaches (at the node itself
+    where there is no link)."""
+    L, nz, nx = values.shape
+    di, dj = _STEPS[d]
+    lv = link[..., d].astype(np.intp)
+    here = lv < 0
+    i = np.clip(np.arange(nz)[None, :, None] + di, 0, nz - 1)
+    j = np.clip(np.arange(nx)[None, None, :] + dj, 0, nx - 1)
+    I = np.where(here, np.arange(nz)[None, :, None], i)
+    J = np.where(here, np.arange(nx)[None, None, :], j)
+    return values[np.where(here, np.arange(L)[:, None, None], lv), I, J]
+
+
+def _target(mask: np.ndarray, link: np.ndarray, d: int) -> np.ndarray:
+    """Whether the link of direction ``d`` exists and reaches a node of ``mask``."""
+    return (link[..., d] >= 0) & _target_index(mask, link, d)
+
+
+def _narrow_joins(ground: "Ground", valid: np.ndarray, link: np.ndarray, heights: np.ndarray, coarse: tuple,
+                  clearance: float, narrow: float, seeds: list, most: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """(nodes, links) to add to an agent grid whose spawns are in parts apart: straight
+    runs of nodes ``narrow`` m from the edges, along one axis, where the tank driven
+    along that axis has ``clearance`` m of way before and behind (its hull fits, not
+    its turning circle: it turns on the parts' nodes), whose two ends join two
+    different parts -- a deck or ramp barely wider than the hull (tools/make_levels.py's
+    bridge: 8 m, 3.96 m of footprint clearance from each edge).  Runs that join a part
+    to itself (the bands along every edge) are not added: the grid hugs no more edges.
+    None when the spawns are in one part."""
+    part = _labels(valid, link)
+    if len({int(part[s]) for s in seeds}) < 2:
+        return None
+    ii, jj, k = coarse
+    ok_n = _clear_enough(ground, narrow)
+    step = _walked(ground, narrow, ok_n, ii, jj, k, remember=False).copy()
+    if math.isfinite(most):
+        _cut_grade(step, heights, most)
+    room = _walked(ground, narrow, ok_n, ii, jj, int(math.ceil(clearance / ground.cell)), remember=False) >= 0
+    cand = ok_n[:, ii][:, :, jj] & ~valid
+    nodes = np.zeros_like(valid)
+    links = np.full(step.shape, -1, dtype=np.int8)
+    for axis in ((0, 2), (1, 3)):
+        fits = (cand | valid) & room[..., axis[0]] & room[..., axis[1]]
+        own = np.full(step.shape, -1, dtype=np.int8)
+        for d in axis:   # a link of this axis between two nodes the hull fits along it, one end narrow
+            ok = fits & _target(fits, step, d) & (cand | _target(cand, step, d))
+            own[..., d] = np.where(ok, step[..., d], -1)
+        chain = _labels(cand, _only_between(cand, own))
+        pairs = []
+        for d in axis:   # (chain, part) at each end of a chain
+            end = cand & _target(valid, own, d)
+            pairs.append(np.stack([chain[end], _target_index(part, own, d)[end]], axis=1))
+        pairs_a = np.unique(np.concatenate(pairs), axis=0)
+        ids, n = np.unique(pairs_a[:, 0], return_counts=True)
+        keep = np.isin(chain, ids[n >= 2]) & cand
+        if not keep.any():
+            continue
+        nodes |= keep
+        for d in axis:
+            ok = (own[..., d] >= 0) & (keep | _target(keep, own, d))
+            links[..., d] = np.where(ok, own[..., d], links[..., d])
+    return (nodes, links) if nodes.any() else None
+
+
+def _only_between(mask: np.ndarray, link: np.ndarray) -> np.ndarray:
+    """``link`` kept only from and to nodes of ``mask``."""
+    out = np.full(link.shape, -1, dtype=np.int8)
+    for d in range(4):
+        out[..., d] = np.where(mask & _target(mask, link, d), link[..., d], -1)
+    return out
 
 
 _RUN_NAMES = ("row_index", "row_total", "col_index", "col_total")

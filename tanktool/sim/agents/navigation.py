@@ -52,7 +52,8 @@ _GRIDS: "weakref.WeakKeyDictionary[object, dict[tuple[float, float], NavGrid]]" 
 FALLBACK = (0.85, 0.7, 0.55, 0.4, 0.25, 0.0)
 
 
-def agent_grid(world: "World", cell: float, clearance: float, grade: float = math.inf) -> NavGrid:
+def agent_grid(world: "World", cell: float, clearance: float, grade: float = math.inf,
+               narrow: float | None = None, one_way: bool = False) -> NavGrid:
     """The navigation grid agents of this clearance use in ``world`` (cached per wall
     set, or per ground on an arena with relief or levels: then a projection carrying
     the layered grid as ``.layers``, see ``agents.layers``).
@@ -61,14 +62,20 @@ def agent_grid(world: "World", cell: float, clearance: float, grade: float = mat
     the tank), the grid is made again with less (``FALLBACK``), down to every node off
     the walls: its ``clearance`` says which it kept.  Agents then plan as close to the
     walls as they must; the physics keeps them out.  ``grade``: on a ground, links
-    rising or falling more than this per metre are cut (``layers.ground_agent_grid``)."""
+    rising or falling more than this per metre are cut (``layers.ground_agent_grid``),
+    only those rising with ``one_way``; ``narrow``: straight runs this far from the
+    edges that join parts of the grid apart are added (there too)."""
     per = _GRIDS.setdefault(world.ground if world.ground.relief else world.walls, {})
-    grade = float(grade) if world.ground.relief else math.inf
-    key = (float(cell), float(clearance)) if not math.isfinite(grade) else (float(cell), float(clearance), grade)
+    relief = world.ground.relief
+    grade = float(grade) if relief else math.inf
+    key: tuple = (float(cell), float(clearance)) if not math.isfinite(grade) else (float(cell), float(clearance), grade)
+    extra = (narrow if relief else None, bool(one_way and relief and math.isfinite(grade)))
+    if extra != (None, False):   # the keys of the grids before these options unchanged
+        key += extra
     if key not in per:
         grid = None
         for c in (clearance, *(clearance * f for f in FALLBACK)):
-            grid = _make_grid(world, cell, c, grade)
+            grid = _make_grid(world, cell, c, grade, narrow=extra[0], one_way=extra[1])
             if grid.spawn_nodes and grid.valid.any():
                 break
         per[key] = grid
@@ -81,12 +88,13 @@ def strict_grid(world: "World", cell: float, clearance: float) -> NavGrid:
     return _make_grid(world, cell, clearance)
 
 
-def _make_grid(world: "World", cell: float, clearance: float, grade: float = math.inf) -> NavGrid:
+def _make_grid(world: "World", cell: float, clearance: float, grade: float = math.inf,
+               narrow: float | None = None, one_way: bool = False) -> NavGrid:
     if world.ground.relief:  # a flat ground: the 2002 grid of the walls
         from .layers import ground_agent_grid
 
         spawns = [(x, z, y) for (x, z, _), y in zip(world.spawns, world.spawn_y)]
-        return ground_agent_grid(world.ground, cell, clearance, spawns, grade)
+        return ground_agent_grid(world.ground, cell, clearance, spawns, grade, narrow=narrow, one_way=one_way)
     bounds = np.asarray(world.bounds, dtype=np.float64)
     shape = grid_shape(bounds, cell)
     origin = bounds[0].copy()

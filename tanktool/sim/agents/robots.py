@@ -26,10 +26,19 @@ opponents held back to judge the agents, not copies), to measure the agents agai
 They drive with the agents' pilot (``driving.Pilot``: speed control and wall feelers,
 so a yardstick does not lose by bumping into walls); their randomness is the view's
 generator, so duels replay exactly.
+
+On relief they plan on a grid of what the tank can drive (``yardstick_grid``): no way
+up a slope steeper than it climbs (the way down one kept, one way), and decks and
+ramps wider than the hull joined where the footprint circle leaves them out.  Driving
+and not getting anywhere (under ``NO_PROGRESS`` m in ``NO_PROGRESS_S`` s: rocking on a
+ramp too steep, wedged at a ramp's side) they back out and plan round that spot for
+``AVOID_S`` s (``Yardstick.recover``) -- tools/make_levels.py's bridge once stranded
+the robot at a ramp's foot for the rest of every other duel.
 """
 
 from __future__ import annotations
 
+import copy
 import math
 from typing import TYPE_CHECKING
 
@@ -43,6 +52,7 @@ from .sight import vantages_for
 from .perception import Sighting, wrap
 
 if TYPE_CHECKING:  # pragma: no cover
+    from ...nav.navgrid import NavGrid
     from ..bots import View
 
 #: the robot and the duellist plan their way to the enemy this often [s]
@@ -55,6 +65,52 @@ EXACT = 0.35
 #: the duellist holds this range of distances [m], strafing, flipping after a time in FLIP [s]
 HOLD = (25.0, 40.0)
 FLIP = (0.8, 2.2)
+#: the steepest way up of their grid on relief, as a share of the steepest slope the
+#: engine holds the tank on (the agents' ``agent.GRADE``: slower is a stall)
+CLIMB = 0.8
+#: no progress: driving, and under NO_PROGRESS m [m] in NO_PROGRESS_S s [s]; then the
+#: spot (AVOID_R m round the way ahead [m]) is planned round for AVOID_S s [s]
+NO_PROGRESS = 1.0
+NO_PROGRESS_S = 2.5
+AVOID_R = 3.0
+AVOID_S = 12.0
+#: off its grid on a slope steeper than this (rise a metre), it drives up it first
+SLOPE = 0.1
+
+
+def yardstick_grid(view: "View", one_way: bool = True) -> "NavGrid":
+    """The grid the yardsticks plan on: the map's (1 m nodes, footprint radius + 0.5 m
+    off the walls), on relief with the grade the tank climbs cut uphill only (both
+    ways: ``one_way`` False, where it can come back from), and the runs as wide as the
+    hull + 0.5 m joining parts apart (``navigation.agent_grid``)."""
+    m, v = view.map, view.me.vehicle
+    if not m.relief:
+        return m.grid
+    from ..rules import GRAVITY
+    from .navigation import agent_grid
+
+    half = 0.5 * (v.box[3] - v.box[1])
+    return agent_grid(m, 1.0, v.radius + 0.5, CLIMB * v.engine_force / (v.mass * GRAVITY),
+                      narrow=half + 0.5, one_way=one_way)
+
+
+def without(grid: "NavGrid", x: float, z: float, r: float) -> "NavGrid":
+    """A copy of ``grid`` (and of its layered grid) with the nodes within ``r`` m of
+    (x, z) taken out, on every level."""
+    def cut(g: "NavGrid") -> "NavGrid":
+        out = copy.copy(g)
+        out.__dict__.pop("_kernel_arrays", None)    # nav.path's cache of the valid nodes
+        ci, cj = g.node_of(x, z)
+        k = int(math.ceil(r / g.cell))
+        valid = g.valid.copy()
+        valid[:, max(ci - k, 0):ci + k + 1, max(cj - k, 0):cj + k + 1] = False
+        out.valid = valid
+        return out
+
+    out = cut(grid)
+    if getattr(grid, "layers", None) is not None:
+        out.layers = cut(grid.layers)
+    return out
 
 
 class Yardstick(Pilot):
@@ -67,24 +123,102 @@ class Yardstick(Pilot):
         super().__init__()
         self.path: list[tuple[float, float]] = []
         self.planned_at = -math.inf
+        self.grid: "NavGrid | None" = None
+        self.home: "NavGrid | None" = None      # its grid without the ways down it cannot come back up
+        # (until, x, z): a spot it got nowhere at, planned round until then
+        self.avoid: tuple[float, float, float] | None = None
+        self.avoid_grid: "NavGrid | None" = None
+        self.moved: tuple[float, float, float] = (-math.inf, math.nan, math.nan)
 
     def act(self, view: "View") -> Command:
         if not view.me.alive:
             self.reset()
             return IDLE
-        return self.think(view)
+        if self.grid is None:
+            self.grid, self.home = yardstick_grid(view), yardstick_grid(view, one_way=False)
+        back = self.back_on_grid(view)
+        return back if back is not None else self.think(view)
+
+    def back_on_grid(self, view: "View") -> Command | None:
+        """Off its grid on a slope (more than ``SLOPE`` rise a metre) with its grid a few
+        metres uphill -- a spawn at the top of a ramp too steep, where a tank that
+        stands to shoot slides down and stays down: straight up onto it first, no
+        strafe (the pilot's push off the walls of the ramp's level strafed it down)."""
+        m, me = view.map, view.me
+        layers = getattr(self.home, "layers", None)
+        if not m.relief or layers is None or self._on_grid(layers, me.x, me.z, me.y):
+            return None
+        g, lv, h = m.ground, me.level, 1.5
+        gx = g.height(me.x + h, me.z, lv) - g.height(me.x - h, me.z, lv)
+        gz = g.height(me.x, me.z + h, lv) - g.height(me.x, me.z - h, lv)
+        n = math.hypot(gx, gz)
+        if n / (2.0 * h) <= SLOPE:
+            return None
+        if not any(self._on_grid(layers, me.x + r * gx / n, me.z + r * gz / n, me.y + 0.5 * r * n / h, 1.5)
+                   for r in (2.0, 4.0, 6.0)):
+            return None
+        err = wrap(math.atan2(gz, gx) - me.heading)
+        return Command(advance=1.0 if abs(err) < 0.8 else 0.0, rotate=self.turn(me, err), strafe=0.0)
+
+    @staticmethod
+    def _on_grid(layers: "NavGrid", x: float, z: float, y: float, within: float = 1.0) -> bool:
+        i, j = layers.node_of(x, z)
+        nz, nx = layers.valid.shape[1:]
+        if not (0 <= i < nz and 0 <= j < nx):
+            return False
+        col = layers.height[:, i, j]
+        return bool(np.any(layers.valid[:, i, j] & (np.abs(np.nan_to_num(col, nan=1e9) - y) <= within)))
+
+    def plan(self, view: "View", goal: tuple[float, ...]) -> list[tuple[float, float]]:
+        """A* waypoints from here to ``goal`` on its grid, round the spot it got nowhere
+        at while that is remembered (straight on its grid when that leaves no way)."""
+        me = view.me
+        start = (me.x, me.z, me.y)
+        grid = self.grid if self.grid is not None else view.map.grid
+        if self.avoid is not None and view.t < self.avoid[0]:
+            if self.avoid_grid is None:
+                self.avoid_grid = without(grid, self.avoid[1], self.avoid[2], AVOID_R)
+            path = view.map.path(start, goal, self.avoid_grid)
+            if path:
+                return path
+        return view.map.path(start, goal, grid)
+
+    def recover(self, view: "View", cmd: Command) -> Command:
+        """The pilot's unstick, and over it: driving (a path being followed) and under
+        ``NO_PROGRESS`` m in ``NO_PROGRESS_S`` s -- rocking on a slope too steep, held
+        at a ramp's side -- the spot ahead on its way is avoided for ``AVOID_S`` s and it
+        backs out, turning, and plans afresh round it."""
+        me, t = view.me, view.t
+        t0, x0, z0 = self.moved
+        driving = bool(self.path) and abs(cmd.advance) >= 0.3
+        if not driving or not math.isfinite(x0) or math.hypot(me.x - x0, me.z - z0) >= NO_PROGRESS:
+            self.moved = (t, me.x, me.z)
+        elif t - t0 >= NO_PROGRESS_S:
+            ax, az = self.path[0]
+            d = math.hypot(ax - me.x, az - me.z) or 1.0
+            ahead = min(d, AVOID_R)
+            self.avoid = (t + AVOID_S, me.x + (ax - me.x) / d * ahead, me.z + (az - me.z) / d * ahead)
+            self.avoid_grid = None
+            self.moved = (t + 0.8, math.nan, math.nan)
+            self.reverse_until = t + 0.8
+            self.reverse_turn = 1.0 if view.rng.random() < 0.5 else -1.0
+            self._replan()
+            return self.drive(view, -4.0, 0.0, self.reverse_turn)
+        return self.unstick(view, cmd)
 
     def think(self, view: "View") -> Command:  # pragma: no cover - abstract
         raise NotImplementedError
 
     def reset(self) -> None:
         self.path, self.planned_at = [], -math.inf
+        self.avoid, self.avoid_grid, self.moved = None, None, (-math.inf, math.nan, math.nan)
 
     def _on_path(self) -> bool:
         return bool(self.path)
 
     def _replan(self) -> None:
         self.path = []
+        self.planned_at = -math.inf
 
     def clear_line(self, view: "View", e: Sighting) -> bool:
         """Nothing between the guns, and the enemy within the shells' range."""
@@ -96,7 +230,7 @@ class Yardstick(Pilot):
         """Along an A* path to ``e``, planned again every ``REPLAN`` s."""
         me = view.me
         if view.t >= self.planned_at + REPLAN or not self.path:
-            self.path = view.map.path((me.x, me.z, me.y), (e.x, e.z, e.y))
+            self.path = self.plan(view, (e.x, e.z, e.y))
             self.planned_at = view.t
         trim(self.path, me.x, me.z)
         return self.follow(view, self.path, speed=1.0, lookahead=4.0, corner=self.path[0] if self.path else None)
@@ -127,7 +261,7 @@ class Robot(Yardstick):
         cmd = self.pursue(view, e)
         if lateral is not None:      # dodging on the way: across the shell's path, steering on
             return self.drive(view, lateral[0], lateral[1], cmd.rotate)
-        return self.unstick(view, cmd)
+        return self.recover(view, cmd)
 
     def _shoot(self, view: "View", e: Sighting, lateral: tuple[float, float] | None) -> Command:
         me = view.me
@@ -206,7 +340,7 @@ class Camper(Yardstick):
         b = int(np.argmax(score))
         self.spot = (float(views.points[b][0]), float(views.points[b][1]))
         self.face = float(vantages_for(views, sn.half_angle, sn.vision_range).block_face[b])
-        self.path = view.map.path((me.x, me.z, me.y), (*self.spot, float(views.heights[b])))
+        self.path = self.plan(view, (*self.spot, float(views.heights[b])))
 
     def think(self, view: "View") -> Command:
         t, me = view.t, view.me
@@ -226,7 +360,7 @@ class Camper(Yardstick):
         gx, gz = self.spot  # type: ignore[misc]
         if math.hypot(gx - me.x, gz - me.z) > 2.5 and self.path:
             trim(self.path, me.x, me.z)
-            return self.unstick(view, self.follow(view, self.path, speed=1.0, lookahead=4.0, corner=self.path[0],
+            return self.recover(view, self.follow(view, self.path, speed=1.0, lookahead=4.0, corner=self.path[0],
                                                   stop=True))
         face = self.face + 0.35 * math.sin(0.5 * t)
         if self.turn_to is not None and t < self.turn_to[1]:
@@ -252,7 +386,7 @@ class Duellist(Yardstick):
             return self.drive(view, 0.0, 0.0, 0.0)
         e = view.radar[0]
         if not self.clear_line(view, e):
-            return self.unstick(view, self.pursue(view, e))
+            return self.recover(view, self.pursue(view, e))
         me, t = view.me, view.t
         err, fire = self.exact_shot(view, e)
         top = me.vehicle.top_speed
