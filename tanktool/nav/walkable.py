@@ -409,7 +409,9 @@ def _main_region(hf: Heightfield, col, floor, region, seeds) -> np.ndarray:
     the largest region among the column's spans), else the largest region."""
     if len(col) == 0:
         return np.zeros(0, dtype=bool)
-    sizes = np.bincount(region)
+    # counted only when asked: labels run up to the span count (hix: 20 ms a count), and
+    # seeds with their heights (a bundle's spawns) never ask
+    sizes = np.zeros(0, dtype=np.int64)
     if seeds is not None and len(seeds):
         nz, nx = hf.shape
         s = np.asarray(seeds, dtype=np.float64).reshape(len(seeds), -1)
@@ -432,12 +434,13 @@ def _main_region(hf: Heightfield, col, floor, region, seeds) -> np.ndarray:
                 y = hf.origin[1] + floor[near] * hf.ch
                 pick = near[int(np.argmin(np.abs(y - s[k, -1])))]
             else:
+                sizes = sizes if len(sizes) else np.bincount(region)
                 pick = near[int(np.argmax(sizes[region[near]]))]
             picked.append(region[pick])
         # the seeds' few regions a compare each: isin's table pass took ~10 of them (hix)
         picked = np.unique(picked)
         return np.isin(region, picked) if len(picked) > 4 else np.logical_or.reduce([region == p for p in picked])
-    return region == int(np.argmax(sizes))
+    return region == int(np.argmax(np.bincount(region)))
 
 
 def surface_layers(surface: Surface, clearance: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray | None,
