@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..bots import IDLE, Command
 from ..rules import GRAVITY
+from .belief import HEARD, SEEN, Belief
 from .combat import CAMP_MEMORY, CAMP_SPEED, OUTGUNNED, WAIT_COOLDOWN, WAIT_NEAR, Attack, Evade, Hunt, LieInWait, ReturnFire
 from .difficulty import DIFFICULTIES, Difficulty, difficulty
 from .dodge import Evasion
@@ -125,6 +126,8 @@ class Nav:
         self.regions = Memory(self.grid, region=16.0)
         self.wanderer = Wanderer(self.grid, self.regions, rng)
         self.coverage = Coverage(self.views, half_angle, vision_range)
+        m = view.map
+        self.belief = Belief(self.views, [(x, z, y) for (x, z, _), y in zip(m.spawns, m.spawn_y)])
 
     @staticmethod
     def tables(map: Any, vehicle: Any, cell: float, margin: float, half_angle: float,
@@ -276,7 +279,9 @@ class Agent(Pilot):
         """Perceive, take the transitions that hold, act."""
         me, nav = view.me, self.nav
         nav.regions.visit(me.x, me.z, view.t)  # type: ignore[union-attr]
-        nav.coverage.look(me.x, me.z, me.heading, view.t, me.y)  # type: ignore[union-attr]
+        looked = nav.coverage.look(me.x, me.z, me.heading, view.t, me.y)  # type: ignore[union-attr]
+        if self.level.hunt:
+            self._believe(view, looked)
         p = self.memory.digest(view, self.level)
         cmd = self.machine.think(self, view, p, lambda: self.drive(view, 0.0, 0.0, 0.0))
         up = self.off_slope(view)
@@ -285,6 +290,22 @@ class Agent(Pilot):
         # fighting too: wedged on a ramp's side (37 degrees of pitch, the gen-bridge),
         # hard pushed forward and sideways at 0.1 m/s for the rest of a duel, 0-0
         return self.unstick(view, cmd, strafe=self.state == "attack")
+
+    def _believe(self, view: "View", looked: Any) -> None:
+        """Where the enemy probably is (``belief.Belief``), from this think's view:
+        spread since the last, nobody in the blocks looked at but those an enemy is
+        seen in, the sightings, the noises heard, the kills in the feed."""
+        b, views, me = self.nav.belief, self.nav.views, view.me  # type: ignore[union-attr]
+        if not math.isfinite(b.t):
+            b.start(view.t, int(looked[0]) if len(looked) else -1)
+        b.spread(view.t, me.vehicle.top_speed)
+        b.looked(looked)
+        if any(e.kind == "kill" and e.other != me.index for e in view.events):
+            b.respawned()
+        for s in view.seen:
+            b.at(views.cell_at(s.x, s.z, s.y), SEEN)
+        for h in (*view.heard, *view.engines):
+            b.at(views.cell_at(h.x, h.z, h.y), HEARD)
 
     def evade_shells(self, view: "View", cmd: Command) -> Command:
         """Dodge a shell seen flying at it (``dodge.Evasion``: noticed after the level's

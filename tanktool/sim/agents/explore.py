@@ -215,12 +215,34 @@ class Search(State["Agent"]):
     def __init__(self) -> None:
         self.plan: SearchPlan | None = None
         self.goal: tuple[float, ...] | None = None
+        self.cell, self.gain, self.recheck = -1, 0.0, -math.inf
 
     def enter(self, agent: "Agent", view: "View", p: "Percept", arg: Any) -> None:
         """``arg``: (x, z) or (x, z, height) to search from (the height: which level first)."""
         where = arg if isinstance(arg, tuple) else (view.me.x, view.me.z, view.me.y)
         self.plan = SearchPlan(agent.nav.grid, where[0], where[1], y=where[2] if len(where) > 2 else None)
         self.goal = None
+        self.cell, self.gain, self.recheck = -1, 0.0, -math.inf
+
+    def _hunt(self, agent: "Agent", view: "View") -> tuple[float, ...] | None:
+        """Hunting (``Difficulty.hunt``): the block whose sight holds the most of where
+        the enemy may be by now (``belief.Belief.goal``), not the next quadrant."""
+        nav, me = agent.nav, view.me
+        best = nav.belief.goal(nav.coverage.sees, nav.views.cell_at(me.x, me.z, me.y))
+        if best is None:
+            return None
+        self.cell, self.gain = best
+        self.recheck = view.t + 1.0
+        gx, gz = nav.views.points[self.cell]
+        return float(gx), float(gz), float(nav.views.heights[self.cell])
+
+    def _spent(self, agent: "Agent", t: float) -> bool:
+        """Hunting: the goal's block sees less than half what it did when chosen
+        (looked at on the way, or the enemy seen or heard elsewhere); asked once a second."""
+        if not agent.level.hunt or self.cell < 0 or t < self.recheck:
+            return False
+        self.recheck = t + 1.0
+        return agent.nav.belief.gain(agent.nav.coverage.sees, self.cell) < 0.5 * self.gain
 
     def update(self, agent: "Agent", view: "View", p: "Percept") -> Command | None:
         t, me = view.t, view.me
@@ -238,14 +260,14 @@ class Search(State["Agent"]):
             trim(agent.path, x, z)
             if agent.path and math.hypot(agent.path[-1][0] - x, agent.path[-1][1] - z) > 4.0:
                 return agent.approach(view, agent.path, known, 0.5 * me.vehicle.top_speed)
-        if self.goal is not None and math.hypot(self.goal[0] - x, self.goal[1] - z) < 4.0:
+        if self.goal is not None and (math.hypot(self.goal[0] - x, self.goal[1] - z) < 4.0 or self._spent(agent, t)):
             self.goal, agent.path = None, []
         tries = 0
         while self.goal is None or not agent.path:
             tries += 1
             if tries > 3:
                 return agent.follow(view, [], speed=0.0, lookahead=4.0) if self.goal else None
-            self.goal = self.plan.next_goal(agent.nav.regions, t)
+            self.goal = self._hunt(agent, view) if agent.level.hunt else self.plan.next_goal(agent.nav.regions, t)
             if self.goal is None:
                 return None
             agent.path = view.map.path((x, z, me.y), self.goal, agent.nav.grid)

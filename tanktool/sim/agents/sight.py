@@ -254,20 +254,24 @@ class Coverage:
         self.seen = np.full(len(views), -math.inf)
         self.sees = (views.visible & (views.distance <= vision_range)).astype(np.float64)
 
-    def look(self, x: float, z: float, heading: float, t: float, y: float | None = None) -> None:
+    def look(self, x: float, z: float, heading: float, t: float, y: float | None = None) -> np.ndarray:
+        """Mark the blocks in sight now as seen at ``t``; returns them (the block it
+        stands in first)."""
         v = self.views
         c = v.cell_at(x, z, y)
         if c < 0:
-            return
+            return np.zeros(0, dtype=np.int64)
         self.seen[c] = t
         cand = np.flatnonzero(self.sees[c])
         if len(cand) == 0:
-            return
+            return np.array([c], dtype=np.int64)
         p = v.points[cand]
         dx, dz = p[:, 0] - x, p[:, 1] - z
         ang = np.abs(np.remainder(np.arctan2(dz, dx) - heading + math.pi, 2.0 * math.pi) - math.pi)
         near = dx * dx + dz * dz < (0.75 * v.k * v.grid.cell) ** 2
-        self.seen[cand[(ang <= self.half_angle) | near]] = t
+        cells = cand[(ang <= self.half_angle) | near]
+        self.seen[cells] = t
+        return np.concatenate(([c], cells))
 
     def staleness(self, t: float) -> np.ndarray:
         age = t - self.seen
