@@ -129,8 +129,10 @@ def import_arena(
     n_faces, model_left_out = len(mesh.faces), list(scene.metadata.get("left_out", []))
     del mesh   # scene.dump()'s copy: the analysis keeps the arrays it needs (vertices, faces)
     preview = _preview(name, result)   # drawn while the analysis is whole
-    _before_vehicles(result, grid)
+    _before_vehicles(result)
     others = _vehicle_grids(result, fleet, remark)
+    if grid:
+        result.grid = None   # the grid stage builds the bundle's own (ImportResult.grid holds it)
     fits = _remark_fit(model, result, fleet, remark, others)
     nav["cell"] = float(params.cell)
     companions = _companion_files(model)
@@ -163,12 +165,13 @@ def _collector(warn: Callable[[str], None] | None) -> tuple[list[str], Callable[
     return remarks, remark
 
 
-def _before_vehicles(result: Any, grid: bool) -> None:
+def _before_vehicles(result: Any) -> None:
     """Let go of what the smaller vehicles' grids and spawns do not read, once the
     report and the preview are done: of the surface all but its spans' columns, levels,
     heights and links (its clearance, regions, floors, ceilings and the heightfield's
-    spans), and the tank grid when the grid stage builds the bundle's own.  On a 2 km
-    terrain ~1 GB, which the smaller vehicle's grid stacked on (the import's peak)."""
+    spans).  On a 2 km terrain ~1 GB, which the smaller vehicle's grid stacked on (the
+    import's peak).  The tank grid stays: the smaller vehicles' grids share its nodes'
+    heights and links (arena_levels.tank_grid ``like``), which they built again else."""
     s = result.surface
     for k in ("floor", "ceil", "region", "main"):   # the grids read none of these
         a = getattr(s, k)
@@ -176,8 +179,6 @@ def _before_vehicles(result: Any, grid: bool) -> None:
     s.clearance = None
     s.derived.clear()
     s.hf = s.hf.geometry()
-    if grid:
-        result.grid = None   # ImportResult.grid holds the grid written with the bundle
     gc.collect()   # the preview's figure is cyclic garbage holding its images (~0.1 GB on 2 km)
     give_back(GIVE_BACK_MIN)
 
@@ -201,8 +202,8 @@ def _preview(name: str, result: Any) -> bytes:
 def _let_go(result: Any) -> None:
     """Drop the analysis' large arrays once the files are staged: its surface (~100
     bytes a grid column: 0.5 GB on a 1 km terrain at 0.5 m) and the model it holds; let
-    go before the grid stage (2 km terrain: ~0.9 GB).  The tank grid went already
-    (:func:`_before_vehicles`)."""
+    go before the grid stage (2 km terrain: ~0.9 GB).  The tank grid went already,
+    once the smaller vehicles' grids no longer shared it."""
     result.surface = None
     result.vertices = result.faces = None
     give_back(GIVE_BACK_MIN)

@@ -90,15 +90,21 @@ def walls_too_close(walls, origin: np.ndarray, cell: float, shape: tuple[int, in
 BAND_NODES = 1 << 20
 
 
-def tank_grid(surface: Surface, lw: LevelWalls, radius: float, runs: bool = True) -> NavGrid:
+def tank_grid(surface: Surface, lw: LevelWalls, radius: float, runs: bool = True,
+              like: NavGrid | None = None) -> NavGrid:
     """The grid of nodes where a tank of ``radius`` fits (exact distance to the walls).
     ``runs`` False: its run arrays empty, never worked out: spawns are chosen by its
     nodes, links and heights alone (choose_spawns); the runs are 16 bytes a node (0.26
-    GB on a 2 km terrain, where two such grids stacked at the import's peak)."""
-    from .walkable import grid_from_surface
+    GB on a 2 km terrain, where two such grids stacked at the import's peak).  ``like``:
+    another tank's grid of this surface, whose nodes (a finite height), heights and
+    links are this one's (shared, not scattered from the surface again)."""
+    from .walkable import grid_from_layers, grid_from_surface
 
     origin = surface.hf.origin[[0, 2]]
     tc = walls_too_close(lw.walls, origin, surface.hf.cs, surface.shape, max(surface.levels, 1), radius)
+    if like is not None and like.height is not None and like.link is not None:
+        return grid_from_layers(np.isfinite(like.height) & ~tc, like.height, like.link, radius, origin,
+                                surface.hf.cs, runs=runs)
     return grid_from_surface(surface, radius, origin, too_close=tc, runs=runs)
 
 
@@ -420,7 +426,7 @@ def smaller_vehicles(result: ArenaLevels, fleet: Fleet,
     for name, radius, length in fleet.sizes:
         if radius >= big.radius - 1e-9 or name in out:
             continue
-        g = tank_grid(result.surface, result.walls, radius, runs=False)   # only its spawns are kept
+        g = tank_grid(result.surface, result.walls, radius, runs=False, like=result.grid)   # only its spawns are kept
         g.climb = result.params.climb
         if not g.valid.any():
             continue
