@@ -241,7 +241,7 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     L = max(len(result.levels), 1)
     w = max(xmax - xmin, 1e-6)
     h = max(zmax - zmin, 1e-6)
-    exists, height = surface_layers(surface, clearance=False)[:2]   # not the span indices (bound to _)
+    exists, height = _played_layers(result, surface_layers)
     nz, nx = hf.shape
     step, extent = image_step((nz, nx), hf.origin[[0, 2]], hf.cs)
     ys = height[exists]
@@ -289,6 +289,16 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", metadata={"Software": None})
     return buf.getvalue()
+
+
+def _played_layers(result: Any, surface_layers: Any) -> tuple[np.ndarray, np.ndarray]:
+    """(exists, height) (L, nz, nx) of the played region: the tank grid's heights when it
+    has them (grid_from_surface scattered these very layers; a node where the height is
+    finite), else surface_layers' (not its span indices)."""
+    s, g = result.surface, result.grid
+    if g is not None and g.height is not None and g.height.shape == (max(s.levels, 1), *s.hf.shape):
+        return np.isfinite(g.height), g.height
+    return surface_layers(s, clearance=False)[:2]
 
 
 def _walls_and_spawns(ax: Any, result: Any, lv: int, tick: float, arrow: float) -> None:
