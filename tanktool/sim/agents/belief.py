@@ -42,6 +42,8 @@ MISSED = 0.1
 #: likely (there may be other enemies; a sound's place is rough)
 SEEN = 0.9
 HEARD = 0.7
+#: a search is over once the belief's mean is above this (it may be anywhere)
+LOST = 0.5
 #: the way's cost of the look itself [m] (goal: possibility in sight per metre + D0)
 D0 = 30.0
 
@@ -100,6 +102,11 @@ class Belief:
     def respawned(self) -> None:
         """An enemy died: it comes back at a spawn point."""
         np.maximum(0.2 * self.p, self._spawned(), out=self.p)
+
+    def spread_out(self) -> bool:
+        """The enemy may be anywhere in most of the arena (``LOST`` of it on
+        average): a search for it has nothing to go on any more."""
+        return float(self.p.mean()) > LOST
 
     def goal(self, sees: np.ndarray, here: int) -> tuple[int, float] | None:
         """(block, the possibility in its sight) to go and look from: the most in sight

@@ -88,7 +88,7 @@ DIFFICULTIES: dict[str, Difficulty] = {
                        dodge_reaction=math.inf, engage=25.0, stand_off=25.0, watch=False, trigger=1.6),
     "normal": Difficulty("normal", reaction=0.3, aim_noise=math.radians(1.5), vision_range=90.0,
                          hearing_radius=80.0, think_hz=15.0, engine_radius=35.0, lead=1.0, fire_tolerance=0.7,
-                         dodge_reaction=0.45, engage=40.0, stand_off=45.0, cover=True, hunt=True),
+                         dodge_reaction=0.45, engage=40.0, stand_off=45.0, cover=True),
     "hard": Difficulty("hard", reaction=0.1, aim_noise=math.radians(0.3), vision_range=130.0,
                        hearing_radius=120.0, think_hz=20.0, engine_radius=40.0, lead=1.0, fire_tolerance=0.5,
                        dodge_reaction=0.25, engage=50.0, stand_off=55.0, hedge=0.35, cover=True, wait=True,

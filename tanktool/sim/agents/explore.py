@@ -226,8 +226,13 @@ class Search(State["Agent"]):
 
     def _hunt(self, agent: "Agent", view: "View") -> tuple[float, ...] | None:
         """Hunting (``Difficulty.hunt``): the block whose sight holds the most of where
-        the enemy may be by now (``belief.Belief.goal``), not the next quadrant."""
+        the enemy may be by now (``belief.Belief.goal``), not the next quadrant; None
+        (done) once it may be anywhere (``Belief.spread_out``): leading, it then lies
+        in wait (against a robot that comes straight at it, searching on for 60 s
+        drove normal into its fire: 4-0-2 -> 2-2-2 in the maze)."""
         nav, me = agent.nav, view.me
+        if nav.belief.spread_out():
+            return None
         best = nav.belief.goal(nav.coverage.sees, nav.views.cell_at(me.x, me.z, me.y))
         if best is None:
             return None
