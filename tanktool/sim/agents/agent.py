@@ -102,7 +102,7 @@ TRANSITIONS = tuple(Transition(*row) for row in (
     (_ROAM, "heard", "search", "from the shot or engine heard"),
     (_ROAM, "hit_unseen", "search", "from behind"),
     (("search",), "heard_again", "search", "a new noise after 2 s of searching"),
-    (("search",), "done", "wander", "every quadrant, or 60 s"),
+    (("search",), "done", "wander", "every quadrant (hunting: it may be anywhere by now), or 60 s"),
     (_ROAM, "leading", "ambush", "kills above deaths"),
     (("ambush",), "done", "wander", "not leading any more"),
     (("wander",), "vantage", "watch", "an arena with a vantage point"),
