@@ -86,3 +86,22 @@ def test_a_yardstick_getting_nowhere_backs_out_and_plans_round_the_spot():
     w.tanks[0].place(5.65, 5.65, 0.785)
     path = bot.plan(drv.perceiver.view(w, drv.rng), (98.26, 98.26))
     assert path and all(math.hypot(x - ax, z - az) > robots.AVOID_R - 1.0 for x, z in path[:-1])
+
+
+def test_a_yardstick_spawned_at_a_ramps_top_stays_up_and_fights(bridge):
+    """The spawn at the west ramp's top (18 degrees, steeper than the light tank climbs):
+    the robot, shooting at an enemy on the other plateau, slid down it and was stranded
+    at its foot; now it drives up onto its grid first and its moves stop short of the ramp."""
+    w = _world(bridge)
+    me, other = w.tanks
+    me.x, me.z, me.heading = 6.589, 15.6209, 0.406411
+    w.stand(me, 4.95)
+    other.x, other.z = 55.7, 23.9
+    w.stand(other, 5.0)
+    drv = driver(Robot(), 1)
+    lowest = me.y
+    for _ in range(int(20.0 / w.dt)):
+        w.step(None, [drv(w, me), IDLE])
+        w.protected_until = [math.inf, math.inf]     # nobody dies: where it drives is the point
+        lowest = min(lowest, me.y)
+    assert lowest > 3.5 and me.y > 4.5

@@ -76,6 +76,10 @@ AVOID_R = 3.0
 AVOID_S = 12.0
 #: off its grid on a slope steeper than this (rise a metre), it drives up it first
 SLOPE = 0.1
+#: driving up onto its grid for longer than this [s] is given up for twice as long
+CLIMB_S = 6.0
+#: the rise a metre its grid's links allow (about; the trap test's slack) [m/m]
+CLIMB_RISE = 0.25
 
 
 def yardstick_grid(view: "View", one_way: bool = True) -> "NavGrid":
@@ -129,6 +133,7 @@ class Yardstick(Pilot):
         self.avoid: tuple[float, float, float] | None = None
         self.avoid_grid: "NavGrid | None" = None
         self.moved: tuple[float, float, float] = (-math.inf, math.nan, math.nan)
+        self.climb = (math.inf, -math.inf)      # (driving up onto its grid since, not again until)
 
     def act(self, view: "View") -> Command:
         if not view.me.alive:
@@ -136,14 +141,23 @@ class Yardstick(Pilot):
             return IDLE
         if self.grid is None:
             self.grid, self.home = yardstick_grid(view), yardstick_grid(view, one_way=False)
-        back = self.back_on_grid(view)
+        back = self.back_on_grid(view) if view.t >= self.climb[1] else None
+        if back is None:
+            self.climb = (math.inf, self.climb[1])
+        elif view.t - min(self.climb[0], view.t) > CLIMB_S:
+            # not up in that time: wedged on something, not on a slope; the rest (and
+            # its recovery) for a while
+            self.climb, back = (math.inf, view.t + 2.0 * CLIMB_S), None
+        else:
+            self.climb = (min(self.climb[0], view.t), self.climb[1])
         return back if back is not None else self.think(view)
 
     def back_on_grid(self, view: "View") -> Command | None:
         """Off its grid on a slope (more than ``SLOPE`` rise a metre) with its grid a few
         metres uphill -- a spawn at the top of a ramp too steep, where a tank that
-        stands to shoot slides down and stays down: straight up onto it first, no
-        strafe (the pilot's push off the walls of the ramp's level strafed it down)."""
+        stands to shoot slides down and stays down: straight up onto it first, forward
+        or backward, whichever faces it more (turning round on the slope it slides),
+        no strafe (the pilot's push off the walls of the ramp's level strafed it down)."""
         m, me = view.map, view.me
         layers = getattr(self.home, "layers", None)
         if not m.relief or layers is None or self._on_grid(layers, me.x, me.z, me.y):
@@ -158,7 +172,47 @@ class Yardstick(Pilot):
                    for r in (2.0, 4.0, 6.0)):
             return None
         err = wrap(math.atan2(gz, gx) - me.heading)
-        return Command(advance=1.0 if abs(err) < 0.8 else 0.0, rotate=self.turn(me, err), strafe=0.0)
+        way = 1.0
+        if abs(err) > 0.5 * math.pi:   # backing up it: turning round on the slope, it slides
+            err, way = wrap(err - math.pi), -1.0
+        return Command(advance=way if abs(err) < 0.8 else 0.0, rotate=self.turn(me, err), strafe=0.0)
+
+    def drive(self, view: "View", forward: float, lateral: float, rotate: float, fire: bool = False) -> Command:
+        """``Pilot.drive``; on relief, a forward or sideways speed whose way ahead (the
+        footprint radius + 1 m + 0.5 s of it + the way to stop) meets a trap (``_trap``: a ramp too
+        steep, a drop) is not driven -- shooting and dodging, the robot slid down a
+        ramp it could not climb back."""
+        layers = getattr(self.home, "layers", None)
+        if view.map.relief and layers is not None:
+            me = view.me
+            for k, (speed, c, s) in enumerate(((forward, me.c, me.s), (lateral, -me.s, me.c))):
+                if abs(speed) < 0.3:
+                    continue
+                # as far as it takes to stop from the speed it has that way, or wants
+                v = max(abs(speed), math.copysign(1.0, speed) * (me.vx * c + me.vz * s))
+                brake = 0.6 * me.vehicle.engine_force / me.vehicle.mass
+                reach = min(me.vehicle.radius + 1.0 + 0.5 * v + v * v / (2.0 * brake), 14.0)
+                r = me.vehicle.radius
+                while r < reach:
+                    r = min(r + 1.5, reach)
+                    if self._trap(view, layers, me.x + c * math.copysign(r, speed), me.z + s * math.copysign(r, speed),
+                                  r):
+                        forward, lateral = (0.0, lateral) if k == 0 else (forward, 0.0)
+                        break
+        return super().drive(view, forward, lateral, rotate, fire)
+
+    def _trap(self, view: "View", layers: "NavGrid", x: float, z: float, r: float) -> bool:
+        """Whether (x, z), ``r`` m off, is off the grid it can come back from and on a
+        ramp too steep (on the map's plain grid) or more than 0.5 m + the slope it
+        climbs above or below here (a drop)."""
+        me = view.me
+        if self._on_grid(layers, x, z, me.y, 1.0 + CLIMB_RISE * r):
+            return False
+        plain = view.map.grid.layers
+        if plain is not None and self._on_grid(plain, x, z, me.y, 1.0 + r):
+            return True
+        g = view.map.ground
+        return abs(g.height(x, z, me.level) - g.height(me.x, me.z, me.level)) > 0.5 + CLIMB_RISE * r
 
     @staticmethod
     def _on_grid(layers: "NavGrid", x: float, z: float, y: float, within: float = 1.0) -> bool:
@@ -212,6 +266,7 @@ class Yardstick(Pilot):
     def reset(self) -> None:
         self.path, self.planned_at = [], -math.inf
         self.avoid, self.avoid_grid, self.moved = None, None, (-math.inf, math.nan, math.nan)
+        self.climb = (math.inf, -math.inf)
 
     def _on_path(self) -> bool:
         return bool(self.path)
