@@ -44,7 +44,7 @@ def test_a_look_empties_what_it_saw_a_sighting_moves_it_a_kill_sends_it_to_the_s
     b.looked(np.array([0, 1, 2]))
     assert b.p[0] == MISSED and b.p[3] == 1.0
     c = v.cell_at(75.0, 35.0)
-    b.at(c, 0.9)
+    b.at([c], 0.9)
     assert b.p[c] == 1.0 and math.isclose(b.p[3], 0.1)
     b.spread(0.0, 10.0)
     b.spread(1.0, 10.0)     # its neighbours fill from it, a link's DECAY less
@@ -65,3 +65,12 @@ def test_the_goal_sees_the_most_of_it_per_metre():
     goal, gain = b.goal(cov.sees, here)
     assert cov.sees[goal, c] == 1.0 and gain == 1.0
     assert b.goal(cov.sees, -1) is None
+
+
+def test_two_enemies_seen_at_once_are_both_kept():
+    v, spawns = views()
+    b = Belief(v, spawns)
+    b.p[:] = 1.0
+    b.at([3, 40, -1], 0.9)      # -1: off the blocks
+    assert b.p[3] == b.p[40] == 1.0 and math.isclose(b.p[5], 0.1)
+    assert not b.spread_out()

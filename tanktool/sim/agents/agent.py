@@ -302,10 +302,8 @@ class Agent(Pilot):
         b.looked(looked)
         if any(e.kind == "kill" and e.other != me.index for e in view.events):
             b.respawned()
-        for s in view.seen:
-            b.at(views.cell_at(s.x, s.z, s.y), SEEN)
-        for h in (*view.heard, *view.engines):
-            b.at(views.cell_at(h.x, h.z, h.y), HEARD)
+        b.at([views.cell_at(h.x, h.z, h.y) for h in (*view.heard, *view.engines)], HEARD)
+        b.at([views.cell_at(s.x, s.z, s.y) for s in view.seen], SEEN)
 
     def evade_shells(self, view: "View", cmd: Command) -> Command:
         """Dodge a shell seen flying at it (``dodge.Evasion``: noticed after the level's

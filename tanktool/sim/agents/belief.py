@@ -93,11 +93,13 @@ class Belief:
         if len(cells):
             self.p[cells] *= MISSED
 
-    def at(self, cell: int, weight: float) -> None:
-        """An enemy seen (``SEEN``) or heard (``HEARD``) in ``cell``."""
-        if cell >= 0:
+    def at(self, cells: list[int], weight: float) -> None:
+        """Enemies seen (``SEEN``) or heard (``HEARD``) in ``cells`` this think (all
+        at once: one after another, each would wipe out the one before)."""
+        cells = [c for c in cells if c >= 0]
+        if cells:
             self.p *= 1.0 - weight
-            self.p[cell] = 1.0
+            self.p[cells] = 1.0
 
     def respawned(self) -> None:
         """An enemy died: it comes back at a spawn point."""
@@ -106,7 +108,7 @@ class Belief:
     def spread_out(self) -> bool:
         """The enemy may be anywhere in most of the arena (``LOST`` of it on
         average): a search for it has nothing to go on any more."""
-        return float(self.p.mean()) > LOST
+        return len(self.p) == 0 or float(self.p.mean()) > LOST
 
     def goal(self, sees: np.ndarray, here: int) -> tuple[int, float] | None:
         """(block, the possibility in its sight) to go and look from: the most in sight
