@@ -554,9 +554,9 @@ def _same_level_links(surface: Surface, span_of: np.ndarray, exists: np.ndarray)
     # were four temporaries of 4 bytes a node (~0.25 GB on a 2 km terrain, the walls' peak)
     out = np.empty((L, nz, nx, 4), dtype=bool)
     rows = max(1, BLOCK // max(L * nx, 1))
-    for a in range(0, nz, rows):
-        sp = span_of[:, a:a + rows]
-        out[:, a:a + rows] = (linked[np.maximum(sp, 0)] == lev) & exists[:, a:a + rows][..., None]
+    for a in range(0, nz, rows):   # take clipped: span -1 (no node) reads span 0, masked by exists (hix: 48 -> 21 ms)
+        o = np.take(linked, span_of[:, a:a + rows], axis=0, mode="clip")
+        out[:, a:a + rows] = (o if L == 1 else o == lev) & exists[:, a:a + rows][..., None]
     return out
 
 
