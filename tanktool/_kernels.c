@@ -139,14 +139,15 @@ static inline int32_t relax_straight(const int32_t *L, const int32_t *dist, Py_s
 
 typedef int32_t (*relax_fn)(const int32_t *, const int32_t *, Py_ssize_t, int32_t);
 
-/* sweeps forward and back (spans come in scan order, so each sweep carries a distance
- * across the level) until nothing changes: the numpy relaxation's fixed point */
+/* sweeps forward and back in turn (spans come in scan order, so each sweep carries a
+ * distance across the level) until one changes nothing: every span then holds its
+ * relaxed value, the numpy relaxation's fixed point (unique: the shortest paths).  A
+ * pair of sweeps without a change was asked for, one or two sweeps more. */
 static inline void sweep(const int32_t *L, int32_t *D, Py_ssize_t n, relax_fn relax_span) {
-    int changed = 1;
-    while (changed) {
+    for (int back = 0, changed = 1; changed; back = !back) {
         changed = 0;
-        for (Py_ssize_t k = 0; k < 2 * n; ++k) {
-            const Py_ssize_t s = k < n ? k : 2 * n - 1 - k;
+        for (Py_ssize_t k = 0; k < n; ++k) {
+            const Py_ssize_t s = back ? n - 1 - k : k;
             const int32_t v = relax_span(L, D, s, D[s]);
             if (v < D[s]) { D[s] = v; changed = 1; }
         }
