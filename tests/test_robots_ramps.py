@@ -105,3 +105,14 @@ def test_a_yardstick_spawned_at_a_ramps_top_stays_up_and_fights(bridge):
         w.protected_until = [math.inf, math.inf]     # nobody dies: where it drives is the point
         lowest = min(lowest, me.y)
     assert lowest > 3.5 and me.y > 4.5
+
+
+def test_a_corridor_narrower_than_the_footprint_joins_a_pocket_a_step_or_two_aside(imported_level):
+    """ramps_and_decks: a spawn in the pocket between a ramp's side and the yard's wall,
+    whose only way out is a 6 m corridor along the deck's block: its run of nodes meets
+    the pocket's and the yard's nodes a step or two aside (1 m nodes), not ahead."""
+    w = _world(load_match_arena(imported_level("ramps_and_decks")))
+    before, after = _grids(w)
+    pocket, yard = (64.0, 42.5, 0.0), (6.2, 6.2, 0.0)
+    assert not plan_path(before, pocket, yard)
+    assert plan_path(after, pocket, yard) and plan_path(after, yard, pocket)

@@ -39,6 +39,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 #: steps (di, dj) of the links +x, +z, -x, -z
 _STEPS = ((0, 1), (1, 0), (0, -1), (-1, 0))
+#: the direction back
+_BACK = (2, 3, 0, 1)
 
 
 def surface_clearance(ground: "Ground", limit: float) -> np.ndarray:
@@ -335,8 +337,8 @@ def _narrow_joins(ground: "Ground", valid: np.ndarray, link: np.ndarray, heights
     """(nodes, links) to add to an agent grid whose spawns are in parts apart: straight
     runs of nodes ``narrow`` m from the edges, along one axis, where the tank driven
     along that axis has ``clearance`` m of way before and behind (its hull fits, not
-    its turning circle: it turns on the parts' nodes), whose two ends join two
-    different parts -- a deck or ramp barely wider than the hull (tools/make_levels.py's
+    its turning circle: it turns on the parts' nodes, a step ahead or aside), that
+    meet two different parts -- a deck or ramp barely wider than the hull (tools/make_levels.py's
     bridge: 8 m, 3.96 m of footprint clearance from each edge).  Runs that join a part
     to itself (the bands along every edge) are not added: the grid hugs no more edges.
     None when the spawns are in one part."""
@@ -355,21 +357,40 @@ def _narrow_joins(ground: "Ground", valid: np.ndarray, link: np.ndarray, heights
     for axis in ((0, 2), (1, 3)):
         fits = (cand | valid) & room[..., axis[0]] & room[..., axis[1]]
         own = np.full(step.shape, -1, dtype=np.int8)
-        for d in axis:   # a link of this axis between two nodes the hull fits along it, one end narrow
-            ok = fits & _target(fits, step, d) & (cand | _target(cand, step, d))
+        run = fits & cand
+        # a node a step aside (that way) of a part's
+        nears = {d: cand & _target(valid, step, d) for d in range(4) if d not in axis}
+        for d in range(4):
+            if d in axis:   # along the axis: between two nodes the hull fits along it, one end narrow
+                ok = fits & _target(fits, step, d) & (cand | _target(cand, step, d))
+            else:           # a step or two aside between a run's node and a part's (it turns there)
+                near, back = nears[d], nears[_BACK[d]]
+                ok = run & (_target(valid, step, d) | _target(near, step, d))          # run -> part, run -> near
+                ok |= near & _target(run, step, _BACK[d])                               # near -> part
+                ok |= (valid | back) & _target(run, step, d)                            # part, near -> run
+                ok |= valid & _target(back & _target(run, step, d), step, d)            # part -> near
             own[..., d] = np.where(ok, step[..., d], -1)
-        chain = _labels(cand, _only_between(cand, own))
+        along = own.copy()
+        along[..., [d for d in range(4) if d not in axis]] = -1
+        chain = _labels(cand, _only_between(cand, along))
         pairs = []
-        for d in axis:   # (chain, part) at each end of a chain
+        for d in range(4):   # (run, part) where a run meets a part, a step or two aside
             end = cand & _target(valid, own, d)
             pairs.append(np.stack([chain[end], _target_index(part, own, d)[end]], axis=1))
+            if d in nears:
+                end = cand & ~nears[d] & _target(nears[d], own, d)
+                far = np.where(nears[d], _target_index(part, step, d), 0)
+                pairs.append(np.stack([chain[end], _target_index(far, own, d)[end]], axis=1))
         pairs_a = np.unique(np.concatenate(pairs), axis=0)
+        pairs_a = pairs_a[(pairs_a[:, 0] > 0) & (pairs_a[:, 1] > 0)]
         ids, n = np.unique(pairs_a[:, 0], return_counts=True)
         keep = np.isin(chain, ids[n >= 2]) & cand
         if not keep.any():
             continue
+        for d, near in nears.items():   # the steps aside of the runs kept
+            keep |= near & _target(keep & fits, own, _BACK[d])
         nodes |= keep
-        for d in axis:
+        for d in range(4):
             ok = (own[..., d] >= 0) & (keep | _target(keep, own, d))
             links[..., d] = np.where(ok, own[..., d], links[..., d])
     return (nodes, links) if nodes.any() else None
