@@ -66,14 +66,13 @@ PyObject *tanktool_grid_labels(PyObject *self, PyObject *args) {
                 }
         /* in node order (a parent always comes before its child: a root is its set's
            first node, and path halving only moves a parent earlier): a root takes the
-           next label, any other node its parent's, which is labelled already; kept
-           negative meanwhile, so a label is never read as a parent */
+           next label, any other node its parent's, which is labelled already (a node's
+           own entry is still its parent when its turn comes: one pass) */
         for (Py_ssize_t s = 0; s < n; ++s) {
             if (!V[s]) P[s] = 0;
-            else if (P[s] == s) P[s] = (int32_t)(-(++k));
+            else if (P[s] == s) P[s] = (int32_t)(++k);
             else P[s] = P[P[s]];
         }
-        for (Py_ssize_t s = 0; s < n; ++s) P[s] = -P[s];
         Py_END_ALLOW_THREADS
     }
     ret = PyLong_FromLongLong(k);
