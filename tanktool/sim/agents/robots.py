@@ -171,6 +171,7 @@ class Yardstick(Pilot):
         if not any(self._on_grid(layers, me.x + r * gx / n, me.z + r * gz / n, me.y + 0.5 * r * n / h, 1.5)
                    for r in (2.0, 4.0, 6.0)):
             return None
+
         err = wrap(math.atan2(gz, gx) - me.heading)
         way = 1.0
         if abs(err) > 0.5 * math.pi:   # backing up it: turning round on the slope, it slides
@@ -202,17 +203,21 @@ class Yardstick(Pilot):
         return super().drive(view, forward, lateral, rotate, fire)
 
     def _trap(self, view: "View", layers: "NavGrid", x: float, z: float, r: float) -> bool:
-        """Whether (x, z), ``r`` m off, is off the grid it can come back from and on a
-        ramp too steep (on the map's plain grid) or more than 0.5 m + the slope it
-        climbs above or below here (a drop)."""
+        """Whether (x, z), ``r`` m off, is off the grid it can come back from and below
+        here: on a ramp too steep (on the map's plain grid) or more than 0.5 m + the
+        slope it climbs below (a drop).  Not what is above (a rock: the pilot's feelers
+        are for that; held back there too, its dodges and moves were lost)."""
         me = view.me
         if self._on_grid(layers, x, z, me.y, 1.0 + CLIMB_RISE * r):
+            return False
+        g = view.map.ground
+        drop = g.height(me.x, me.z, me.level) - g.height(x, z, me.level)
+        if drop <= 0.3:
             return False
         plain = view.map.grid.layers
         if plain is not None and self._on_grid(plain, x, z, me.y, 1.0 + r):
             return True
-        g = view.map.ground
-        return abs(g.height(x, z, me.level) - g.height(me.x, me.z, me.level)) > 0.5 + CLIMB_RISE * r
+        return drop > 0.5 + CLIMB_RISE * r
 
     @staticmethod
     def _on_grid(layers: "NavGrid", x: float, z: float, y: float, within: float = 1.0) -> bool:
