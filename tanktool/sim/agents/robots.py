@@ -78,6 +78,9 @@ AVOID_S = 12.0
 SLOPE = 0.1
 #: driving up onto its grid for longer than this [s] is given up for twice as long
 CLIMB_S = 6.0
+#: a drop: lower by more than 1 m + this a metre off [m/m] (a plateau's edge; 0.25, the
+#: slope of its grid, made the hills' hollows 14 m off drops, and held its moves back there)
+DROP_RISE = 0.4
 #: the rise a metre its grid's links allow (about; the trap test's slack) [m/m]
 CLIMB_RISE = 0.25
 
@@ -204,8 +207,8 @@ class Yardstick(Pilot):
 
     def _trap(self, view: "View", layers: "NavGrid", x: float, z: float, r: float) -> bool:
         """Whether (x, z), ``r`` m off, is off the grid it can come back from and below
-        here: on a ramp too steep (on the map's plain grid) or more than 0.5 m + the
-        slope it climbs below (a drop).  Not what is above (a rock: the pilot's feelers
+        here: on a ramp too steep (on the map's plain grid) or more than 1 m +
+        ``DROP_RISE`` m a metre below (a drop).  Not what is above (a rock: the pilot's feelers
         are for that; held back there too, its dodges and moves were lost)."""
         me = view.me
         if self._on_grid(layers, x, z, me.y, 1.0 + CLIMB_RISE * r):
@@ -217,7 +220,7 @@ class Yardstick(Pilot):
         plain = view.map.grid.layers
         if plain is not None and self._on_grid(plain, x, z, me.y, 1.0 + r):
             return True
-        return drop > 0.5 + CLIMB_RISE * r
+        return drop > 1.0 + DROP_RISE * r
 
     @staticmethod
     def _on_grid(layers: "NavGrid", x: float, z: float, y: float, within: float = 1.0) -> bool:
