@@ -51,6 +51,63 @@ def winding_region(seg: np.ndarray, tolerance: float, inside: Callable[[np.ndarr
     return shapely.union_all(faces[winding > 0])
 
 
+def cells_polygon(mask: np.ndarray, origin: np.ndarray, cell: float, tolerance: float):
+    """The union of the cells of a 2-D mask (row i: z, column j: x) as a polygon
+    (:func:`winding_region` of the cells' outline, a face looked up by its cell).
+
+    The outline goes in as one segment per run of cell edges on a line (one
+    orientation, no other edge meeting it between its ends: two edges in line with
+    the same free side leave no cell change across the point between them), not one
+    per unit edge: line_merge and simplify took most of the time over unit edges
+    (hix: 74 -> 25 ms a call) and dropped the runs' inner points anyway."""
+    m = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), dtype=bool)
+    m[1:-1, 1:-1] = mask
+    segs = []
+    # horizontal edges at z line i (rows i - 1, i): free above -> +x (split by side, in rows)
+    hi = m[1:, 1:-1]
+    i, j = np.nonzero(hi != m[:-1, 1:-1])
+    rise = hi[i, j]
+    for sign, sel in ((1, rise), (-1, ~rise)):
+        line, j0, j1 = _edge_runs(i[sel], j[sel])
+        a = np.stack([j0, line], axis=1).astype(np.float64)
+        b = np.stack([j1, line], axis=1).astype(np.float64)
+        segs.append(np.stack([a, b] if sign > 0 else [b, a], axis=1))
+    # vertical edges at x line j (between columns j - 1 and j): free to the right -> -z;
+    # found column by column, so a run's edges come one after the other
+    right = m[1:-1, 1:]
+    j, i = np.nonzero((right != m[1:-1, :-1]).T)
+    rise = right[i, j]
+    for sign, sel in ((1, rise), (-1, ~rise)):
+        line, i0, i1 = _edge_runs(j[sel], i[sel])
+        a = np.stack([line, i0], axis=1).astype(np.float64)
+        b = np.stack([line, i1], axis=1).astype(np.float64)
+        segs.append(np.stack([b, a] if sign > 0 else [a, b], axis=1))
+    seg = np.concatenate(segs)
+    if len(seg) == 0:
+        return shapely.Polygon()
+    seg = np.asarray(origin, dtype=np.float64) + seg * cell
+
+    def in_cells(p: np.ndarray) -> np.ndarray:
+        # the faces of the cells' outline are unions of whole cells: a point inside one
+        # is in the region when its cell is (no crossing count over every edge)
+        ij = np.floor((p - origin) / cell).astype(np.int64)
+        return m[ij[:, 1] + 1, ij[:, 0] + 1]
+
+    return winding_region(seg, tolerance, in_cells)
+
+
+def _edge_runs(line: np.ndarray, k: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(line, first, past the last) of each run of consecutive unit edges ``k`` on one
+    line, the edges given sorted by line, then k."""
+    if len(line) == 0:
+        return line, k, k
+    new = np.ones(len(line), dtype=bool)
+    new[1:] = (line[1:] != line[:-1]) | (k[1:] != k[:-1] + 1)
+    starts = np.flatnonzero(new)
+    ends = np.append(starts[1:], len(line)) - 1
+    return line[starts], k[starts], k[ends] + 1
+
+
 def components(nodes: np.ndarray) -> np.ndarray:
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components

@@ -39,6 +39,7 @@ from ..formats.walls_txt import WallList, aux_rectangle
 from ..memory import give_back
 from ..geometry import contours, slivers
 from ..geometry import cross_section as xs
+from ..geometry.cross_section import cells_polygon
 from ..geometry import walls as cut
 from ..geometry.wall_pairs import Repairs, pair_tolerance, repair_walls
 from ..geometry.heightfield import FACE_BLOCK, FLAT_GAP, flat_heights
@@ -87,41 +88,6 @@ class LevelWalls:
     def free(self, level: int | None = None):
         parts = [r.free for r in self.regions if level is None or r.level == level]
         return shapely.union_all(parts) if parts else shapely.Polygon()
-
-
-def cells_polygon(mask: np.ndarray, origin: np.ndarray, cell: float, tolerance: float):
-    """The union of the cells of a 2-D mask (row i: z, column j: x) as a polygon."""
-    m = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), dtype=bool)
-    m[1:-1, 1:-1] = mask
-    segs = []
-    # horizontal edges at z line i (rows i - 1, i): free above -> +x (split by side in nonzero's order)
-    hi = m[1:, 1:-1]
-    i, j = np.nonzero(hi != m[:-1, 1:-1])
-    rise = hi[i, j]
-    for sign, sel in ((1, rise), (-1, ~rise)):
-        a = np.stack([j[sel], i[sel]], axis=1).astype(np.float64)
-        b = a + [1.0, 0.0]
-        segs.append(np.stack([a, b] if sign > 0 else [b, a], axis=1))
-    # vertical edges at x line j (between columns j - 1 and j): free to the right -> -z
-    right = m[1:-1, 1:]
-    i, j = np.nonzero(right != m[1:-1, :-1])
-    rise = right[i, j]
-    for sign, sel in ((1, rise), (-1, ~rise)):
-        a = np.stack([j[sel], i[sel]], axis=1).astype(np.float64)
-        b = a + [0.0, 1.0]
-        segs.append(np.stack([b, a] if sign > 0 else [a, b], axis=1))
-    seg = np.concatenate(segs) if segs else np.zeros((0, 2, 2))
-    if len(seg) == 0:
-        return shapely.Polygon()
-    seg = np.asarray(origin, dtype=np.float64) + seg * cell
-
-    def in_cells(p: np.ndarray) -> np.ndarray:
-        # the faces of the cells' outline are unions of whole cells: a point inside one
-        # is in the region when its cell is (no crossing count over every edge)
-        ij = np.floor((p - origin) / cell).astype(np.int64)
-        return m[ij[:, 1] + 1, ij[:, 0] + 1]
-
-    return xs.winding_region(seg, tolerance, in_cells)
 
 
 class ExactCuts:
