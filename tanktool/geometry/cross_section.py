@@ -51,6 +51,21 @@ def winding_region(seg: np.ndarray, tolerance: float, inside: Callable[[np.ndarr
     return shapely.union_all(faces[winding > 0])
 
 
+def _oriented_runs(line: np.ndarray, along: np.ndarray, rise: np.ndarray, across: bool) -> list[np.ndarray]:
+    """The runs of unit edges on grid lines ``line`` (cell indices ``along`` them) as
+    (k, 2, 2) segments in (x, z) cell units, each run the way its free side asks:
+    ``rise`` edges one way and the others the opposite way.  ``across``: the lines are
+    x lines (vertical edges), whose forward way is the reverse of the z lines'."""
+    out = []
+    for forward, sel in ((not across, rise), (across, ~rise)):
+        at, s0, s1 = _edge_runs(line[sel], along[sel])
+        pair = (lambda s: [at, s]) if across else (lambda s: [s, at])
+        a = np.stack(pair(s0), axis=1).astype(np.float64)
+        b = np.stack(pair(s1), axis=1).astype(np.float64)
+        out.append(np.stack([a, b] if forward else [b, a], axis=1))
+    return out
+
+
 def cells_polygon(mask: np.ndarray, origin: np.ndarray, cell: float, tolerance: float):
     """The union of the cells of a 2-D mask (row i: z, column j: x) as a polygon
     (:func:`winding_region` of the cells' outline, a face looked up by its cell).
@@ -62,26 +77,15 @@ def cells_polygon(mask: np.ndarray, origin: np.ndarray, cell: float, tolerance: 
     (hix: 74 -> 25 ms a call) and dropped the runs' inner points anyway."""
     m = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), dtype=bool)
     m[1:-1, 1:-1] = mask
-    segs = []
     # horizontal edges at z line i (rows i - 1, i): free above -> +x (split by side, in rows)
     hi = m[1:, 1:-1]
     i, j = np.nonzero(hi != m[:-1, 1:-1])
-    rise = hi[i, j]
-    for sign, sel in ((1, rise), (-1, ~rise)):
-        line, j0, j1 = _edge_runs(i[sel], j[sel])
-        a = np.stack([j0, line], axis=1).astype(np.float64)
-        b = np.stack([j1, line], axis=1).astype(np.float64)
-        segs.append(np.stack([a, b] if sign > 0 else [b, a], axis=1))
+    segs = _oriented_runs(i, j, hi[i, j], across=False)
     # vertical edges at x line j (between columns j - 1 and j): free to the right -> -z;
     # found column by column, so a run's edges come one after the other
     right = m[1:-1, 1:]
     j, i = np.nonzero((right != m[1:-1, :-1]).T)
-    rise = right[i, j]
-    for sign, sel in ((1, rise), (-1, ~rise)):
-        line, i0, i1 = _edge_runs(j[sel], i[sel])
-        a = np.stack([line, i0], axis=1).astype(np.float64)
-        b = np.stack([line, i1], axis=1).astype(np.float64)
-        segs.append(np.stack([b, a] if sign > 0 else [a, b], axis=1))
+    segs += _oriented_runs(j, i, right[i, j], across=True)
     seg = np.concatenate(segs)
     if len(seg) == 0:
         return shapely.Polygon()
