@@ -67,6 +67,8 @@ def test_a_daemonic_worker_builds_its_bands_in_turn():
     whole = build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9)
     with mp.get_context("fork").Pool(1) as pool:
         counts = pool.apply(_tiled_counts, (V, F))
+        pool.close()      # the worker leaves on its own: terminate (the with's exit) would
+        pool.join()       # wait for ever on one whose inherited SIGTERM handler does not exit
     assert counts == whole.counts
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import signal
 from pathlib import Path
 
 import pytest
@@ -23,12 +24,19 @@ HUNTER = str(HERE / "data" / "bots" / "hunter.py") + ":Hunter"
 
 @pytest.fixture(scope="module")
 def cluster():
+    # ray.init installs a SIGTERM handler that does not exit; left in place it is
+    # inherited by every process this pytest worker forks later, and Pool.terminate
+    # then waits for ever on a worker blocked on its task queue (a hung CI run:
+    # test_tiles' pool after this module on the same xdist worker)
+    handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGINT)}
     started = not ray.is_initialized()
     if started:
         ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False, configure_logging=False)
     yield ray
     if started:
         ray.shutdown()
+    for sig, handler in handlers.items():
+        signal.signal(sig, handler)
 
 
 def _plain(report: dict) -> dict:
