@@ -110,35 +110,9 @@ def tank_grid(surface: Surface, lw: LevelWalls, radius: float, runs: bool = True
 
 def grid_components(grid: NavGrid) -> tuple[np.ndarray, int]:
     """Component labels (L, nz, nx) of a grid's valid nodes over its links (0: none)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    from .navgrid import layered_labels
 
-    from .navgrid import STEPS, compiled_labels
-
-    valid = grid.valid
-    link = grid.links()
-    compiled = compiled_labels(valid, link)
-    if compiled is not None:  # the same labels, in 4 bytes a node
-        return compiled
-    L, nz, nx = valid.shape
-    ids = np.full(valid.shape, -1, dtype=np.int64)
-    pts = np.nonzero(valid)
-    ids[pts] = np.arange(len(pts[0]))
-    src, dst = [], []
-    for d, (di, dj) in enumerate(STEPS.values()):
-        l_, i_, j_ = pts
-        t = link[l_, i_, j_, d].astype(np.int64)
-        ok = t >= 0
-        src.append(ids[l_[ok], i_[ok], j_[ok]])
-        dst.append(ids[t[ok], i_[ok] + di, j_[ok] + dj])
-    s, t = np.concatenate(src), np.concatenate(dst)
-    good = t >= 0
-    n = len(pts[0])
-    g = coo_matrix((np.ones(int(good.sum()), dtype=np.int8), (s[good], t[good])), shape=(n, n))
-    k, lab = connected_components(g, directed=True, connection="weak")
-    labels = np.zeros(valid.shape, dtype=np.int64)
-    labels[pts] = lab + 1
-    return labels, int(k)
+    return layered_labels(grid.valid, grid.links())
 
 
 #: spawn points prefer ground no steeper than this (degrees), and no rougher than half

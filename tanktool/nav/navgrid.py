@@ -405,48 +405,53 @@ def compiled_labels(valid: np.ndarray, link: np.ndarray) -> tuple[np.ndarray, in
     return out, int(k)
 
 
-def layered_reachable(valid: np.ndarray, link: np.ndarray, seeds: list) -> np.ndarray:
-    """Valid nodes connected through links to any seed node ``(level, i, j)``."""
+def layered_labels(valid: np.ndarray, link: np.ndarray) -> tuple[np.ndarray, int]:
+    """(labels, k): the components of a layered grid's valid nodes over its links
+    (either way), numbered 1..k in the order of each one's first node, 0 off the valid
+    nodes: :func:`compiled_labels`, else scipy's connected components (the same numbers)."""
+    compiled = compiled_labels(valid, link)
+    if compiled is not None:
+        return compiled
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
     L, nz, nx = valid.shape
-    n = valid.size
+    ids = np.full(valid.shape, -1, dtype=np.int64)
+    pts = np.nonzero(valid)
+    ids[pts] = np.arange(len(pts[0]))
+    src, dst = [], []
+    for d, (di, dj) in enumerate(STEPS.values()):
+        l_, i_, j_ = pts
+        t = link[l_, i_, j_, d].astype(np.int64)
+        ii, jj = i_ + di, j_ + dj
+        ok = (t >= 0) & (ii >= 0) & (ii < nz) & (jj >= 0) & (jj < nx)
+        to = ids[t[ok], ii[ok], jj[ok]]
+        src.append(ids[l_[ok], i_[ok], j_[ok]][to >= 0])
+        dst.append(to[to >= 0])
+    s, t = np.concatenate(src), np.concatenate(dst)
+    n = len(pts[0])
+    k, lab = connected_components(coo_matrix((np.ones(len(s), dtype=np.int8), (s, t)), shape=(n, n)),
+                                  directed=True, connection="weak")
+    labels = np.zeros(valid.shape, dtype=np.int32)
+    labels[pts] = lab + 1
+    return labels, int(k)
+
+
+def layered_reachable(valid: np.ndarray, link: np.ndarray, seeds: list) -> np.ndarray:
+    """Valid nodes connected through links to any seed node ``(level, i, j)``."""
     if not seeds:
         return valid.copy()
-    compiled = compiled_labels(valid, link)
-    if compiled is not None:
-        label = compiled[0]
-        keep = np.unique([label[s] for s in seeds])
-        keep = keep[keep > 0]
-        if len(keep) > 32:
-            return np.isin(label, keep)
-        # a comparison per seed's component: 1 byte a node at a time, where isin's
-        # table lookup took ~12 (the same nodes)
-        out = np.zeros(valid.shape, dtype=bool)
-        for k in keep:
-            out |= label == k
-        return out
-    src, dst = [], []
-    base = np.arange(n).reshape(L, nz, nx)
-    for d, (di, dj) in enumerate(STEPS.values()):
-        lv = link[..., d]
-        ok = valid & (lv >= 0)
-        l_, i_, j_ = np.nonzero(ok)
-        ii, jj = i_ + di, j_ + dj
-        inside = (ii >= 0) & (ii < nz) & (jj >= 0) & (jj < nx)
-        l_, i_, j_, ii, jj = l_[inside], i_[inside], j_[inside], ii[inside], jj[inside]
-        tl = lv[l_, i_, j_].astype(np.int64)
-        good = valid[tl, ii, jj]
-        src.append(base[l_, i_, j_][good])
-        dst.append(base[tl, ii, jj][good])
-    src_a = np.concatenate(src) if src else np.zeros(0, dtype=np.int64)
-    dst_a = np.concatenate(dst) if dst else np.zeros(0, dtype=np.int64)
-    g = coo_matrix((np.ones(len(src_a), dtype=np.int8), (src_a, dst_a)), shape=(n, n))
-    _, label = connected_components(g, directed=True, connection="weak")
-    label = label.reshape(L, nz, nx)
+    label = layered_labels(valid, link)[0]
     keep = np.unique([label[s] for s in seeds])
-    return valid & np.isin(label, keep)
+    keep = keep[keep > 0]
+    if len(keep) > 32:
+        return np.isin(label, keep)
+    # a comparison per seed's component: 1 byte a node at a time, where isin's table
+    # lookup took ~12 (the same nodes)
+    out = np.zeros(valid.shape, dtype=bool)
+    for k in keep:
+        out |= label == k
+    return out
 
 
 def nearest_valid_node3(valid: np.ndarray, height: np.ndarray, x_node: tuple[int, int], y: float | None,

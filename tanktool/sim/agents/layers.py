@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ...nav.navgrid import NavGrid, layered_reachable, layered_runs, nearest_valid_node3, runs
+from ...nav.navgrid import NavGrid, layered_labels, layered_reachable, layered_runs, nearest_valid_node3, runs
 from ...nav.walkable import CELL_HEIGHT, chamfer_clearance
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -291,26 +291,8 @@ def ground_agent_grid(ground: "Ground", cell: float, clearance: float, spawns: l
 
 def _labels(valid: np.ndarray, link: np.ndarray) -> np.ndarray:
     """Components of a layered grid's valid nodes over its links (either way): int32
-    labels, 0 off the valid nodes."""
-    from ...nav.navgrid import compiled_labels
-
-    got = compiled_labels(valid, np.ascontiguousarray(link, dtype=np.int8))
-    if got is not None:
-        return got[0]
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    L, nz, nx = valid.shape
-    base = np.arange(valid.size).reshape(L, nz, nx)
-    src, dst = [base[valid]], [base[valid]]
-    for d in range(4):
-        ok = valid & _target(valid, link, d)
-        src.append(base[ok])
-        dst.append(_target_index(base, link, d)[ok])
-    a, b = np.concatenate(src), np.concatenate(dst)
-    g = coo_matrix((np.ones(len(a), dtype=np.int8), (a, b)), shape=(valid.size, valid.size))
-    _, lab = connected_components(g, directed=True, connection="weak")
-    return np.where(valid, lab.reshape(L, nz, nx) + 1, 0).astype(np.int32)
+    labels, 0 off the valid nodes (``navgrid.layered_labels``)."""
+    return layered_labels(valid, np.ascontiguousarray(link, dtype=np.int8))[0]
 
 
 def _target_index(values: np.ndarray, link: np.ndarray, d: int) -> np.ndarray:
