@@ -442,23 +442,15 @@ def print_table(title: str, rows: list[dict], worst: dict) -> None:
           f"(goal < 10), {worst['max_bytes_up_per_s']} B/s up (goal < 16384)")
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--seconds", type=float, default=20.0, help="steady play (the issue's goal run: 60)")
-    ap.add_argument("--peers", type=int, default=8)
-    ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
-    ap.add_argument("--parts", default="steady,password,migration,attack,judge,flood",
-                    help="which phases to run (comma-separated)")
-    ap.add_argument("--flood-seconds", type=float, default=5.0)
-    args = ap.parse_args()
-    parts = set(args.parts.split(","))
-    unknown = parts - {"steady", "password", "migration", "attack", "judge", "flood"}
-    if unknown:
-        ap.error(f"--parts: unknown {sorted(unknown)}")
+PARTS = ("steady", "password", "migration", "attack", "judge", "flood")
+
+
+def measure(args: argparse.Namespace, parts: set[str]) -> dict:
+    """Run the phases named in ``parts``; one dict of every figure (the --json object)."""
     result: dict = {"peers": args.peers, "seconds": args.seconds,
                     "goals": {"updates_per_s": 30, "latency_p99_ms": 10, "bytes_up_per_s_with_headers": 16 * 1024,
                               "migration_s": 3, "honest_per_s_under_flood": 30}}
-    result["seal_costs"] = costs = seal_costs()
+    result["seal_costs"] = seal_costs()
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         # the machine may be shared: say how busy it was when each phase began
@@ -478,10 +470,11 @@ def main() -> None:
             result["judge"] = judge_costs()
         if "flood" in parts:
             result["flood"] = dict(flood(tmp, args.flood_seconds), load_average=round(os.getloadavg()[0], 2))
-    if args.json:
-        print(json.dumps(result))
-        return
-    if "judge" in parts:
+    return result
+
+
+def print_judge_and_flood(result: dict) -> None:
+    if "judge" in result:
         print("host CPU per member state, in this process [us]: decode + kept for drawing; and the whole path")
         print("through the protocol core (net/core.py: budget, member, window, rate, judge, event)")
         print(f"{'arena':<8} {'no judge':>9} {'judged':>9} {'ratio':>6} {'core, no judge':>15} {'judged':>9} {'ratio':>6}")
@@ -489,19 +482,22 @@ def main() -> None:
             print(f"{arena:<8} {c['off_us']:>9.2f} {c['on_us']:>9.2f} {c['ratio']:>6.2f} {c['core_off_us']:>15.2f} "
                   f"{c['core_on_us']:>9.2f} {c['core_ratio']:>6.2f}")
         print()
-    if "flood" in parts:
+    if "flood" in result:
         f = result["flood"]
         print(f"flood: a member sends {f['flood_per_s']} valid states/s for {f['seconds']} s; the honest member "
               f"sends {f['honest_sent_per_s']}/s and the host takes {f['honest_taken_by_host_per_s']}/s of them "
               f"(goal 30); {f['flood_dropped_unread']} flood datagrams dropped unread, "
               f"{f['host_skipped_steps']} host steps skipped (load average {f['load_average']})")
         print()
-    if not {"steady", "password"} <= parts:
-        return
+
+
+def print_steady(result: dict) -> None:
+    """The plain and sealed tables, their comparison, then migration and attack if run."""
+    peers, seconds, costs = result["peers"], result["seconds"], result["seal_costs"]
     plain, worst, load_plain = result["rows"], result["worst"], result["load_average"]
     sealed, worst_sealed, load_sealed = (result["password"][k] for k in ("rows", "worst", "load_average"))
     mig, atk = result.get("migration"), result.get("attack")
-    print_table(f"{args.peers} peers on loopback, {args.seconds:g} s of steady play (separate processes, box arena; "
+    print_table(f"{peers} peers on loopback, {seconds:g} s of steady play (separate processes, box arena; "
                 f"load average {load_plain} at the start)", plain, worst)
     print()
     print_table("the same with a password: every datagram sealed (keyed BLAKE2b, 8-byte tag, a key per pair; "
@@ -529,6 +525,27 @@ def main() -> None:
           f"{atk['join_under_silent_flood_s']} s while 200 silent connections are held and ~500/s more opened "
           f"({atk['host_evicted']} evicted); a 2 s flood of {atk['flood_joins']} joins: {atk['flood_admitted']} "
           f"admitted, {atk['flood_refused']} refused; the real peers' rate-limit drops: {atk['peers_rate_drops']}")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--seconds", type=float, default=20.0, help="steady play (the issue's goal run: 60)")
+    ap.add_argument("--peers", type=int, default=8)
+    ap.add_argument("--json", action="store_true", help="print one JSON object instead of the table")
+    ap.add_argument("--parts", default=",".join(PARTS), help="which phases to run (comma-separated)")
+    ap.add_argument("--flood-seconds", type=float, default=5.0)
+    args = ap.parse_args()
+    parts = set(args.parts.split(","))
+    unknown = parts - set(PARTS)
+    if unknown:
+        ap.error(f"--parts: unknown {sorted(unknown)}")
+    result = measure(args, parts)
+    if args.json:
+        print(json.dumps(result))
+        return
+    print_judge_and_flood(result)
+    if {"steady", "password"} <= parts:
+        print_steady(result)
 
 
 if __name__ == "__main__":
