@@ -168,7 +168,7 @@ def build_grid(target: Target, cell: float | None = None, clearance: float | Non
                max_slope: float | None = None, climb: float | None = None, headroom: float | None = None,
                quadtree_depth: int | None = None, warn: Callable[[str], None] | None = None,
                progress: Callable[[int], None] | None = None, fleet: Any = None,
-               base: Any = None) -> BuiltGrid:
+               base: Any = None, analysed: dict[str, Any] | None = None) -> BuiltGrid:
     """The navigation grid and wall quadtree of ``target``: on a bundle with its model,
     the layered grid of the model's walkable surface; on a bare walls file, the flat
     2002 grid.  Options left None come from the manifest, then the defaults.
@@ -179,7 +179,11 @@ def build_grid(target: Target, cell: float | None = None, clearance: float | Non
 
     On a bundle with its model and [grids] tables, the smaller vehicles' grids are
     built too (``BuiltGrid.vehicles``), of the same walkable surface reseeded
-    (``base``: the larger grid's, see :func:`_smaller_vehicles`) where each built it again."""
+    (``base``: the larger grid's, see :func:`_smaller_vehicles`) where each built it again.
+
+    ``analysed`` ({"params", "surface"}: import-arena's analysed surface of the bundle's
+    model, on the model lattice, the import's only reference) is reseeded instead of
+    rasterising model.glb again: the same surface by construction (nav/grid_window.py)."""
     import numpy as np
 
     from .nav.navgrid import build_navgrid as build, free_space, grid_shape
@@ -218,7 +222,12 @@ def build_grid(target: Target, cell: float | None = None, clearance: float | Non
     t0 = time.perf_counter()
     if params is not None:
         reuse = base if base is not None and base["params"] == params else None
-        grid, free, surface = _layered(target, params, clearance, bounds, shape, reuse)
+        if reuse is None and analysed is not None and analysed["params"] == params:
+            reuse = analysed   # import-arena's surface of this model on the same lattice: not built again
+        grid, free, surface = _layered(target, params, clearance, bounds, reuse)
+        if analysed is not None:   # the caller's reference too: the reseeded surface shares what it reads
+            analysed["surface"] = None
+        analysed = reuse = None
     else:
         surface = None
         grid = build(target.walls, cell, clearance, spawns=target.spawns, bounds=bounds, progress=progress)
@@ -258,25 +267,25 @@ def _smaller_vehicles(target: Target, built: BuiltGrid, shared: dict[str, Any]) 
                                           **_surface_options(built.params))
 
 
-def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: tuple[int, int],
-             base: Any = None) -> tuple[Any, Any, Any]:
-    """The layered grid of a bundle: its model's walkable surface on the grid over the
-    bounds, valid where a node keeps ``clearance`` from the walls of its level (``base``:
-    {"surface": a surface of the same model and settings, "last": ..., "levels", "grid"},
-    reseeded when it lies on the same grid; see :func:`_smaller_vehicles`).
+def _layered(target: Target, params: Any, clearance: float, bounds: Any, base: Any = None) -> tuple[Any, Any, Any]:
+    """The layered grid of a bundle: its model's walkable surface on the model lattice,
+    the nodes cut to the walls' bounds (nav/grid_window.py: the rule both commands
+    follow), valid where a node keeps ``clearance`` from the walls of its level
+    (``base``: {"surface": a surface of the same model and settings, "last": ...,
+    "levels", "grid"}, reseeded; see :func:`_smaller_vehicles`).
     Returns (grid, mask of nodes that exist, for the picture, the surface or None)."""
     import numpy as np
 
     from .nav.arena_levels import walls_too_close
-    from .nav.walkable import grid_from_layers, grid_from_surface, level_nodes, reseed, walkable_surface
+    from .nav.grid_window import grid_window, model_lattice, window_grid, window_nodes
+    from .nav.walkable import grid_from_layers, level_nodes, reseed, walkable_surface
 
-    origin = np.asarray(bounds, dtype=np.float64)[0]
     seeds = None
     if target.spawns is not None:  # [x, z] and the spawn's height when the manifest has it
         sp = np.asarray(target.spawns, dtype=np.float64)
         seeds = sp[:, [0, 1, 3]] if sp.shape[1] >= 4 else sp[:, :2]
     old = base["surface"] if base is not None else None
-    if old is not None and tuple(old.shape) == tuple(shape) and np.array_equal(old.hf.origin[[0, 2]], origin):
+    if old is not None:
         surface = reseed(old, clearance, seeds)
         del old
         if base.get("last"):  # its only reference: what the grid does not read goes now
@@ -287,14 +296,16 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
         del old
         vertices, faces = _model_triangles(target.model)
         gc.collect()   # the scene read is cyclic garbage (~0.2 GB on a 2 km terrain) the surface would stack on
+        origin, shape = model_lattice(vertices, params.cell)
         surface = walkable_surface(vertices, faces, params, clearance, origin_xz=origin, shape=shape,
                                    seeds=seeds, lean=True)   # its grid reads the walls' distance (too_close)
         del vertices, faces
     if not surface.main.any():
         raise ArenaError(f"{target.model}: no walkable surface (max slope {params.max_slope:g} deg, "
                          f"headroom {params.headroom:g} m)")
+    w = grid_window(surface.hf.origin[[0, 2]], params.cell, bounds)
     levels = max(surface.levels, 1)
-    tc = walls_too_close(target.walls, origin, params.cell, shape, levels, clearance)
+    tc = walls_too_close(target.walls, w.origin, params.cell, w.shape, levels, clearance)
     if base is not None and base.get("levels") is not None and np.array_equal(surface.level, base["levels"]):
         # the larger grid's levels again: its nodes (a finite height), heights and links
         # are this grid's; the surface (~0.75 GB on a 2 km terrain) goes before it is built
@@ -304,11 +315,10 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, shape: 
             base["surface"] = None
             give_back(GIVE_BACK_MIN)
         nodes = np.isfinite(g0.height)
-        grid = grid_from_layers(nodes & ~tc, g0.height, g0.link, clearance, origin, cell, seeds=target.spawns)
+        grid = grid_from_layers(nodes & ~tc, g0.height, g0.link, clearance, w.origin, cell, seeds=target.spawns)
         return grid, (nodes[0] if grid.levels == 1 else None), None
-    grid = grid_from_surface(surface, clearance, origin, seeds=target.spawns, too_close=tc)
-    return grid, (level_nodes(surface) if grid.levels == 1 else None), surface
-
+    grid = window_grid(surface, w, tc, clearance, seeds=target.spawns)
+    return grid, (window_nodes(level_nodes(surface), w) if grid.levels == 1 else None), surface
 
 
 def _model_triangles(model: Path) -> tuple[Any, Any]:

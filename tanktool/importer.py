@@ -124,12 +124,13 @@ def import_arena(
     _check_heights(params.climb, height, wall_height)
     scene, mesh = _read_mesh(model, params.cell, max_cells, progress, up=up, scale=scale, warn=remark,
                              wall_height=wall_height, wall_thickness=wall_thickness)
+    _as_stored(mesh)
     # with the grid stage, the tank grid is only the spawns' (the bundle's is built anew)
     result = _analyse(model, mesh, params, fleet, height, tolerance, progress, keep_runs=not grid)
     n_faces, model_left_out = len(mesh.faces), list(scene.metadata.get("left_out", []))
     del mesh   # scene.dump()'s copy: the analysis keeps the arrays it needs (vertices, faces)
-    preview = _preview(name, result)   # drawn while the analysis is whole
-    _before_vehicles(result)
+    preview = _preview(name, result, keep_region=grid)   # drawn while the analysis is whole
+    _before_vehicles(result, reseed=grid)
     others = _vehicle_grids(result, fleet, remark)
     if grid:
         result.grid = None   # the grid stage builds the bundle's own (ImportResult.grid holds it)
@@ -146,9 +147,12 @@ def import_arena(
         # one grid per smaller vehicle: grid_files builds navgrid.<vehicle>.npz from these
         write_toml(tmp / MANIFEST, {**doc, **({"grids": others} if others else {})})
         scene = None
+        # the grid stage reseeds the analysis' surface (on the model lattice, as
+        # build-navgrid's from model.glb): its only reference goes with the dict
+        analysed = {"params": params, "surface": result.surface} if grid else None
         _let_go(result)
         # the same files, built the same way, as build-navgrid on the bundle
-        built = _stage_grid(tmp, fits, remark, progress) if grid else None
+        built = _stage_grid(tmp, fits, remark, progress, analysed) if grid else None
     return ImportResult(target, name, result.walls.walls, result.spawns, result.floor_y, n_faces,
                         result.walls.thin_walls, time.perf_counter() - t0, warnings, result, params, where, built,
                         model_left_out)
@@ -165,15 +169,15 @@ def _collector(warn: Callable[[str], None] | None) -> tuple[list[str], Callable[
     return remarks, remark
 
 
-def _before_vehicles(result: Any) -> None:
+def _before_vehicles(result: Any, reseed: bool = False) -> None:
     """Let go of what the smaller vehicles' grids and spawns do not read, once the
     report and the preview are done: of the surface all but its spans' columns, levels,
     heights and links (its clearance, regions, floors, ceilings and the heightfield's
-    spans).  On a 2 km terrain ~1 GB, which the smaller vehicle's grid stacked on (the
+    spans; ``reseed``: the floors and regions stay, for the grid stage's reseed).  On a 2 km terrain ~1 GB, which the smaller vehicle's grid stacked on (the
     import's peak).  The tank grid stays: the smaller vehicles' grids share its nodes'
     heights and links (arena_levels.tank_grid ``like``), which they built again else."""
     s = result.surface
-    for k in ("floor", "ceil", "region", "main"):   # the grids read none of these
+    for k in ("ceil", "main") if reseed else ("floor", "ceil", "region", "main"):   # the grids read none of these
         a = getattr(s, k)
         setattr(s, k, np.zeros(0, dtype=a.dtype))
     s.clearance = None
@@ -183,15 +187,18 @@ def _before_vehicles(result: Any) -> None:
     give_back(GIVE_BACK_MIN)
 
 
-def _preview(name: str, result: Any) -> bytes:
+def _preview(name: str, result: Any, keep_region: bool = False) -> bytes:
     """preview.png's bytes: the levels, walls, spawns and what was left out (the
-    report's answers, kept with the surface: its clearance and regions go first)."""
+    report's answers, kept with the surface: its clearance and regions go first;
+    ``keep_region``: the regions stay, for the grid stage's reseed)."""
     from .nav.surface_report import asked
     from .plots.arena import render_levels
 
     s = result.surface
     if result.grid is not None and asked(s, result.grid.clearance, (result.vertices, result.faces)):
-        s.clearance, s.region = None, np.zeros(0, dtype=s.region.dtype)
+        s.clearance = None
+        if not keep_region:
+            s.region = np.zeros(0, dtype=s.region.dtype)
     walls, spawns, lv = result.walls.walls, result.spawns, result.levels
     bounds = walls.bounds
     title = (f"{name}: {len(lv)} level{'s' if len(lv) != 1 else ''}, {len(walls)} walls + 4 auxiliary, "
@@ -269,6 +276,14 @@ def _one_mesh(model: Path, scene: Any, cell: float, max_cells: int | None) -> An
     check_cells(str(model), float(hi[0] - lo[0]), float(hi[2] - lo[2]), cell, model.stat().st_size,
                 max_cells)  # before the heightfield: its cost follows the cells
     return mesh
+
+
+def _as_stored(mesh: Any) -> None:
+    """The mesh's vertices rounded, in place, to the float32 model.glb stores them in:
+    the analysis' surface is then the one build-navgrid rasterises from model.glb
+    (a vertex on the other side of a cell or step line moved a span else)."""
+    v = mesh.vertices
+    v[...] = np.asarray(v, dtype=np.float64).astype(np.float32)
 
 
 def _as_placed(scene: Any) -> list[Any] | None:
@@ -391,13 +406,14 @@ def _manifest(tmp: Path, model: Path, companions: list[Path], name: str, source:
 
 
 def _stage_grid(tmp: Path, fits: Any, remark: Callable[[str], None],
-                progress: Callable[[str], None] | None) -> Any:
-    """navgrid.npz, quadtree.npz and navgrid.png as build-navgrid writes them, recorded in the manifest."""
+                progress: Callable[[str], None] | None, analysed: dict[str, Any] | None = None) -> Any:
+    """navgrid.npz, quadtree.npz and navgrid.png as build-navgrid writes them, recorded
+    in the manifest (``analysed``: the analysis' surface, see grid_files.build_grid)."""
     from .formats.bundle import write_toml
     from .grid_files import build_grid, open_target, picture_and_grids, stage_grid_files
 
     staged = open_target(tmp)
-    built = build_grid(staged, warn=remark, fleet=fits)
+    built = build_grid(staged, warn=remark, fleet=fits, analysed=analysed)
     write_toml(tmp / MANIFEST, stage_grid_files(tmp, staged, built, *picture_and_grids(built, staged)))
     if progress:
         progress("navgrid")

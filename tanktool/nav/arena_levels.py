@@ -29,6 +29,7 @@ from ..errors import ArenaError
 from ..fleet import Fleet
 from ..memory import give_back
 from ..geometry.spawns import SPAWN_CLEARANCE, SPAWN_COUNT, facing_centre, spawn_candidates, spread
+from .grid_window import model_lattice
 from .level_walls import LevelWalls, level_walls
 from .navgrid import NavGrid, on_wall_tolerance, too_close
 from .surface_report import LeftOut, left_out
@@ -260,7 +261,9 @@ def analyse_arena(vertices: np.ndarray, faces: np.ndarray, params: WalkableParam
         raise ArenaError("the model has non-finite vertices (NaN or inf)")
     t = {}
     t0 = time.perf_counter()
-    surface = walkable_surface(vertices, faces, params, fleet.radius)
+    # on the model lattice (nav/grid_window.py): the bundle's grid is this surface's, cut to the walls
+    origin, shape = model_lattice(vertices, params.cell)
+    surface = walkable_surface(vertices, faces, params, fleet.radius, origin_xz=origin, shape=shape)
     keep_for_analysis(surface)
     t["surface"] = time.perf_counter() - t0
     step("surface")
