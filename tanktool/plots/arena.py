@@ -1,7 +1,8 @@
 """Top view of an arena: walls with their normals, the auxiliary rectangle, spawns.
 
-matplotlib is imported inside the function (Agg backend), so importing this module
-costs nothing and works without a display.
+preview.png (:func:`render_levels`) is drawn with Pillow (plots/raster.py);
+:func:`render_preview` (a plain wall list) still with matplotlib.  Both are imported
+inside the functions, so importing this module costs nothing and works without a display.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..formats.walls_txt import WallList
+from .colourmaps import apply, lut
 
 
 #: the free space's fill, the walls, their normals' ticks
@@ -221,18 +223,11 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     walkable cells coloured by height (a flat floor in light green), that level's walls
     with their normals and its spawns; the first panel also shows what was left out
     (unreachable surfaces, too little headroom, too small for a tank, too steep faces),
-    with a legend of their areas."""
-    import matplotlib
+    with a legend of their areas.  Drawn with Pillow (plots/raster.py), no matplotlib."""
+    from PIL import Image, ImageDraw
 
-    matplotlib.use("Agg", force=False)
-    from matplotlib.cm import ScalarMappable
-    from matplotlib.collections import PolyCollection
-    from matplotlib.colors import Normalize
-    from matplotlib.figure import Figure
-    from matplotlib.patches import Patch
-
-    from ..nav.surface_report import low_headroom, steep_faces, too_small, unreachable
     from ..nav.walkable import surface_layers
+    from . import raster
 
     surface = result.surface
     hf = surface.hf
@@ -242,53 +237,66 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     w = max(xmax - xmin, 1e-6)
     h = max(zmax - zmin, 1e-6)
     exists, height = _played_layers(result, surface_layers)
-    nz, nx = hf.shape
-    step, extent = image_step((nz, nx), hf.origin[[0, 2]], hf.cs)
+    step, extent = image_step(hf.shape, hf.origin[[0, 2]], hf.cs)
     ys = height[exists]
     lo, hi = (float(ys.min()), float(ys.max())) if len(ys) else (0.0, 1.0)
     flat = hi - lo <= 2 * hf.ch
     layout = _LevelsLayout.of(L, h / w, bar=not flat)
-    fig = Figure(figsize=(layout.width, layout.height), dpi=size_px / layout.width)
-    cmap = matplotlib.colormaps["viridis"]
-    norm = Normalize(lo, max(hi, lo + 1e-6))
+    dpi = size_px / layout.width
+    W, H = size_px, int(round(layout.height * dpi))
+    img = Image.new("RGB", (W, H), raster.WHITE)
+    pt = dpi / 72.0   # pixels a point, the sizes matplotlib drew with
+    pad = 0.03 * max(w, h)
+    view = (xmin - pad, xmax + pad, zmin - pad, zmax + pad)
+    hi = max(hi, lo + 1e-6)
     for lv in range(L):
-        ax = fig.add_axes(layout.panel(lv))
-        ax.set_aspect("equal")
+        fl, fb, fw, fh = layout.panel(lv)
+        panel = raster.Panel.fit(img, (fl * W, (1 - fb - fh) * H, fw * W, fh * H), view)
         rgba = None
         if flat:
-            fill_region(ax, result.walls.free(lv), FREE_COLOUR)
+            fill_free(panel, result.walls.free(lv), raster.rgb(FREE_COLOUR))
         else:
-            rgba = height_image(exists[lv, ::step, ::step], height[lv, ::step, ::step], cmap, norm)
-        handles = []
-        if lv == 0:
-            handles = _left_out_layers(ax, result, hf, surface, (step, extent), PolyCollection, Patch, steep_faces,
-                                       too_small, low_headroom, unreachable, base=rgba)
-        if rgba is not None:   # the heights with what was left out over them: one image to resample
-            ax.imshow(rgba, origin="lower", extent=extent, interpolation="nearest", zorder=0)
-        _walls_and_spawns(ax, result, lv, 0.012 * max(w, h), 0.03 * max(w, h))
-        pad = 0.03 * max(w, h)
-        ax.set_xlim(xmin - pad, xmax + pad)
-        ax.set_ylim(zmin - pad, zmax + pad)
-        ax.set_xlabel("x (m)")
-        ax.set_ylabel("z (m)")
+            rgba = height_image(exists[lv, ::step, ::step], height[lv, ::step, ::step], lo, hi)
+        keys = _left_out_layers(panel, result, hf, surface, (step, extent), base=rgba) if lv == 0 else []
+        if rgba is not None:   # the heights with what was left out over them: one image
+            panel.image(rgba, extent)
+        ticks = panel.ticks(10 * pt)
+        panel.grid_lines(*ticks)
+        _walls_and_spawns(panel, result, lv, 0.012 * max(w, h), 0.03 * max(w, h), pt)
+        panel.finish("x (m)", "z (m)", 10 * pt, ticks)
         info = result.levels[lv] if lv < len(result.levels) else None
         sub = f"level {lv}" + (f": {info.area:,.0f} m^2, y {info.y_lo:.2f}..{info.y_hi:.2f}" if info else "")
-        ax.set_title(sub if L > 1 else f"{title}\n{sub}", fontsize=9)
-        ax.grid(True, lw=0.3, alpha=0.5)
-        if handles:
-            # below the panel, where it hides no spawn or wall
-            from matplotlib.transforms import offset_copy
-
-            under = offset_copy(ax.transAxes, fig, y=-30, units="points")  # past the ticks and the x label
-            ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0), bbox_transform=under, ncol=2,
-                      fontsize=7, framealpha=0.85)
+        lines = [sub] if L > 1 else [title, sub]
+        d = ImageDraw.Draw(img)
+        for k, s in enumerate(lines[::-1]):
+            raster.text(d, (panel.left + panel.width / 2, panel.top - 6 * pt - k * 12 * pt), s, 9 * pt, anchor="md")
+        if keys:   # below the panel, past the ticks and the x label, where it hides no spawn or wall
+            kw, _ = raster.legend_size(keys, 7.5 * pt, cols=2)
+            raster.legend(img, (panel.left + panel.width / 2 - kw / 2, panel.top + panel.height + 30 * pt), keys,
+                          7.5 * pt, cols=2, frame=True)
     if not flat:
-        fig.colorbar(ScalarMappable(norm, cmap), cax=fig.add_axes(layout.colour_bar()), label="surface height y (m)")
+        bl, bb, bw, bh = layout.colour_bar()
+        box = (int(round(bl * W)), int(round((1 - bb - bh) * H)), int(round(bw * W)), int(round(bh * H)))
+        raster.colour_bar(img, box, lut("viridis"), lo, hi, "surface height y (m)", 10 * pt)
     if L > 1:
-        fig.suptitle(title, fontsize=10, y=1 - 0.2 / layout.height, va="top")
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    return buf.getvalue()
+        raster.text(ImageDraw.Draw(img), (W / 2, 0.2 * dpi), title, 10 * pt, anchor="ma")
+    return raster.png_bytes(img)
+
+
+def fill_free(panel: Any, geom: Any, colour: tuple[int, ...]) -> None:
+    """Fill a shapely (Multi)Polygon on a raster panel, its holes left as they were:
+    parts from the largest down, each outline filled and then its holes in white, so an
+    island standing in a hole (a smaller part) is filled again after the hole."""
+    import shapely
+
+    from .raster import WHITE
+
+    if geom is None or geom.is_empty:
+        return
+    polys = [p for p in shapely.get_parts(geom) if p.geom_type == "Polygon" and not p.is_empty]
+    for p in sorted(polys, key=lambda q: -q.area):
+        panel.polygons([shapely.get_coordinates(p.exterior)], colour)
+        panel.polygons([shapely.get_coordinates(r) for r in p.interiors], WHITE)
 
 
 def _played_layers(result: Any, surface_layers: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -301,16 +309,32 @@ def _played_layers(result: Any, surface_layers: Any) -> tuple[np.ndarray, np.nda
     return surface_layers(s, clearance=False)[:2]
 
 
-def _walls_and_spawns(ax: Any, result: Any, lv: int, tick: float, arrow: float) -> None:
-    """Level ``lv``'s walls (:func:`draw_walls`) and its spawns as numbered arrows
-    ``arrow`` long."""
+def _walls_and_spawns(panel: Any, result: Any, lv: int, tick: float, arrow: float, pt: float) -> None:
+    """Level ``lv``'s walls with their normals' ticks (``tick`` m), the auxiliary
+    rectangle dashed, and its spawns as numbered arrows ``arrow`` m long."""
+    from . import raster
+
     walls = result.walls.walls
     sel = walls.level == lv
-    draw_walls(ax, walls.segments[sel], walls.normals[sel], walls.aux, tick, 1.2)
+    seg = walls.segments[sel]
+    if walls.aux is not None:
+        panel.segments(walls.aux, raster.rgb("#4060c0"), 0.9 * pt, dash=(3.7 * pt, 1.6 * pt))
+    panel.segments(seg, raster.rgb(WALL_COLOUR), 1.2 * pt)
+    if len(seg):
+        mid = seg.mean(axis=1)
+        panel.segments(np.stack([mid, mid + walls.normals[sel] * tick], axis=1), raster.rgb(NORMAL_COLOUR), 0.72 * pt)
     spawns = np.asarray(result.spawns, dtype=np.float64)
+    green = raster.rgb("#1a7a1a")
     for k in np.flatnonzero(_spawns_on_level(result, lv)):
         x, z, th = spawns[k, :3]
-        _spawn_mark(ax, x, z, th, k + 1, arrow, 0.45, zorder=5)
+        u = np.array([np.cos(th), np.sin(th)])
+        a, b, n = panel.px(np.array([[x, z], [x + arrow * u[0], z + arrow * u[1]],
+                                     [x - 0.45 * arrow * u[0], z - 0.45 * arrow * u[1]]]))
+        raster.arrow(panel.draw, a, b, green, 1.5 * pt, 6 * pt, halo=1.0 * pt)
+        r = 2.5 * pt
+        panel.draw.ellipse((a[0] - r, a[1] - r, a[0] + r, a[1] + r), fill=green, outline=raster.WHITE, width=1)
+        raster.text(panel.draw, tuple(n), str(k + 1), 8 * pt, fill=green, anchor="mm", bold=True,
+                    halo=max(1, int(round(1.2 * pt))))
 
 
 def image_step(shape: tuple[int, int], origin: np.ndarray, cell: float) -> tuple[int, tuple[float, ...]]:
@@ -339,14 +363,17 @@ def _spawns_on_level(result: Any, level: int) -> np.ndarray:
     return best == level
 
 
-def _left_out_layers(ax, result, hf, surface, sampled, PolyCollection, Patch, steep_faces, too_small, low_headroom,
-                     unreachable, base: np.ndarray | None = None) -> list:
-    """Draw what the surface left out on ``ax`` (``sampled``: the image's step and
-    extent, image_step); returns legend handles.  ``base``: the heights' image (RGBA
-    bytes, :func:`height_image`), painted over in place, else an image of its own."""
+def _left_out_layers(panel: Any, result: Any, hf: Any, surface: Any, sampled: Any,
+                     base: np.ndarray | None = None) -> list:
+    """Draw what the surface left out on the raster ``panel`` (``sampled``: the image's
+    step and extent, image_step); returns the legend's keys.  ``base``: the heights'
+    image (RGBA bytes, :func:`height_image`), painted over in place, else an image of its own."""
+    from ..nav.surface_report import low_headroom, steep_faces, too_small, unreachable
+    from .raster import Key, rgb
+
     nz, nx = hf.shape
     step, extent = sampled
-    handles = []
+    keys = []
     which = np.zeros((-(-nz // step), -(-nx // step)), dtype=np.int8)   # 0 none, else 1 + colour's index
     colours: list[tuple[float, ...]] = []
 
@@ -357,7 +384,7 @@ def _left_out_layers(ax, result, hf, surface, sampled, PolyCollection, Patch, st
         on = (i % step == 0) & (j % step == 0)  # the cells the image samples
         colours.append(matplotlib_rgba(colour))
         which[i[on] // step, j[on] // step] = len(colours)
-        handles.append(Patch(color=colour, label=f"{label}: {area:,.0f} m^2"))
+        keys.append(Key("patch", f"{label}: {area:,.0f} m^2", rgb(colour)))
 
     cell2 = hf.cs ** 2
     other = unreachable(surface, result.grid.clearance, result.vertices, result.faces)
@@ -367,57 +394,57 @@ def _left_out_layers(ax, result, hf, surface, sampled, PolyCollection, Patch, st
     small = too_small(surface, result.grid.clearance)
     paint(surface.col[small], LEFT_OUT_COLOURS["small"], "too small for a tank", small.sum() * cell2)
     if colours:
-        overlay(which, colours, base, ax, extent)
-    for x in result.left_out:
-        if x.reason.startswith("too steep"):
-            break
-    else:
-        return handles
+        own = overlay(which, colours, base)
+        if own is not None:
+            panel.image(own, extent)
+    if not any(x.reason.startswith("too steep") for x in result.left_out) or result.vertices is None:
+        return keys
     vertices = result.vertices
-    if vertices is not None:
-        sel, area = steep_faces(vertices, result.faces, result.params.max_slope)
-        tri = vertices[result.faces[sel]][:, :, [0, 2]]
-        ax.add_collection(PolyCollection(tri, facecolors=LEFT_OUT_COLOURS["steep"], edgecolors="none", alpha=0.6,
-                                         zorder=2))
-        handles.append(Patch(color=LEFT_OUT_COLOURS["steep"], label=f"too steep: {area.sum():,.0f} m^2"))
-    return handles
+    sel, area = steep_faces(vertices, result.faces, result.params.max_slope)
+    tri = vertices[result.faces[sel]][:, :, [0, 2]]
+    panel.mask_fill(list(tri), rgb(LEFT_OUT_COLOURS["steep"]), 0.6)
+    keys.append(Key("patch", f"too steep: {area.sum():,.0f} m^2", rgb(LEFT_OUT_COLOURS["steep"])))
+    return keys
 
 
-def height_image(exists: np.ndarray, height: np.ndarray, cmap: Any, norm: Any) -> np.ndarray:
-    """(nz, nx, 4) RGBA bytes of the heights through ``cmap`` and ``norm``, clear where
-    there is no surface: what imshow draws of the heights, composed here so the
-    left-out cells go over it before matplotlib resamples one image of bytes (two
-    images of floats took it ~0.2 s on hix)."""
-    rgba = np.zeros((*exists.shape, 4), dtype=np.uint8)
-    # Normalize's arithmetic ((h - vmin) / (vmax - vmin), float64) on a plain array: its
-    # masked array's checks took ~40 ms on hix for no mask
-    rgba[exists] = cmap((height[exists] - norm.vmin) / (norm.vmax - norm.vmin), bytes=True)
-    return rgba
+def height_image(exists: np.ndarray, height: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """(nz, nx, 4) RGBA bytes of the heights through viridis from ``lo`` to ``hi``,
+    clear where there is no surface (the left-out cells go over it in place).  One
+    lookup over the whole grid (entry 256 the clear one): boolean scatters of ~1M
+    samples cost hix ~40 ms."""
+    table = np.zeros((257, 4), dtype=np.uint8)
+    table[:256, :3] = lut("viridis")
+    table[:256, 3] = 255
+    x = np.where(exists, height, lo)
+    x -= lo
+    x *= 256.0 / (hi - lo)
+    idx = x.astype(np.intp)
+    np.clip(idx, 0, 255, out=idx)
+    idx[~exists] = 256
+    return table[idx]
 
 
 #: the left-out cells' opacity over the heights
 LEFT_OUT_ALPHA = 0.75
 
 
-def overlay(which: np.ndarray, colours: list, base: np.ndarray | None, ax: Any, extent: Any) -> None:
+def overlay(which: np.ndarray, colours: list, base: np.ndarray | None) -> np.ndarray | None:
     """The left-out cells (``which``: 1 + their colour's index, 0 none) at
-    LEFT_OUT_ALPHA: blended into ``base`` (bytes, in place) as Agg would draw them over
-    it (on the axes' white where ``base`` is clear), else an image over the panel."""
-    table = np.array([(0.0, 0.0, 0.0, 0.0)] + [(*c[:3], LEFT_OUT_ALPHA) for c in colours])
+    LEFT_OUT_ALPHA: composited over ``base`` (RGBA bytes, in place; None returned),
+    over white where ``base`` is clear, else an RGBA image of their own to draw over the panel."""
+    from PIL import Image
+
+    table = (np.array([(0.0, 0.0, 0.0, 0.0)] + [(*c[:3], LEFT_OUT_ALPHA) for c in colours]) * 255).astype(np.uint8)
     if base is None:
-        ax.imshow((table * 255).astype(np.uint8)[which], origin="lower", extent=extent, interpolation="nearest",
-                  zorder=1)
-        return
-    on = which > 0
-    c = table[which[on]]
-    under = base[on]
-    solid = under[:, 3:] == 255
-    rgb = np.where(solid, LEFT_OUT_ALPHA * c[:, :3] + (1 - LEFT_OUT_ALPHA) * under[:, :3] / 255.0, c[:, :3])
-    alpha = np.where(solid[:, 0], 1.0, LEFT_OUT_ALPHA)
-    base[on] = (np.column_stack([rgb, alpha]) * 255).astype(np.uint8)
+        return table[which]
+    # Pillow's "over" in C: a*c + (1 - a)*under on the heights, c at alpha a where clear
+    base[...] = np.asarray(Image.alpha_composite(Image.fromarray(base), Image.fromarray(table[which])))
+    return None
 
 
 def matplotlib_rgba(colour: str) -> tuple[float, float, float, float]:
-    from matplotlib.colors import to_rgba
+    """``"#rrggbb"`` as matplotlib's RGBA floats (alpha 1)."""
+    from .raster import rgb
 
-    return to_rgba(colour)
+    r, g, b = rgb(colour)[:3]
+    return (r / 255.0, g / 255.0, b / 255.0, 1.0)

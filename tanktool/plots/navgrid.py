@@ -299,10 +299,15 @@ def render_navgrid(
     spawns : (k, 3) ``[x, z, heading]``; region : ``[[x0, z0], [x1, z1]]`` to zoom in;
     annotate : "rows" (renglón/total), "cols" (columna/total), "both" or "none".
     """
+    fr = _frame(grid, region, annotate)
+    if fmt == "png":   # Pillow: a fraction of matplotlib's cost (plots/navgrid_png.py)
+        from .navgrid_png import render_png
+
+        return render_png(grid, walls, fr, quadtree=quadtree, free=free, spawns=spawns, annotate=annotate,
+                          title=title, dpi=dpi)
     import matplotlib
     from matplotlib.figure import Figure
 
-    fr = _frame(grid, region, annotate)
     L = grid.levels
     # a Figure of its own, not pyplot's (0.3 s to import, and a figure manager to close)
     fig = Figure(figsize=(fr.width_in, (fr.height_in + 0.8) * L))
