@@ -380,10 +380,12 @@ def _left_out_layers(panel: Any, result: Any, hf: Any, surface: Any, sampled: An
     def paint(cols, colour, label, area):
         if len(cols) == 0:
             return
-        i, j = np.divmod(cols, nx)
-        on = (i % step == 0) & (j % step == 0)  # the cells the image samples
+        # the cells the image samples: a mask of every column, sliced as the image is
+        # (a scatter, where dividing each column's index by nx and step cost hix ~25 ms)
+        mask = np.zeros(nz * nx, dtype=bool)
+        mask[cols] = True
         colours.append(matplotlib_rgba(colour))
-        which[i[on] // step, j[on] // step] = len(colours)
+        which[mask.reshape(nz, nx)[::step, ::step]] = len(colours)
         keys.append(Key("patch", f"{label}: {area:,.0f} m^2", rgb(colour)))
 
     cell2 = hf.cs ** 2

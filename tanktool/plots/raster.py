@@ -15,15 +15,15 @@ import importlib.util
 import io
 import math
 import os
-from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any, Sequence
+from typing import Any, NamedTuple, Sequence
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-#: zlib level of the PNGs: measured on hix's and box's pictures (~1100 px a side, large
-#: flat areas), level 6 cost ~2x level 1's time for files ~25 % smaller; 3 sits between
+#: zlib level of the PNGs: on hix's, box's and hills' pictures (1100-1500 px a side)
+#: levels 1-3 cost the same (~22 ms for 1100 x 1080 px: Pillow's adaptive row filters
+#: are most of it) and level 6 ~30 % more for files ~27 % smaller
 PNG_LEVEL = 3
 BLACK = (0, 0, 0)
 WHITE = (255, 255, 255)
@@ -117,21 +117,18 @@ def tick_label(v: float, ticks: np.ndarray) -> str:
     return s.replace("-", "\u2212")
 
 
-@dataclass
 class Panel:
     """An axes box on ``img``: the view [x0, x1] x [z0, z1] in metres drawn equal-aspect
     in the pixel box (left, top, width, height), centred in the box it was given.
     Drawing goes on ``tile``, a panel-sized image pasted at :meth:`finish`, so what
-    reaches past the view is cut off."""
+    reaches past the view is cut off.  (A plain class: a dataclass' generated code is
+    compiled at import, ~2 ms each.)"""
 
-    img: Image.Image
-    left: int
-    top: int
-    width: int
-    height: int
-    view: tuple[float, float, float, float]   # x0, x1, z0, z1
-    tile: Image.Image
-    draw: Any
+    def __init__(self, img: Image.Image, left: int, top: int, width: int, height: int,
+                 view: tuple[float, float, float, float], tile: Image.Image, draw: Any) -> None:
+        self.img, self.left, self.top, self.width, self.height = img, left, top, width, height
+        self.view = view   # x0, x1, z0, z1
+        self.tile, self.draw = tile, draw
 
     @classmethod
     def fit(cls, img: Image.Image, box: tuple[float, float, float, float], view: Sequence[float],
@@ -188,6 +185,8 @@ class Panel:
         if dash is not None:
             p = dashes(p, *dash)
         w = max(1, int(round(width)))
+        if w % 2 == 0:   # Pillow truncates and widens an even line down / right: centre it on the wall
+            p = p - 0.5
         line = self.draw.line
         for (a, b), (c, d) in p.tolist():
             line((a, b, c, d), fill=colour, width=w)
@@ -312,8 +311,7 @@ def colour_bar(img: Image.Image, box: tuple[int, int, int, int], table: np.ndarr
     vtext(img, (l + w + 14 + widest + 0.6 * size, t + h / 2), label, size * 1.05)
 
 
-@dataclass(frozen=True)
-class Key:
+class Key(NamedTuple):
     """A legend entry: ``kind`` "patch" (a filled box), "line" (``dash`` for dashed),
     "star" or "text" (a note, no mark)."""
 
@@ -326,6 +324,7 @@ class Key:
 
 def legend_size(keys: Sequence[Key], size: float, cols: int = 1) -> tuple[int, int]:
     """(width, height) px of :func:`legend`."""
+    cols = max(1, min(cols, len(keys)))
     rows = -(-len(keys) // cols)
     lines = [k.label.count("\n") + 1 for k in keys]
     col_w = max((text_width(line, size) for k in keys for line in k.label.split("\n")), default=0.0)
@@ -336,6 +335,7 @@ def legend(img: Image.Image, xy: tuple[float, float], keys: Sequence[Key], size:
            frame: bool = False) -> None:
     """The legend's entries in ``cols`` columns from the top-left corner ``xy``."""
     d = ImageDraw.Draw(img, "RGBA")
+    cols = max(1, min(cols, len(keys)))
     w, h = legend_size(keys, size, cols)
     x0, y0 = xy
     if frame:
