@@ -126,6 +126,22 @@ static int height(const Ground *g, double x, double z, i64 level, double *out) {
     return 1;
 }
 
+/* sim/ground.py's supported: an end of the hull over ground more than drop below its
+   centre y is not under it; the hull lies on the other end's slope (both: level) */
+static void supported(double y, double *ha, double *hb, double drop) {
+    const double low = y - drop;
+    if (*ha < low) {
+        if (*hb < low) {
+            *ha = y;
+            *hb = y;
+        } else {
+            *ha = y + (y - *hb);
+        }
+    } else if (*hb < low) {
+        *hb = y + (y - *ha);
+    }
+}
+
 PyObject *tanktool_ground_tilt(PyObject *self, PyObject *args) {
     Py_buffer hb, fb;
     Ground g;
@@ -159,6 +175,8 @@ PyObject *tanktool_ground_tilt(PyObject *self, PyObject *args) {
             Py_INCREF(ret);
             goto done;
         }
+        supported(y, &hf, &hbk, g.climb + hl);
+        supported(y, &hlft, &hr, g.climb + hw);
         const double pitch = hl > 0 ? atan2(hf - hbk, 2.0 * hl) : 0.0;
         const double roll = hw > 0 ? atan2(hlft - hr, 2.0 * hw) : 0.0;
         ret = Py_BuildValue("(ddd)", y, pitch, roll);

@@ -45,6 +45,23 @@ GROUND_BAND = 256
 STEPS = ((0, 1), (1, 0), (0, -1), (-1, 0))
 
 
+def supported(y: float, ha: float, hb: float, drop: float) -> tuple[float, float]:
+    """The heights at a hull's two ends (front and back, or left and right) that it
+    rests on, its centre at ``y``: an end over ground more than ``drop`` (the climb +
+    1 m a metre out to it) below the centre is not under the hull -- a ramp's side, a
+    plateau's edge, a cell with no surface (read as 0) -- and the hull lies on the
+    slope of the other end (both: level).  Read as ground, the back of a tank parked
+    at a ramp's top 0.5 m from the ramp's side pitched it 41 degrees and gravity slid
+    it to the foot of the ramp (the gen-bridge's spawn, 0-0 all duel).  The compiled
+    kernel does the same (_kernels_ground.c)."""
+    low = y - drop
+    if ha < low:
+        return (y, y) if hb < low else (y + (y - hb), hb)
+    if hb < low:
+        return ha, y + (y - ha)
+    return ha, hb
+
+
 class MeshIndex:
     """Triangles in (x, z) buckets of ``bucket`` metres, for segment queries."""
 
@@ -436,6 +453,8 @@ class Ground:
         # the right-hand side of a facing (c, s) is (-s, c) in (x, z)
         hr = self.height(x - s * half_width, z + c * half_width, level)
         hl = self.height(x + s * half_width, z - c * half_width, level)
+        hf, hb = supported(y, hf, hb, self.climb + half_length)
+        hl, hr = supported(y, hl, hr, self.climb + half_width)
         pitch = math.atan2(hf - hb, 2.0 * half_length) if half_length > 0 else 0.0
         roll = math.atan2(hl - hr, 2.0 * half_width) if half_width > 0 else 0.0
         return y, pitch, roll

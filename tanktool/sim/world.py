@@ -38,6 +38,7 @@ from .flat_ground import FlatGround
 from .resolve import SLOP, correct_walls, pair_impulse, separate_pair, wall_impulse
 from .rules import DEFAULT as DEFAULT_RULES, GRAVITY, MatchState, Rules
 from .weapons import Shell, fire, fly, stop_fraction
+from .on_ground import slope_pull
 from .world_ground import EYE, GroundMixin  # noqa: F401
 
 DT = 1.0 / 120.0
@@ -311,13 +312,10 @@ class World(GroundMixin):
             t.fx = ff * c - fr * sn
             t.fz = ff * sn + fr * c
             if t.pitch != 0.0 or t.roll != 0.0:
-                # gravity along the slope: on a plane of gradient G the horizontal pull is
-                # g G / (1 + |G|^2) downhill (g sin(theta) cos(theta))
-                gf, gr = math.tan(t.pitch), -math.tan(t.roll)   # rise along forward, along right
-                gx, gz = gf * c - gr * sn, gf * sn + gr * c
-                k = -m * GRAVITY / (1.0 + gx * gx + gz * gz)
-                t.fx += k * gx
-                t.fz += k * gz
+                # gravity along the slope, but for what the tracks hold (on_ground.slope_pull)
+                px, pz = slope_pull(t, m, a, s, vf, vr)
+                t.fx += px
+                t.fz += pz
             turn_drag = min(sp.turn_drag, sp.inertia * inv_dt)
             t.torque = sp.turn_torque * r - turn_drag * t.omega
             if want_fire and t.reload <= 0.0:
