@@ -355,7 +355,7 @@ def legend(img: Image.Image, xy: tuple[float, float], keys: Sequence[Key], size:
             for (a, b), (p, q) in (dashes(seg[0:1], 4, 3) if k.dash else seg).tolist():
                 d.line((a, b, p, q), fill=k.colour, width=max(1, int(round(k.width))))
         elif k.kind == "star":
-            star(d, np.array([x + 0.95 * size, mid]), 0.75 * size, k.colour)
+            star(d, np.array([x + 0.95 * size, mid]), 0.95 * size, k.colour)
         for m, line in enumerate(k.label.split("\n")):
             text(d, (x + 2.5 * size, mid + m * 1.45 * size), line, size, anchor="lm")
         y_of[c] += (k.label.count("\n") + 1) * 1.45 * size
