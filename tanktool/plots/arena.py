@@ -252,14 +252,16 @@ def render_levels(result: Any, title: str, size_px: int = 1100) -> bytes:
     for lv in range(L):
         fl, fb, fw, fh = layout.panel(lv)
         panel = raster.Panel.fit(img, (fl * W, (1 - fb - fh) * H, fw * W, fh * H), view)
-        rgba = None
         if flat:
             fill_free(panel, result.walls.free(lv), raster.rgb(FREE_COLOUR))
-        else:
-            rgba = height_image(exists[lv, ::step, ::step], height[lv, ::step, ::step], lo, hi)
-        keys = _left_out_layers(panel, result, hf, surface, (step, extent), base=rgba) if lv == 0 else []
-        if rgba is not None:   # the heights with what was left out over them: one image
-            panel.image(rgba, extent)
+        which, colours, keys, steep = _left_out_layers(result, hf, surface, step) if lv == 0 else (None, [], [], [])
+        if not flat:   # the heights with what was left out over them: one lookup, one image
+            hidx = height_index(exists[lv, ::step, ::step], height[lv, ::step, ::step], lo, hi)
+            panel.image(compose(hidx, which, colours), extent)
+        elif colours:
+            panel.image(overlay(which, colours), extent)
+        if len(steep):
+            panel.mask_fill(steep, raster.rgb(LEFT_OUT_COLOURS["steep"]), 0.6)
         ticks = panel.ticks(10 * pt)
         panel.grid_lines(*ticks)
         _walls_and_spawns(panel, result, lv, 0.012 * max(w, h), 0.03 * max(w, h), pt)
@@ -363,18 +365,16 @@ def _spawns_on_level(result: Any, level: int) -> np.ndarray:
     return best == level
 
 
-def _left_out_layers(panel: Any, result: Any, hf: Any, surface: Any, sampled: Any,
-                     base: np.ndarray | None = None) -> list:
-    """Draw what the surface left out on the raster ``panel`` (``sampled``: the image's
-    step and extent, image_step); returns the legend's keys.  ``base``: the heights'
-    image (RGBA bytes, :func:`height_image`), painted over in place, else an image of its own."""
+def _left_out_layers(result: Any, hf: Any, surface: Any, step: int) -> tuple[np.ndarray, list, list, list]:
+    """What the surface left out, for the first panel: (which: the sampled cells' 1 +
+    colour index, 0 none, every ``step``-th cell as the image samples them; their
+    colours; the legend's keys; the too steep faces' triangles (k, 3, 2) in x, z)."""
     from ..nav.surface_report import low_headroom, steep_faces, too_small, unreachable
     from .raster import Key, rgb
 
     nz, nx = hf.shape
-    step, extent = sampled
     keys = []
-    which = np.zeros((-(-nz // step), -(-nx // step)), dtype=np.int8)   # 0 none, else 1 + colour's index
+    which = np.zeros((-(-nz // step), -(-nx // step)), dtype=np.int8)
     colours: list[tuple[float, ...]] = []
 
     def paint(cols, colour, label, area):
@@ -395,53 +395,70 @@ def _left_out_layers(panel: Any, result: Any, hf: Any, surface: Any, sampled: An
     paint(hf.col[low], LEFT_OUT_COLOURS["headroom"], "too little headroom", low.sum() * cell2)
     small = too_small(surface, result.grid.clearance)
     paint(surface.col[small], LEFT_OUT_COLOURS["small"], "too small for a tank", small.sum() * cell2)
-    if colours:
-        own = overlay(which, colours, base)
-        if own is not None:
-            panel.image(own, extent)
     if not any(x.reason.startswith("too steep") for x in result.left_out) or result.vertices is None:
-        return keys
+        return which, colours, keys, []
     vertices = result.vertices
     sel, area = steep_faces(vertices, result.faces, result.params.max_slope)
-    tri = vertices[result.faces[sel]][:, :, [0, 2]]
-    panel.mask_fill(list(tri), rgb(LEFT_OUT_COLOURS["steep"]), 0.6)
     keys.append(Key("patch", f"too steep: {area.sum():,.0f} m^2", rgb(LEFT_OUT_COLOURS["steep"])))
-    return keys
+    return which, colours, keys, list(vertices[result.faces[sel]][:, :, [0, 2]])
 
 
-def height_image(exists: np.ndarray, height: np.ndarray, lo: float, hi: float) -> np.ndarray:
-    """(nz, nx, 4) RGBA bytes of the heights through viridis from ``lo`` to ``hi``,
-    clear where there is no surface (the left-out cells go over it in place).  One
-    lookup over the whole grid (entry 256 the clear one): boolean scatters of ~1M
-    samples cost hix ~40 ms."""
-    table = np.zeros((257, 4), dtype=np.uint8)
-    table[:256, :3] = lut("viridis")
-    table[:256, 3] = 255
+def height_index(exists: np.ndarray, height: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """Each sample's entry of viridis from ``lo`` to ``hi`` (a value x is entry int(x *
+    256), as matplotlib looks it up), 256 where there is no surface."""
     x = np.where(exists, height, lo)
     x -= lo
     x *= 256.0 / (hi - lo)
     idx = x.astype(np.intp)
     np.clip(idx, 0, 255, out=idx)
     idx[~exists] = 256
-    return table[idx]
+    return idx
+
+
+def _height_table() -> np.ndarray:
+    """(257, 4) RGBA bytes: viridis' 256 entries, then clear."""
+    table = np.zeros((257, 4), dtype=np.uint8)
+    table[:256, :3] = lut("viridis")
+    table[:256, 3] = 255
+    return table
+
+
+def height_image(exists: np.ndarray, height: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """(nz, nx, 4) RGBA bytes of the heights through viridis, clear where there is no surface."""
+    return _height_table()[height_index(exists, height, lo, hi)]
 
 
 #: the left-out cells' opacity over the heights
 LEFT_OUT_ALPHA = 0.75
 
 
-def overlay(which: np.ndarray, colours: list, base: np.ndarray | None) -> np.ndarray | None:
-    """The left-out cells (``which``: 1 + their colour's index, 0 none) at
-    LEFT_OUT_ALPHA: composited over ``base`` (RGBA bytes, in place; None returned),
-    over white where ``base`` is clear, else an RGBA image of their own to draw over the panel."""
-    from PIL import Image
+def compose(hidx: np.ndarray, which: np.ndarray | None, colours: list) -> np.ndarray:
+    """RGBA bytes of the heights (``hidx``: :func:`height_index`) with the left-out
+    cells (``which``) over them at LEFT_OUT_ALPHA, by one lookup in a table of every
+    (left-out colour, height entry) pair blended once: a*c + (1 - a)*under on a height,
+    c at alpha a where there is none.  (Composing two images of ~1M samples cost hix ~20 ms.)"""
+    base = _height_table()
+    if which is None or not colours:
+        return base[hidx]
+    under = base[:256, :3] / 255.0
+    parts = [base]
+    for c in colours:
+        part = np.empty((257, 4))
+        part[:256, :3] = LEFT_OUT_ALPHA * np.asarray(c[:3]) + (1 - LEFT_OUT_ALPHA) * under
+        part[:256, 3] = 1.0
+        part[256] = (*c[:3], LEFT_OUT_ALPHA)
+        parts.append((part * 255).astype(np.uint8))
+    idx = which.astype(np.intp)
+    idx *= 257
+    idx += hidx
+    return np.concatenate(parts)[idx]
 
-    table = (np.array([(0.0, 0.0, 0.0, 0.0)] + [(*c[:3], LEFT_OUT_ALPHA) for c in colours]) * 255).astype(np.uint8)
-    if base is None:
-        return table[which]
-    # Pillow's "over" in C: a*c + (1 - a)*under on the heights, c at alpha a where clear
-    base[...] = np.asarray(Image.alpha_composite(Image.fromarray(base), Image.fromarray(table[which])))
-    return None
+
+def overlay(which: np.ndarray, colours: list) -> np.ndarray:
+    """RGBA bytes of the left-out cells (``which``: 1 + their colour's index, 0 none)
+    at LEFT_OUT_ALPHA, to draw over a flat level's panel."""
+    table = np.array([(0.0, 0.0, 0.0, 0.0)] + [(*c[:3], LEFT_OUT_ALPHA) for c in colours])
+    return (table * 255).astype(np.uint8)[which]
 
 
 def matplotlib_rgba(colour: str) -> tuple[float, float, float, float]:
