@@ -223,10 +223,9 @@ def build_grid(target: Target, cell: float | None = None, clearance: float | Non
     if params is not None:
         reuse = base if base is not None and base["params"] == params else None
         if reuse is None and analysed is not None and analysed["params"] == params:
-            reuse = analysed   # import-arena's surface of this model on the same lattice: not built again
+            # import-arena's surface of this model on the same lattice: not built again
+            reuse = {"surface": _handed_over(analysed)}
         grid, free, surface = _layered(target, params, clearance, bounds, reuse)
-        if analysed is not None:   # the caller's reference too: the reseeded surface shares what it reads
-            analysed["surface"] = None
         analysed = reuse = None
     else:
         surface = None
@@ -240,6 +239,17 @@ def build_grid(target: Target, cell: float | None = None, clearance: float | Non
         _smaller_vehicles(target, built, shared)
     built.seconds = time.perf_counter() - t0
     return built
+
+
+def _handed_over(analysed: dict[str, Any]) -> Any:
+    """import-arena's analysed surface, taken out of ``analysed`` (the caller's last
+    reference), without its played region and levels: the reseed finds them anew, and
+    the old levels beside the new ones were +0.13 GB at a 2 km terrain's peak."""
+    import numpy as np
+
+    s = analysed.pop("surface")
+    s.main, s.level = np.zeros(0, dtype=bool), np.zeros(0, dtype=s.level.dtype)
+    return s
 
 
 def _smaller_vehicles(target: Target, built: BuiltGrid, shared: dict[str, Any]) -> None:
