@@ -37,6 +37,7 @@
  *   grid_runs(valid, link, L, nz, nx, row_index, row_total, col_index, col_total)   (_kernels_grid.c)
  *   open_spans(col, smin, smax, walk, out_col, out_floor, out_ceil) -> m   (_kernels_surface.c)
  *   snap_heights(floor, walk, flat, heights, origin_y, ch, out)   (_kernels_surface.c)
+ *   flat_floor_of(flat_cells, span_of, span_y, flat_h, cell_h, out_idx, out_pos)   (_kernels_surface.c)
  *   scatter_layers(level, col, height, clear, per, exists, height_out, span_out, clear_out)
  *       (_kernels_surface.c)
  *   level_votes(col, keep, link, level, rounds)   (_kernels_surface.c)
@@ -485,6 +486,7 @@ static PyMethodDef methods[] = {
     {"chamfer_grid", chamfer_grid, METH_VARARGS, "chamfer() on the ground's (L, nz, nx, 4) int8 links, in place"},
     {"open_spans", tanktool_open_spans, METH_VARARGS, "the walkable spans' columns, floors, ceilings (_kernels_surface.c)"},
     {"snap_heights", tanktool_snap_heights, METH_VARARGS, "the open spans' floor heights (_kernels_surface.c)"},
+    {"flat_floor_of", tanktool_flat_floor_of, METH_VARARGS, "level_walls' flat cells and their floors (_kernels_surface.c)"},
     {"scatter_layers", tanktool_scatter_layers, METH_VARARGS, "surface_layers' scatter (_kernels_surface.c)"},
     {"level_votes", tanktool_level_votes, METH_VARARGS, "levels by column rank, then the voting rounds (_kernels_surface.c)"},
     {"lift_portals", tanktool_lift_portals, METH_VARARGS, "level_lift.lift_to_portals in place (_kernels_surface.c)"},
@@ -502,7 +504,7 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernels", "tanktool
 
 /* ABI: raised whenever a kernel's name or arguments change; geometry/kernels.py uses a
    build only when it matches (an editable install keeps an old build in the tree). */
-#define TANKTOOL_KERNELS_ABI 17
+#define TANKTOOL_KERNELS_ABI 18
 PyMODINIT_FUNC PyInit__kernels(void) {
     PyObject *m = PyModule_Create(&module);
     if (m != NULL && PyModule_AddIntConstant(m, "ABI", TANKTOOL_KERNELS_ABI) < 0) {

@@ -59,6 +59,7 @@ PyObject *tanktool_grid_runs(PyObject *self, PyObject *args);
 /* the open spans, their clearance and levels (_kernels_surface.c) */
 PyObject *tanktool_open_spans(PyObject *self, PyObject *args);
 PyObject *tanktool_snap_heights(PyObject *self, PyObject *args);
+PyObject *tanktool_flat_floor_of(PyObject *self, PyObject *args);
 PyObject *tanktool_scatter_layers(PyObject *self, PyObject *args);
 PyObject *tanktool_level_votes(PyObject *self, PyObject *args);
 PyObject *tanktool_lift_portals(PyObject *self, PyObject *args);

@@ -499,3 +499,62 @@ done:
     PyBuffer_Release(&col);
     return ret;
 }
+
+/* level_walls._flat_floor_of: each flat cell's flat index and the model floor its
+ * span's height rounds up from, in one pass where numpy took flatnonzero, a gather,
+ * searchsorted and where (hix: ~0.13 s).  flat_cells bool (N,); span_of int32 (N,);
+ * span_y float64; flat_h float64 sorted; out_idx int32 (m,), out_pos int32 (m,), m the
+ * flat cells: pos the highest floor at or below hy + 1e-6 (searchsorted side right,
+ * minus one) when hy - that floor <= cell_h + 1e-6, else -1 */
+PyObject *tanktool_flat_floor_of(PyObject *self, PyObject *args) {
+    Py_buffer cells, span_of, span_y, flat_h, oi, op;
+    double cell_h;
+    if (!PyArg_ParseTuple(args, "y*y*y*y*dw*w*", &cells, &span_of, &span_y, &flat_h, &cell_h, &oi, &op))
+        return NULL;
+    const Py_ssize_t n = cells.len, m = oi.len / 4, nh = flat_h.len / 8, ns = span_y.len / 8;
+    PyObject *ret = NULL;
+    int bad = 0;
+    if (!need(&span_of, n, 4, "span_of") || !need(&op, m, 4, "out_pos")) goto done;
+    {
+        const uint8_t *C = cells.buf;
+        const int32_t *S = span_of.buf;
+        const double *Y = span_y.buf, *H = flat_h.buf, tol = cell_h + 1e-6;
+        int32_t *I = oi.buf, *P = op.buf;
+        Py_ssize_t k = 0, lo = 0;
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t c = 0; c < n; ++c) {
+            if (!C[c]) continue;
+            if (k >= m || S[c] < 0 || S[c] >= ns) { bad = 1; break; }
+            const double hy = Y[S[c]], v = hy + 1e-6;
+            /* the first floor above v: the last cell's when it still is (neighbours
+             * mostly stand on one floor), else a binary search */
+            if (!((lo == 0 || H[lo - 1] <= v) && (lo == nh || H[lo] > v))) {
+                Py_ssize_t hi = nh;
+                lo = 0;
+                while (lo < hi) {
+                    const Py_ssize_t mid = lo + (hi - lo) / 2;
+                    if (H[mid] <= v) lo = mid + 1; else hi = mid;
+                }
+            }
+            /* numpy: p = lo - 1; ok = p >= 0 and hy - H[max(p, 0)] <= tol */
+            I[k] = (int32_t)c;
+            P[k++] = (lo > 0 && hy - H[lo - 1] <= tol) ? (int32_t)(lo - 1) : -1;
+        }
+        Py_END_ALLOW_THREADS
+        if (!bad && k != m) bad = 1;
+    }
+    if (bad) {
+        PyErr_SetString(PyExc_ValueError, "flat_floor_of: out arrays do not match the flat cells");
+        goto done;
+    }
+    ret = Py_None;
+    Py_INCREF(ret);
+done:
+    PyBuffer_Release(&cells);
+    PyBuffer_Release(&span_of);
+    PyBuffer_Release(&span_y);
+    PyBuffer_Release(&flat_h);
+    PyBuffer_Release(&oi);
+    PyBuffer_Release(&op);
+    return ret;
+}

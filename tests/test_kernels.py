@@ -177,3 +177,27 @@ def test_random_layered_grids_have_the_same_components(seed):
         b, kb = grid_components(grid)
     assert ka == kb > 1
     np.testing.assert_array_equal(a, b)
+
+
+@needs_kernels
+@pytest.mark.parametrize("seed", range(5))
+def test_random_flat_cells_find_the_same_floors(seed):
+    # level_walls._flat_floor_of: heights on a floor, a rounding above it, within and
+    # past a cell height, below every floor; the kernel's one pass and numpy's blocks
+    from tanktool.nav.level_walls import _flat_floor_of
+
+    rng = np.random.default_rng(seed)
+    floors = np.sort(rng.choice(np.arange(-20, 40) * 0.35, size=8, replace=False))
+    n_spans = 5000
+    base = floors[rng.integers(0, len(floors), n_spans)]
+    span_y = base + rng.choice([0.0, 1e-7, 0.05, 0.1, 0.1 + 2e-6, 0.3, -0.2], n_spans)
+    span_y[:50] = floors[0] - 1.0
+    flat_cells = rng.random((60, 70)) < 0.6
+    span_of = np.where(flat_cells, rng.integers(0, n_spans, (60, 70)), -1).astype(np.int32)
+    out = {}
+    for on in (True, False):
+        with use_kernels(on):
+            out[on] = _flat_floor_of(flat_cells, span_of, span_y, floors, 0.1)
+    for a, b in zip(out[True], out[False]):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
+    assert (out[True][1] == -1).any() and (out[True][1] >= 0).any()

@@ -21,7 +21,7 @@ from typing import Iterator
 import numpy as np
 
 #: the kernels' interface this code calls (TANKTOOL_KERNELS_ABI in tanktool/_kernels.c)
-ABI = 17
+ABI = 18
 
 try:  # built by setup.py when a compiler was there
     from .. import _kernels as _compiled

@@ -43,6 +43,7 @@ from ..geometry.cross_section import cells_polygon
 from ..geometry import walls as cut
 from ..geometry.wall_pairs import Repairs, pair_tolerance, repair_walls
 from ..geometry.heightfield import FACE_BLOCK, FLAT_GAP, flat_heights
+from ..geometry.kernels import active
 from .inner_walls import inner_walls
 from .walkable import BLOCK, DIRS, Surface, surface_layers
 
@@ -317,18 +318,9 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
     if not (flat_cells.any() and len(c.flat_h)):
         return fl
     flat_h, cell = c.flat_h, c.cell
-    # each flat cell as one int32 index, and the cluster whose height its span's top
-    # rounds up from (within a cell height; -1: none), a block of cells at a time: the
-    # heights, indices and their temporaries took ~60 bytes a flat cell (+0.25 GB on 2 km)
-    fidx = np.flatnonzero(flat_cells).astype(np.int32 if cells.size < 2**31 else np.int64)
+    # each flat cell as one int32 index, and the cluster its span's top rounds up from
+    fidx, pos = _flat_floor_of(flat_cells, c.span_of[level], c.span_y, flat_h, c.cell_h)
     del flat_cells
-    spans = c.span_of[level].ravel()
-    pos = np.empty(len(fidx), dtype=np.int32)
-    for a in range(0, len(fidx), BLOCK):
-        hy = c.span_y[spans[fidx[a:a + BLOCK]]]
-        p = np.searchsorted(flat_h, hy + 1e-6, side="right") - 1
-        ok = (p >= 0) & (hy - flat_h[np.maximum(p, 0)] <= c.cell_h + 1e-6)
-        pos[a:a + BLOCK] = np.where(ok, p, -1)
     # the floors present, sorted: np.unique(pos[okc]) without sorting (hix: 0.1 s)
     floors = np.flatnonzero(np.bincount(pos[pos >= 0], minlength=len(flat_h)))
     present = flat_h[floors]
@@ -358,6 +350,32 @@ def _exact_floors(c: _Cut, level: int, cells: np.ndarray) -> _Floors:
         _cut_floor(c, cells, mask, float(flat_h[k]), base, fl)
         fl.heights.append((float(flat_h[k]), float(mask.sum() * cell * cell)))
     return fl
+
+
+def _flat_floor_of(flat_cells: np.ndarray, span_of: np.ndarray, span_y: np.ndarray, flat_h: np.ndarray,
+                   cell_h: float) -> tuple[np.ndarray, np.ndarray]:
+    """(each flat cell's flat index, the floor (index into ``flat_h``) its span's
+    height rounds up from, within a cell height; -1: none), a block of cells at a time:
+    the heights, indices and their temporaries took ~60 bytes a flat cell (+0.25 GB on
+    2 km).  The compiled kernel does it in one pass (hix: ~0.13 s in numpy)."""
+    kern = active()
+    spans = span_of.ravel()
+    small = flat_cells.size < 2**31
+    if kern is not None and small and spans.dtype == np.int32 and span_y.dtype == np.float64:
+        fc = np.ascontiguousarray(flat_cells).ravel()
+        fidx = np.empty(int(np.count_nonzero(fc)), dtype=np.int32)
+        pos = np.empty(len(fidx), dtype=np.int32)
+        kern.flat_floor_of(fc, np.ascontiguousarray(spans), np.ascontiguousarray(span_y),
+                           np.ascontiguousarray(flat_h, dtype=np.float64), float(cell_h), fidx, pos)
+        return fidx, pos
+    fidx = np.flatnonzero(flat_cells).astype(np.int32 if small else np.int64)
+    pos = np.empty(len(fidx), dtype=np.int32)
+    for a in range(0, len(fidx), BLOCK):
+        hy = span_y[spans[fidx[a:a + BLOCK]]]
+        p = np.searchsorted(flat_h, hy + 1e-6, side="right") - 1
+        ok = (p >= 0) & (hy - flat_h[np.maximum(p, 0)] <= cell_h + 1e-6)
+        pos[a:a + BLOCK] = np.where(ok, p, -1)
+    return fidx, pos
 
 
 def _label_sizes(lab: np.ndarray, n: int) -> np.ndarray:
