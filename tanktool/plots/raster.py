@@ -66,7 +66,7 @@ def font(size_px: float, bold: bool = False) -> Any:
             return ImageFont.truetype(path, size)
         except OSError:   # a damaged font file: the default font still writes
             pass
-    return ImageFont.load_default(size)
+    return ImageFont.load_default(size)   # Pillow >= 10.1: a FreeType font of any size
 
 
 def text(draw: Any, xy: tuple[float, float], s: str, size: float, fill: Any = TEXT, anchor: str = "la",
