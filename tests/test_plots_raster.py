@@ -122,3 +122,27 @@ def test_navgrids_sampled_states_are_the_states_sliced():
     for k in (1, 2, 3):
         for mask in (free, None):
             assert np.array_equal(sampled_states(g, mask, k), node_states(g, mask)[::k, ::k])
+
+
+def test_segments_are_cut_to_the_tile_before_drawing():
+    p = np.array([[[-10, 5], [20, 5]], [[-10, -10], [-5, -5]], [[5, -100], [5, 100]], [[-1e6, 3], [1e6, 3]]], float)
+    cut = raster.clip_segments(p, 10, 10)
+    assert np.allclose(cut, [[[0, 5], [10, 5]], [[5, 0], [5, 10]], [[0, 3], [10, 3]]], atol=1e-6)
+    # a dashed line a million pixels long outside the tile costs nothing (it is dropped first)
+    panel = raster.Panel.fit(Image.new("RGB", (50, 50)), (0, 0, 50, 50), (0.0, 1.0, 0.0, 1.0))
+    panel.segments(np.array([[[-1e5, -1e5], [1e5, -1e5]]]), raster.BLACK, 1, dash=(3, 2))
+
+
+def test_a_navgrid_picture_of_a_region_beside_the_grid_is_refused_in_words():
+    from tanktool.formats.walls_txt import WallList, aux_rectangle
+    from tanktool.nav.navgrid import NavGrid
+    from tanktool.plots.navgrid import render_navgrid
+
+    shape = (20, 30)
+    v = np.ones((1, *shape), dtype=bool)
+    z = np.zeros((1, *shape), dtype=np.int32)
+    g = NavGrid(np.array([0.0, 0.0]), 0.5, shape, v, z, z, z, z, v.copy(), 1.0)
+    walls = WallList(np.array([[[1.0, 1.0], [5.0, 1.0]]]), np.ones(1, np.int8), aux_rectangle(0, 0, 15, 10))
+    with pytest.raises(ValueError, match="no node"):
+        render_navgrid(g, walls, region=np.array([[100.0, 100.0], [103.0, 103.0]]))
+    assert render_navgrid(g, walls, region=np.array([[1.0, 1.0], [2.0, 2.0]]))[:4] == b"\x89PNG"

@@ -300,6 +300,8 @@ def render_navgrid(
     annotate : "rows" (renglón/total), "cols" (columna/total), "both" or "none".
     """
     fr = _frame(grid, region, annotate)
+    if fr.j1 <= fr.j0 or fr.i1 <= fr.i0:
+        raise ValueError(f"region {np.asarray(region).tolist()} holds no node of the grid")
     if fmt == "png":   # Pillow: a fraction of matplotlib's cost (plots/navgrid_png.py)
         from .navgrid_png import render_png
 

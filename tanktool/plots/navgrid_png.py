@@ -64,6 +64,8 @@ def node_image(grid: Any, free: np.ndarray | None, relief: tuple[float, float] |
 def _cells(panel: raster.Panel, grid: Any, states: np.ndarray, fr: Any, labelling: bool, pt: float) -> None:
     """Node centres and cell edges, when cells are big enough to show them."""
     i0, i1, j0, j1 = fr.i0, fr.i1, fr.j0, fr.j1
+    if i1 <= i0 or j1 <= j0:   # a view beside the grid: no cell in it
+        return
     xs, zs = np.meshgrid(grid.node_x[j0:j1], grid.node_z[i0:i1])
     dot = states[i0:i1, j0:j1] > 0   # no dots on solid ground (clutter) nor under labels
     if labelling:

@@ -182,7 +182,9 @@ class Panel:
         seg = np.asarray(seg, dtype=np.float64).reshape(-1, 2, 2)
         if not len(seg):
             return
-        p = self.px(seg)
+        # cut to the tile first: a zoom puts far walls (and the dashed rectangle, in
+        # ~400,000 dashes on hix at 1 m) hundreds of thousands of pixels away
+        p = clip_segments(self.px(seg), self.width, self.height, margin=width + 2)
         if dash is not None:
             p = dashes(p, *dash)
         w = max(1, int(round(width)))
@@ -240,7 +242,26 @@ class Panel:
             widest = max(widest, text_width(s, size))
             text(d, (l - tick - 4, Z), s, size, anchor="rm")
         text(d, (l + w / 2, t + h + tick + 6 + 1.3 * size), xlabel, size * 1.05, anchor="mt")
-        vtext(img, (l - tick - 8 - widest - 0.6 * size, t + h / 2), ylabel, size * 1.05)
+        # beside the widest tick label, but never off the picture's edge
+        vtext(img, (max(0.7 * size, l - tick - 8 - widest - 0.6 * size), t + h / 2), ylabel, size * 1.05)
+
+
+def clip_segments(p: np.ndarray, w: float, h: float, margin: float = 0.0) -> np.ndarray:
+    """Pixel segments (n, 2, 2) cut to [-margin, w + margin] x [-margin, h + margin]
+    (Liang-Barsky on every segment at once); those wholly outside are dropped."""
+    a, d = p[:, 0], p[:, 1] - p[:, 0]
+    t0, t1 = np.zeros(len(p)), np.ones(len(p))
+    keep = np.ones(len(p), dtype=bool)
+    lo, hi = -margin, (w + margin, h + margin)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for k in (0, 1):
+            for pk, qk in ((-d[:, k], a[:, k] - lo), (d[:, k], hi[k] - a[:, k])):
+                keep &= ~((pk == 0) & (qk < 0))     # parallel to this edge and beyond it
+                r = qk / pk
+                t0 = np.where(pk < 0, np.maximum(t0, r), t0)
+                t1 = np.where(pk > 0, np.minimum(t1, r), t1)
+    keep &= t0 <= t1
+    return np.stack([a + t0[:, None] * d, a + t1[:, None] * d], axis=1)[keep]
 
 
 def bins(length: float, size: float) -> int:
