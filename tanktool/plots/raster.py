@@ -3,8 +3,8 @@ image: a panel mapping metres to pixels (z up), images of grids, segments, dashe
 polygons, text with a halo, axes with ticks in metres, a colour bar, a legend, PNG bytes.
 
 Why not matplotlib: its figure, axes, ticks and text machinery and its PNG writer were
-most of the pictures' cost (hix: 0.55 s of CPU for the two, box 0.3 s, most of a small
-level's import), while what these pictures draw is a few images and a few thousand
+most of the pictures' cost (hix: ~0.7 s of CPU for the two, box ~0.4 s, most of a small
+level's import; now 0.16 and 0.09 s, docs/speed.md), while what these pictures draw is a few images and a few thousand
 lines.  Pillow is already a dependency; the text is DejaVu Sans (matplotlib's font file,
 found without importing matplotlib), else Pillow's own default font.
 """
