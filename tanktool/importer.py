@@ -283,7 +283,11 @@ def _as_stored(mesh: Any) -> None:
     the analysis' surface is then the one build-navgrid rasterises from model.glb
     (a vertex on the other side of a cell or step line moved a span else)."""
     v = mesh.vertices
-    v[...] = np.asarray(v, dtype=np.float64).astype(np.float32)
+    stored = np.asarray(v, dtype=np.float64).astype(np.float32)
+    if getattr(v, "flags", None) is not None and v.flags.writeable:
+        v[...] = stored
+    else:   # a loader's read-only view of its file's bytes
+        mesh.vertices = stored.astype(np.float64)
 
 
 def _as_placed(scene: Any) -> list[Any] | None:

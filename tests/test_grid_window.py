@@ -61,3 +61,14 @@ def test_import_and_build_navgrid_give_one_grid_off_the_lattice(tmp_path, name):
 
     g = NavGrid.load(out / "navgrid.npz")
     assert g.levels == 2 and abs(g.origin[0] / 0.5 - round(g.origin[0] / 0.5)) < 1e-9
+
+
+def test_the_import_rounds_the_model_as_model_glb_stores_it():
+    import trimesh
+
+    from tanktool.importer import _as_stored
+
+    m = trimesh.Trimesh([[0.1, 0.0, 0.3], [1.1, 0.0, 0.3], [0.1, 0.0, 1.7]], [[0, 1, 2]], process=False)
+    assert not np.array_equal(m.vertices, m.vertices.astype(np.float32))
+    _as_stored(m)
+    assert m.vertices.dtype == np.float64 and np.array_equal(m.vertices, m.vertices.astype(np.float32))
