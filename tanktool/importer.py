@@ -124,8 +124,6 @@ def import_arena(
     _check_heights(params.climb, height, wall_height)
     scene, mesh = _read_mesh(model, params.cell, max_cells, progress, up=up, scale=scale, warn=remark,
                              wall_height=wall_height, wall_thickness=wall_thickness)
-    _as_stored(mesh)
-    # with the grid stage, the tank grid is only the spawns' (the bundle's is built anew)
     result = _analyse(model, mesh, params, fleet, height, tolerance, progress, keep_runs=not grid)
     n_faces, model_left_out = len(mesh.faces), list(scene.metadata.get("left_out", []))
     del mesh   # scene.dump()'s copy: the analysis keeps the arrays it needs (vertices, faces)
@@ -147,9 +145,7 @@ def import_arena(
         # one grid per smaller vehicle: grid_files builds navgrid.<vehicle>.npz from these
         write_toml(tmp / MANIFEST, {**doc, **({"grids": others} if others else {})})
         scene = None
-        # the grid stage reseeds the analysis' surface (on the model lattice, as
-        # build-navgrid's from model.glb): its only reference goes with the dict
-        analysed = {"params": params, "surface": result.surface} if grid else None
+        analysed = {"params": params, "surface": result.surface} if grid else None   # see _stage_grid
         _let_go(result)
         # the same files, built the same way, as build-navgrid on the bundle
         built = _stage_grid(tmp, fits, remark, progress, analysed) if grid else None
@@ -246,13 +242,15 @@ def _check_heights(climb: float, height: float, wall_height: float | None) -> No
 
 def _read_mesh(model: Path, cell: float, max_cells: int | None, progress: Callable[[str], None] | None,
                **load: Any) -> tuple[Any, Any]:
-    """(scene, its triangles as one mesh): ``load`` goes to load_scene."""
+    """(scene, its triangles as one mesh, rounded as model.glb stores them): ``load``
+    goes to load_scene."""
     from .formats.models import load_scene
 
     scene = load_scene(model, progress=progress, **load)
     if progress:
         progress("read")
     mesh = _one_mesh(model, scene, cell, max_cells)
+    _as_stored(mesh)
     give_back(GIVE_BACK_MIN)   # the parser's temporaries (2 km terrain: ~0.36 GB of free heap kept)
     return scene, mesh
 
@@ -308,7 +306,9 @@ def _as_placed(scene: Any) -> list[Any] | None:
 
 def _analyse(model: Path, mesh: Any, params: Any, fleet: Any, height: float, tolerance: float,
              progress: Callable[[str], None] | None, keep_runs: bool = True) -> Any:
-    """analyse_arena on the mesh, its errors naming the file (``keep_runs``: see there)."""
+    """analyse_arena on the mesh, its errors naming the file (``keep_runs``: see there;
+    False with the grid stage: the tank grid is only the spawns', the bundle's is built
+    anew from the same surface)."""
     from .nav.arena_levels import analyse_arena
 
     try:
@@ -412,7 +412,9 @@ def _manifest(tmp: Path, model: Path, companions: list[Path], name: str, source:
 def _stage_grid(tmp: Path, fits: Any, remark: Callable[[str], None],
                 progress: Callable[[str], None] | None, analysed: dict[str, Any] | None = None) -> Any:
     """navgrid.npz, quadtree.npz and navgrid.png as build-navgrid writes them, recorded
-    in the manifest (``analysed``: the analysis' surface, see grid_files.build_grid)."""
+    in the manifest.  ``analysed`` ({"params", "surface"}: the analysis' surface, on the
+    model lattice as build-navgrid's from model.glb, its only reference) is reseeded
+    instead of rasterising model.glb again (grid_files.build_grid)."""
     from .formats.bundle import write_toml
     from .grid_files import build_grid, open_target, picture_and_grids, stage_grid_files
 

@@ -18,8 +18,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:   # annotations only: this module imports nothing of nav at load time
+    from .navgrid import NavGrid
+    from .walkable import Surface
 
 #: a whisker so that a bound a rounding error past a lattice line stays on it
 _EPS = 1e-9
@@ -64,7 +69,7 @@ def grid_window(lattice_origin: np.ndarray, cell: float, bounds: np.ndarray) -> 
     return Window(first[1], first[0], nz, nx, origin)
 
 
-def crop(a: np.ndarray, w: Window, fill, ax: int = 1) -> np.ndarray:
+def crop(a: np.ndarray, w: Window, fill: bool | float | int, ax: int = 1) -> np.ndarray:
     """``a`` with its axes ``ax``, ``ax + 1`` the lattice's (NZ, NX) cut to the window's
     (nz, nx) (layers (L, NZ, NX), links (L, NZ, NX, 4), a mask (NZ, NX) with ``ax`` 0),
     ``fill`` where the window reaches past the lattice."""
@@ -95,7 +100,8 @@ def crop_links(link: np.ndarray, w: Window) -> np.ndarray:
     return out
 
 
-def window_grid(surface, w: Window, too_close: np.ndarray, clearance: float, seeds: np.ndarray | None = None):
+def window_grid(surface: "Surface", w: Window, too_close: np.ndarray, clearance: float,
+                seeds: np.ndarray | None = None) -> "NavGrid":
     """The layered grid of ``surface`` (on the model lattice) on the window ``w``:
     ``walkable.grid_from_surface`` with the nodes cut to the window, valid where not
     ``too_close`` ((L, nz, nx), the walls' exact distance on the window)."""
