@@ -1,9 +1,10 @@
 """A camper standing still on a hill above, hidden by a crest: hard, remembering where
 it camps, hunts it from a place whose shot carries onto it (``combat.Hunt._carrying``:
 on the hills hard once sat 60 s below a camper, the hull pitched up, every shot 2-4 m
-over it).  Twelve seeded set-ups: hard hits the camper within 60 s in 8 of them.  (10
-of 12 was counted while an idle tank rolled down any slope: the camper left its hill,
-35-72 m, in 10 of the 12; held by its tracks (``sim.on_ground.slope_pull``) it stays.)"""
+over it).  Twelve seeded set-ups: hard hits the camper within 60 s in 8 of them (two
+place hard under a rock).  (10 was counted while an idle tank rolled down any slope:
+the camper left its hill, 35-72 m, in 10 of the 12; held by its tracks,
+``sim.on_ground.slope_pull``, it stays.)"""
 
 import math
 

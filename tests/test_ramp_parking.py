@@ -70,6 +70,22 @@ def test_a_tank_stopped_on_the_ramp_stays_and_one_driven_down_it_goes(bridge):
         for _ in range(int(3.0 / w.dt)):
             w.step(None, [IDLE])
         assert math.hypot(t.x - x0, t.z - z0) < 0.1, heading
+    # a pilot braking to a stop commands a little against the way it goes: held
+    w = _world(bridge, (8.0, 9.0, -0.5 * math.pi))
+    t = w.tanks[0]
+    w.stand(t, None)
+    z0 = t.z
+    for _ in range(int(5.0 / w.dt)):
+        w.step(None, [Command(advance=-0.3 * (t.vx * t.c + t.vz * t.s) - 0.01)])
+    assert abs(t.z - z0) < 0.1, t.z - z0
+    # a little of the command up it is not a crawl up what it cannot climb
+    w = _world(bridge, (8.0, 9.0, 0.5 * math.pi))
+    t = w.tanks[0]
+    w.stand(t, None)
+    z0 = t.z
+    for _ in range(int(3.0 / w.dt)):
+        w.step(None, [Command(advance=0.25)])
+    assert t.z < z0
     w = _world(bridge, (8.0, 9.0, -0.5 * math.pi))
     t = w.tanks[0]
     w.stand(t, None)

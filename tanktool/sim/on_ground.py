@@ -18,9 +18,10 @@ from .rules import GRAVITY
 
 #: metres of height difference that weigh as one metre across, choosing the node
 HEIGHT_WEIGHT = 0.5
-#: a tank on a slope not driven along its length (or across it), slower than this that
-#: way [m/s], is held there by its tracks (a parked tank's brake; across, the tracks'
-#: grip) ...
+#: a tank on a slope not driven uphill along its length (or across it), with less than
+#: this of the command that way, slower than HOLD_SPEED that way [m/s], is held there by
+#: its tracks (a parked tank's brake; across, the tracks' grip) ...
+HOLD_DRIVE = 0.3
 HOLD_SPEED = 0.5
 #: ... on slopes up to this gradient (rise per metre: 35 degrees)
 HOLD_GRADE = 0.7
@@ -29,19 +30,24 @@ HOLD_GRADE = 0.7
 def slope_pull(t: Any, m: float, advance: float, strafe: float, vf: float, vr: float) -> tuple[float, float]:
     """The pull (x, z) of gravity along the slope on a tank of mass ``m`` tilted
     ``t.pitch``, ``t.roll``: on a plane of gradient G, g G / (1 + |G|^2) downhill
-    (g sin(theta) cos(theta)); but for the part along its length when it is not driven
-    that way (``advance`` 0) and moves slower than ``HOLD_SPEED`` that way (``vf``),
-    and the part across it when not strafing and slower across (``vr``): the tracks
-    hold those.  Without it a tank stopped on a ramp's 18 degrees crept sideways at
-    0.36 m/s (the grip against the pull) and rolled back down it: parked at the
-    gen-bridge's ramp top, it was at the ramp's side in 10 s and tipped over it."""
+    (g sin(theta) cos(theta)); but for the part along its length when it is driven
+    that way with less than ``HOLD_DRIVE`` (``advance``; a pilot braking to a stop
+    commands a little), not crawling uphill, and moves slower than ``HOLD_SPEED`` that way
+    (``vf``), and the same across it (``strafe``, ``vr``): the tracks hold those.
+    Without it a tank stopped on a ramp's 18 degrees crept sideways at 0.36 m/s (the
+    grip against the pull) and rolled back down it: parked at the gen-bridge's ramp
+    top, it was at the ramp's side in 10 s and tipped over it; the camper rolled off
+    the hill it held (the pilot's braking, -0.3 of its speed, a third of the pull)."""
     c, sn = t.c, t.s
     gf, gr = math.tan(t.pitch), -math.tan(t.roll)   # rise along forward, along right
     gx, gz = gf * c - gr * sn, gf * sn + gr * c
     k = -m * GRAVITY / (1.0 + gx * gx + gz * gz)
     if gx * gx + gz * gz <= HOLD_GRADE * HOLD_GRADE:
-        along = advance == 0.0 and abs(vf) < HOLD_SPEED
-        across = strafe == 0.0 and abs(vr) < HOLD_SPEED
+        # a little of the command uphill, from rest or on the way it goes, is a crawl up
+        # the slope (not held: 0.29 of it would climb the 18 degrees it cannot climb);
+        # against the way it goes, a brake
+        along = abs(advance) < HOLD_DRIVE and abs(vf) < HOLD_SPEED and not (advance * gf > 0.0 <= advance * vf)
+        across = abs(strafe) < HOLD_DRIVE and abs(vr) < HOLD_SPEED and not (strafe * gr > 0.0 <= strafe * vr)
         if along or across:
             gf, gr = (0.0 if along else gf), (0.0 if across else gr)
             gx, gz = gf * c - gr * sn, gf * sn + gr * c
