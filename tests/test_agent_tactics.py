@@ -1,6 +1,7 @@
 """Computer opponents (issue 7): hearing engines, watching from a vantage point in an
 open arena, what the agent does after a kill, ambushing while it leads, returning fire."""
 
+import dataclasses
 import math
 import random
 
@@ -61,9 +62,16 @@ def test_a_faster_engine_is_heard_farther():
     assert eyes.listen_engines(w, me) != ()
 
 
+def _no_wait():
+    """Normal without lying in wait (both levels wait now): a level that goes looking."""
+    from tanktool.sim.agents.difficulty import DIFFICULTIES
+
+    return dataclasses.replace(DIFFICULTIES["normal"], name="no-wait", wait=False)
+
+
 def test_an_agent_goes_towards_an_engine_it_hears():
     w = box_world([(50.0, 35.0), (75.0, 35.0)], headings=[math.pi, 0.0])
-    agent = driver(Agent("normal"), 1)
+    agent = driver(Agent(_no_wait()), 1)
     me, o = w.tanks
     o.vx = ENGINE_FULL
     agent(w, me)
@@ -442,7 +450,7 @@ def test_a_hunt_that_comes_no_nearer_goes_for_the_camp_itself_then_gives_up():
 def test_an_enemy_heard_coming_behind_cover_is_waited_for_with_the_gun_on_the_corner():
     # the enemy's engine behind the thin wall x=60 (z 20-50), nearer its north end: hard
     # stands, turned from facing away to that end, where the enemy's way round comes
-    # past; normal goes looking
+    # past; a level that does not lie in wait goes looking
     from tanktool.sim.agents.combat import WAIT
 
     w = box_world([(50.0, 35.0), (75.0, 44.0)], headings=[math.pi, 0.0])
@@ -462,7 +470,7 @@ def test_an_enemy_heard_coming_behind_cover_is_waited_for_with_the_gun_on_the_co
     for _ in range(int(0.5 * WAIT / w.dt)):       # it does not come: search from the noise
         w.step(None, [agent(w, me), IDLE])
     assert agent.bot.state == "search"
-    normal = driver(Agent("normal"), 1)
+    normal = driver(Agent(_no_wait()), 1)
     w2 = box_world([(50.0, 35.0), (75.0, 44.0)], headings=[math.pi, 0.0])
     w2.tanks[1].vx = ENGINE_FULL
     normal(w2, w2.tanks[0])
