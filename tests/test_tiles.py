@@ -1,6 +1,6 @@
 """Heightfields built in bands of rows (tanktool/geometry/tiles.py) are the whole
 build's, span for span and count for count, with or without the compiled kernels,
-in this process or on worker processes."""
+in turn or on worker threads."""
 
 from __future__ import annotations
 
@@ -48,10 +48,25 @@ def test_bands_give_the_whole_build(name, kernels):
     assert whole.walkable.sum() > 1000 and whole.counts["ledge"] > 0
 
 
-def test_bands_on_worker_processes_give_the_whole_build():
+@pytest.mark.parametrize("kernels", [True, False] if available() else [False], ids=["compiled", "numpy"][:2])
+def test_bands_on_worker_threads_give_the_whole_build(kernels):
     V, F = _mesh("dungeon")
-    whole = build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9)
-    _same(build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9, band_rows=40, workers=2), whole)
+    with use_kernels(kernels):
+        whole = build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9)
+        _same(build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9, band_rows=40, workers=2), whole)
+
+
+def test_concurrent_tiled_builds_keep_apart():
+    """Two levels tiled at once in one process (a server's threads): each its own."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    meshes = [_mesh("dungeon"), _mesh("two_storeys")]
+    whole = [build_heightfield(V, F, 0.3, 0.2, 45.0, 2.0, 0.9) for V, F in meshes]
+    with ThreadPoolExecutor(2) as pool:
+        tiled = list(pool.map(lambda m: build_heightfield(*m, 0.3, 0.2, 45.0, 2.0, 0.9, band_rows=9, workers=2),
+                              meshes))
+    for a, b in zip(tiled, whole):
+        _same(a, b)
 
 
 def test_bands_cover_the_rows_once():
@@ -60,7 +75,8 @@ def test_bands_cover_the_rows_once():
 
 
 def test_a_daemonic_worker_builds_its_bands_in_turn():
-    """A pool worker (daemonic: it may not start processes) importing a large level."""
+    """A pool worker (daemonic: it may not start processes) importing a large level
+    builds its bands on threads."""
     import multiprocessing as mp
 
     V, F = _mesh("two_storeys")
