@@ -15,6 +15,7 @@ import contextlib
 import ctypes
 import errno
 import os
+import re
 import shutil
 import stat
 from pathlib import Path
@@ -41,10 +42,15 @@ def _obj_materials(model: Path) -> set[str]:
         data = read_input(model, "an .obj file")
     except FormatError:
         return out
-    for raw in data.splitlines():
-        if raw.startswith(b"mtllib"):
-            out.update(n.decode("utf-8", "replace") for n in raw.split()[1:])
+    # the lines that start with mtllib, found by one scan (bytes.splitlines on a 120 MB
+    # model made 3 M lines: 0.26 s a call, three calls replacing a bundle)
+    for m in _MTLLIB.finditer(data):
+        out.update(n.decode("utf-8", "replace") for n in m.group().split()[1:])
     return out
+
+
+#: a line starting with mtllib (lines end at \n, \r or \r\n, as bytes.splitlines splits)
+_MTLLIB = re.compile(rb"(?:^|(?<=\r))mtllib[^\r\n]*", re.M)
 
 
 def _texture_folders(folder: Path, doc: dict[str, Any]) -> set[str]:
