@@ -64,8 +64,7 @@ HOOKS = [
     ("thin walls", "tanktool.geometry.walls:thin_walls"),
     ("walls", "tanktool.nav.level_walls:level_walls"),
     ("grids", "tanktool.nav.arena_levels:walls_too_close"),
-    ("grids", "tanktool.nav.walkable:grid_from_surface"),
-    ("grids", "tanktool.nav.grid_window:window_grid"),   # the bundle's grid (a window of the lattice)
+    ("grids", "tanktool.nav.walkable:grid_from_surface"),   # the analysis' grids and the bundle's (a window)
     ("spawns", "tanktool.nav.arena_levels:choose_spawns"),
     ("report", "tanktool.nav.surface_report:left_out"),
     ("quadtree", "tanktool.nav.quadtree:WallQuadtree.build"),

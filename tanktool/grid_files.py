@@ -287,8 +287,8 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, base: A
     import numpy as np
 
     from .nav.arena_levels import walls_too_close
-    from .nav.grid_window import grid_window, model_lattice, window_grid, window_nodes
-    from .nav.walkable import grid_from_layers, level_nodes, reseed, walkable_surface
+    from .nav.grid_window import grid_window, model_lattice, window_nodes
+    from .nav.walkable import grid_from_layers, grid_from_surface, level_nodes, reseed, walkable_surface
 
     seeds = None
     if target.spawns is not None:  # [x, z] and the spawn's height when the manifest has it
@@ -327,7 +327,7 @@ def _layered(target: Target, params: Any, clearance: float, bounds: Any, base: A
         nodes = np.isfinite(g0.height)
         grid = grid_from_layers(nodes & ~tc, g0.height, g0.link, clearance, w.origin, cell, seeds=target.spawns)
         return grid, (nodes[0] if grid.levels == 1 else None), None
-    grid = window_grid(surface, w, tc, clearance, seeds=target.spawns)
+    grid = grid_from_surface(surface, clearance, w.origin, seeds=target.spawns, too_close=tc, window=w)
     return grid, (window_nodes(level_nodes(surface), w) if grid.levels == 1 else None), surface
 
 

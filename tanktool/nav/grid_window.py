@@ -18,13 +18,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
-
-if TYPE_CHECKING:   # annotations only: this module imports nothing of nav at load time
-    from .navgrid import NavGrid
-    from .walkable import Surface
 
 #: a whisker so that a bound a rounding error past a lattice line stays on it
 _EPS = 1e-9
@@ -98,25 +93,6 @@ def crop_links(link: np.ndarray, w: Window) -> np.ndarray:
     out[:, :, 0, 2] = -1
     out[:, 0, :, 3] = -1
     return out
-
-
-def window_grid(surface: "Surface", w: Window, too_close: np.ndarray, clearance: float,
-                seeds: np.ndarray | None = None) -> "NavGrid":
-    """The layered grid of ``surface`` (on the model lattice) on the window ``w``:
-    ``walkable.grid_from_surface`` with the nodes cut to the window, valid where not
-    ``too_close`` ((L, nz, nx), the walls' exact distance on the window)."""
-    from .walkable import _grid_links, grid_from_layers, surface_layers
-
-    exists, height, _, span = surface_layers(surface, clearance=False)
-    L, NZ, NX = exists.shape
-    link = _grid_links(surface, exists, span).reshape(L, NZ, NX, 4)
-    del span
-    link = crop_links(link, w)
-    exists = crop(exists, w, False)
-    height = crop(height, w, np.nan)
-    valid = exists & ~too_close
-    del exists
-    return grid_from_layers(valid, height, link, clearance, w.origin, surface.hf.cs, seeds)
 
 
 def window_nodes(mask: np.ndarray, w: Window) -> np.ndarray:

@@ -533,7 +533,7 @@ def _grid_links(surface: Surface, exists: np.ndarray, span: np.ndarray) -> np.nd
 
 
 def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray, seeds: np.ndarray | None = None,
-                      too_close: np.ndarray | None = None, runs: bool = True):
+                      too_close: np.ndarray | None = None, runs: bool = True, window=None):
     """The layered navigation grid of a surface (cell = the heightfield's cell).
 
     There is a node wherever the main region has a span (its height and links are
@@ -541,20 +541,25 @@ def grid_from_surface(surface: Surface, clearance: float, origin_xz: np.ndarray,
     ``too_close`` (L, nz, nx) is given, the exact distance to the level's walls) is at
     least ``clearance``.  ``seeds`` (k, 2+) spawn points
     ``[x, z, ...]`` mark the reachable nodes (all valid nodes when None); ``runs``:
-    see :func:`grid_from_layers`.
+    see :func:`grid_from_layers`.  ``window`` (a ``grid_window.Window`` of the surface's
+    lattice): the nodes cut to it, at its origin (``origin_xz`` unused; ``too_close``
+    on the window), as a bundle's grid is (nav/grid_window.py).
     """
     exists, height, clear, span = surface_layers(surface, clearance=too_close is None)
-    if too_close is None:
-        valid = exists & (clear >= clearance)
-    else:
-        valid = exists & ~too_close
-    del clear
-    L, nz, nx = valid.shape
+    L, nz, nx = exists.shape
     # each node's span, and the node its link reaches: flat indices throughout.  Links
     # and heights are kept for every node of the surface, valid (a tank fits) or not:
     # the simulation drives on all of it; runs, reachability and paths use valid nodes.
     link = _grid_links(surface, exists, span).reshape(L, nz, nx, 4)
-    del span, exists
+    del span
+    if window is not None:
+        from .grid_window import crop, crop_links
+
+        link, exists, height = crop_links(link, window), crop(exists, window, False), crop(height, window, np.nan)
+        clear = None if clear is None else crop(clear, window, 0.0)
+        origin_xz = window.origin
+    valid = exists & (clear >= clearance) if too_close is None else exists & ~too_close
+    del clear, exists
     return grid_from_layers(valid, height, link, clearance, origin_xz, surface.hf.cs, seeds, runs)
 
 
