@@ -30,7 +30,7 @@ _done = False
 
 def keep_freed_memory() -> bool:
     """Raise glibc's thresholds once (and stop numpy asking for huge pages); False
-    where there is no glibc (nothing done)."""
+    where there is no glibc (the thresholds untouched)."""
     global _done
     if _done:
         return True

@@ -17,7 +17,7 @@ merging -- is one band per worker, not the whole level.  Without the kernels the
 numpy path runs the same way (numpy lets go of the GIL in its large operations).
 
     hf = build_heightfield(vertices, faces, 0.5, 0.1, 35, 2.35, 0.9)   # tiles by itself when large
-    hf = build_heightfield_tiled(vertices, faces, 0.5, 0.1, 35, 2.35, 0.9, band_rows=256, workers=2)
+    hf = build_heightfield(vertices, faces, 0.5, 0.1, 35, 2.35, 0.9, band_rows=256, workers=2)   # bands of 256 rows on 2 threads
 """
 
 from __future__ import annotations
