@@ -151,7 +151,8 @@ def profile_one(spec: str, work: Path) -> dict:
     return {"faces": int(r.faces), "walls": len(r.walls), "spawns": len(r.spawns),
             "levels": len(r.levels.levels), "nodes": int(tank_grid.valid.sum()),
             "seconds": total, "cpu_seconds": cpu, "import_seconds": t_import, "modules_seconds": t_modules, "two_step": two_step,
-            "stages": stages, "stage_peak_mb": {k: round(v, 1) for k, v in prof.peak_mb.items()},
+            "stages": stages, "thread_stages": {k: round(v, 3) for k, v in prof.thread_stages.items()},
+            "stage_peak_mb": {k: round(v, 1) for k, v in prof.peak_mb.items()},
             "missing_hooks": prof.missing, "kernels": kernels_active(),
             "params": {"cell": p.cell, "cell_height": p.cell_height, "max_slope": p.max_slope,
                        "headroom": p.headroom, "climb": p.climb, "radius": float(r.levels.fleet.radius)
@@ -324,6 +325,9 @@ def print_stages(rows: list[dict]) -> None:
         if "dominant" in r:
             share = sum(r["stages"][k] for k in r["dominant"]) / max(r["seconds"], 1e-9)
             print(f"  {r['level']}: dominated by {', '.join(r['dominant'])} ({100 * share:.0f} % of the import)")
+        if r.get("thread_stages"):  # beside the main thread's stages, not added to them
+            print(f"  {r['level']}: in worker threads, within the stages above: "
+                  + ", ".join(f"{k} {v:.3f} s" for k, v in r["thread_stages"].items()))
 
 
 def scale_part(sizes: list[float], timeout: float) -> list[dict]:
@@ -341,7 +345,7 @@ def scale_part(sizes: list[float], timeout: float) -> list[dict]:
             path = terrain(size, Path(tmp))
             row = {"size_m": size, **child(str(path), timeout)}
             if "error" not in row:
-                row = {k: row[k] for k in ("size_m", "faces", "seconds", "cpu_seconds", "peak_mb", "stages",
+                row = {k: row[k] for k in ("size_m", "faces", "seconds", "cpu_seconds", "peak_mb", "stages", "thread_stages",
                                            "stage_peak_mb", "nodes", "walls", "kernels")}
                 row["seconds"] = round(row["seconds"], 3)
                 row["cpu_seconds"] = round(row["cpu_seconds"], 3)

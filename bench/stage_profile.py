@@ -5,14 +5,18 @@ bound (the module that defines it and every tanktool module that imported it by
 name, since ``from x import f`` copies the reference), and restores them all on
 exit.  Time is *exclusive*: a hooked call inside another hooked call is charged to
 its own stage and taken off its caller's, so the stages add up to at most the whole
-and "other" is what no hook covers.  A hook whose module or name does not exist
+and "other" is what no hook covers.  A hooked call in a worker thread (the heightfield's
+bands, the grids compressed while a picture is drawn) runs beside the main thread's
+stage, so it is kept apart, in ``thread_stages``: adding it in would count the same
+wall time twice (a negative "other").  A hook whose module or name does not exist
 (yet) is skipped, so the bench keeps working while the pipeline changes.
 
     HOOKS = [("rasterise", "tanktool.geometry.heightfield:rasterize"),
              ("quadtree", "tanktool.nav.quadtree:WallQuadtree.build")]   # a classmethod
     with Profile(HOOKS) as prof:
         run_the_import()
-    prof.stages  # {"rasterise": seconds, ...}
+    prof.stages  # {"rasterise": seconds, ...}, main thread: they add up to <= the whole
+    prof.thread_stages  # the same for hooked calls in worker threads
     prof.peak_mb  # {"rasterise": the largest resident size seen during it, ...}
 
 With ``memory=True`` a thread samples the process's resident size every 20 ms
@@ -39,6 +43,7 @@ class Profile:
     def __init__(self, hooks: list[tuple[str, str]], memory: bool = False):
         self.hooks = hooks
         self.stages: dict[str, float] = defaultdict(float)
+        self.thread_stages: dict[str, float] = defaultdict(float)
         self.calls: dict[str, int] = defaultdict(int)
         self.peak_mb: dict[str, float] = defaultdict(float)
         self._memory = memory
@@ -50,23 +55,23 @@ class Profile:
         self._undo: list[tuple[Any, str, Any]] = []
         self.missing: list[str] = []
 
-    def _frames(self) -> tuple[list[float], list[str]]:
-        """This thread's stack of inner times and of stage names: a hooked call in a
-        worker thread (the grids compressed while the picture is drawn) is charged to
-        its own stage without taking it off the stage the main thread is in (the
-        stages then add up to more than the wall time; the sampler follows the main
-        thread's names)."""
+    def _frames(self) -> tuple[list[float], list[str], dict[str, float]]:
+        """This thread's stack of inner times, of stage names, and where its time goes:
+        a hooked call in a worker thread is charged to ``thread_stages`` without taking
+        it off the stage the main thread is in (the sampler follows the main thread's
+        names)."""
         loc = self._local
         if not hasattr(loc, "stack"):
             main = threading.current_thread() is threading.main_thread()
-            loc.stack, loc.names = (self._stack, self._names) if main else ([], ["other"])
-        return loc.stack, loc.names
+            loc.stack, loc.names, loc.sink = ((self._stack, self._names, self.stages) if main
+                                              else ([], ["other"], self.thread_stages))
+        return loc.stack, loc.names, loc.sink
 
     def _wrap(self, stage: str, fn: Callable) -> Callable:
-        stages, calls, frames = self.stages, self.calls, self._frames
+        calls, frames = self.calls, self._frames
 
         def timed(*args, **kwargs):
-            stack, names = frames()
+            stack, names, stages = frames()
             t0 = time.perf_counter()
             stack.append(0.0)
             names.append(stage)

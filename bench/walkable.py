@@ -139,6 +139,8 @@ def our_stages(V: np.ndarray, F: np.ndarray, repeat: int) -> dict:
             total = time.perf_counter() - t0
         out = dict(prof.stages)
         out["grid"] = out.get("grid", 0.0) + total - sum(prof.stages.values())
+        # work done in the heightfield's band threads, inside the main thread's stage
+        out.update({f"{k} in threads": v for k, v in prof.thread_stages.items()})
         for k, v in out.items():
             best[k] = min(best.get(k, float("inf")), v)
     return {k: round(v * 1000, 2) for k, v in best.items()}
