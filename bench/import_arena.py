@@ -79,6 +79,9 @@ HOOKS = [
     ("writing", "tanktool.formats.bundle:atomic_write_text"),
     ("writing", "tanktool.nav.navgrid:NavGrid.to_bytes"),
     ("writing", "shutil:copyfile"),
+    # its own time, the picture's drawing taken off, is the wait for the grids'
+    # compression in its thread (that thread's work is reported beside the stages)
+    ("writing", "tanktool.grid_files:picture_and_grids"),
 ]
 STAGES = list(dict.fromkeys(s for s, _ in HOOKS)) + ["other"]
 
