@@ -397,3 +397,18 @@ def test_check_replaceable_refuses_links(tmp_path):
     (tmp_path / "link").symlink_to(real)
     with pytest.raises(OutputError, match="symbolic link"):
         check_replaceable(tmp_path / "link", True, "arena.toml")
+
+
+def test_obj_materials_reads_mtllib_lines_only(tmp_path):
+    """The .obj's material libraries a bundle holds: only lines starting with mtllib, at
+    any line ending (\\n, \\r\\n, \\r), never a comment or another keyword."""
+    from tanktool.formats.bundle_swap import _obj_materials
+
+    cases = {b"mtllib a.mtl\nv 1 2 3\n": {"a.mtl"},
+             b"v 1\r\nmtllib b.mtl c.mtl\r\n": {"b.mtl", "c.mtl"},
+             b"v 1\rmtllib d.mtl": {"d.mtl"},
+             b"# mtllib x.mtl\n  mtllib y.mtl\nusemtl z\nxmtllib q\n": set(),
+             b"": set(), b"mtllib": set()}
+    for data, expected in cases.items():
+        (tmp_path / "m.obj").write_bytes(data)
+        assert _obj_materials(tmp_path / "m.obj") == expected, data

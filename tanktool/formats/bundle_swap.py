@@ -42,15 +42,19 @@ def _obj_materials(model: Path) -> set[str]:
         data = read_input(model, "an .obj file")
     except FormatError:
         return out
-    # the lines that start with mtllib, found by one scan (bytes.splitlines on a 120 MB
-    # model made 3 M lines: 0.26 s a call, three calls replacing a bundle)
-    for m in _MTLLIB.finditer(data):
-        out.update(n.decode("utf-8", "replace") for n in m.group().split()[1:])
+    # the lines that start with mtllib, found by bytes.find (a memchr-speed scan): on a
+    # 120 MB model bytes.splitlines made 3 M lines and a regex anchored at line starts
+    # tried every position, ~2.3 s a call and three calls replacing a bundle; this ~0.09 s
+    i = data.find(b"mtllib")
+    while i != -1:
+        if i == 0 or data[i - 1] in b"\r\n":   # lines end at \n, \r or \r\n
+            line = _TO_LINE_END.match(data, i).group()
+            out.update(n.decode("utf-8", "replace") for n in line.split()[1:])
+        i = data.find(b"mtllib", i + 6)
     return out
 
 
-#: a line starting with mtllib (lines end at \n, \r or \r\n, as bytes.splitlines splits)
-_MTLLIB = re.compile(rb"(?:^|(?<=\r))mtllib[^\r\n]*", re.M)
+_TO_LINE_END = re.compile(rb"[^\r\n]*")
 
 
 def _texture_folders(folder: Path, doc: dict[str, Any]) -> set[str]:
