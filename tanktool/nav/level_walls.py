@@ -533,7 +533,7 @@ def _same_level_links(surface: Surface, span_of: np.ndarray, exists: np.ndarray)
     # (n, 4); a missing link (-1) reads the appended -1.  One level: every link stays on it (hix: -40 ms)
     linked = lv[surface.link] if L > 1 else surface.link >= 0
     del lv
-    lev = np.arange(L, dtype=small)[:, None, None, None] if L > 1 else True
+    lev = np.arange(L, dtype=small)[:, None, None, None]
     # a block of rows at a time: the whole grid's gathered levels, compare and mask
     # were four temporaries of 4 bytes a node (~0.25 GB on a 2 km terrain, the walls' peak)
     out = np.empty((L, nz, nx, 4), dtype=bool)

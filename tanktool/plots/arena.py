@@ -1,21 +1,17 @@
 """Top view of an arena: walls with their normals, the auxiliary rectangle, spawns.
 
-preview.png (:func:`render_levels`) is drawn with Pillow (plots/raster.py);
-:func:`render_preview` (a plain wall list) still with matplotlib.  Both are imported
-inside the functions, so importing this module costs nothing and works without a display.
+preview.png (:func:`render_levels`) is drawn with Pillow (plots/raster.py), imported
+inside the functions, so importing this module costs little and works without a display.
 """
 
 from __future__ import annotations
 
-import io
-import os
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
 
-from ..formats.walls_txt import WallList
-from .colourmaps import apply, lut
+from .colourmaps import lut
 
 
 #: the free space's fill, the walls, their normals' ticks
@@ -26,137 +22,6 @@ FREE_COLOUR = "#e8efe6"
 MAX_IMAGE_SIDE = 1200
 WALL_COLOUR = "#202020"
 NORMAL_COLOUR = "#d04020"
-
-
-
-def _spawn_mark(ax, x: float, z: float, th: float, number: int, arrow: float, back: float, zorder: int) -> None:
-    """A spawn point: a dot, an arrow ``arrow`` long the way it faces, and its number
-    ``back`` arrow lengths behind it, each with a white halo so it reads on any height's colour."""
-    from matplotlib.patheffects import withStroke
-
-    halo = [withStroke(linewidth=3.5, foreground="white")]
-    ax.annotate("", xy=(x + arrow * np.cos(th), z + arrow * np.sin(th)), xytext=(x, z),
-                arrowprops=dict(arrowstyle="-|>", color="#1a7a1a", lw=1.5, path_effects=halo), zorder=zorder)
-    ax.plot([x], [z], "o", color="#1a7a1a", mec="white", ms=5, zorder=zorder)
-    ax.text(x - back * arrow * np.cos(th), z - back * arrow * np.sin(th), str(number), color="#1a7a1a",
-            fontsize=8, fontweight="bold", ha="center", va="center", zorder=zorder + 1, path_effects=halo)
-
-
-def fill_region(ax: Any, geom: Any, colour: str, zorder: float = 0) -> None:
-    """Fill a shapely (Multi)Polygon on ``ax`` as one compound path: every part's
-    outline counter-clockwise, its holes clockwise, so the non-zero rule leaves the
-    holes empty (and an island standing in a hole filled).
-
-    One patch whatever the number of parts and holes: a patch per outline and per
-    hole (each pillar of a floor plan is a hole) cost matplotlib seconds on a plan of
-    800 pillars (``bench/preview.py``)."""
-    import shapely
-    from matplotlib.patches import PathPatch
-    from matplotlib.path import Path as MplPath
-    from shapely.geometry.polygon import orient
-
-    if geom is None or geom.is_empty:
-        return
-    polys = [p for p in shapely.get_parts(geom) if p.geom_type == "Polygon" and not p.is_empty]
-    if not polys:
-        return
-    rings = []
-    for poly in (orient(p, 1.0) for p in polys):
-        rings.append(shapely.get_coordinates(poly.exterior))
-        rings.extend(shapely.get_coordinates(h) for h in poly.interiors)
-    verts = np.concatenate(rings)
-    codes = np.full(len(verts), MplPath.LINETO, dtype=MplPath.code_type)
-    start = np.cumsum([0] + [len(r) for r in rings[:-1]])
-    codes[start] = MplPath.MOVETO
-    codes[start + np.array([len(r) for r in rings]) - 1] = MplPath.CLOSEPOLY
-    # add_artist, not add_patch: the limits are set by the caller, and add_patch walks
-    # every segment of the path to update them (a second on 800 pillars)
-    ax.add_artist(PathPatch(MplPath(verts, codes), facecolor=colour, edgecolor="none", lw=0, zorder=zorder))
-
-
-def draw_segments(ax: Any, seg: np.ndarray, colour: str, width: float, zorder: float) -> None:
-    """Stroke segments (n, 2, 2) as one path of n pieces (butt ends, like a
-    LineCollection's); a LineCollection makes a matplotlib Path per segment, which
-    is most of the drawing time on tens of thousands of walls."""
-    from matplotlib.patches import PathPatch
-    from matplotlib.path import Path as MplPath
-
-    seg = np.asarray(seg, dtype=np.float64).reshape(-1, 2, 2)
-    if not len(seg):
-        return
-    codes = np.tile(np.array([MplPath.MOVETO, MplPath.LINETO], dtype=MplPath.code_type), len(seg))
-    ax.add_artist(PathPatch(MplPath(seg.reshape(-1, 2), codes), fill=False, edgecolor=colour, lw=width,
-                            capstyle="butt", joinstyle="miter", zorder=zorder))
-
-
-def draw_walls(ax: Any, seg: np.ndarray, normals: np.ndarray, aux: Any, tick: float, width: float) -> None:
-    """Walls (n, 2, 2) ``width`` wide with a ``tick`` of normal at each middle, on the
-    free side, and the auxiliary rectangle ``aux`` (or None) dashed beneath."""
-    from matplotlib.collections import LineCollection
-
-    draw_segments(ax, seg, WALL_COLOUR, width, zorder=2)
-    if len(seg):
-        mid = seg.mean(axis=1)
-        draw_segments(ax, np.stack([mid, mid + normals * tick], axis=1), NORMAL_COLOUR, 0.6 * width, zorder=3)
-    if aux is not None:
-        ax.add_collection(LineCollection(aux, colors="#4060c0", linewidths=0.9, linestyles="dashed", zorder=1))
-
-
-def render_preview(walls: WallList, spawns: np.ndarray, title: str, free: Any = None,
-                   size_px: int = 900) -> bytes:
-    """PNG bytes of the arena's top view.
-
-    walls : the wall list (auxiliary rectangle drawn dashed)
-    spawns : (k, 3) ``[x, z, heading]``, drawn as numbered arrows
-    free : optional shapely geometry of the free space, filled light grey
-    The x axis points right and z up, equal aspect; each wall has a short tick
-    along its normal, on the free-space side.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    from matplotlib.figure import Figure
-
-    (xmin, zmin), (xmax, zmax) = walls.bounds
-    w = max(xmax - xmin, 1e-6)
-    h = max(zmax - zmin, 1e-6)
-    aspect = h / w
-    fig_w = 9.0
-    fig_h = float(np.clip(fig_w * aspect + 0.8, 3.0, 14.0))
-    fig = Figure(figsize=(fig_w, fig_h), dpi=size_px / fig_w)
-    ax = fig.add_subplot(1, 1, 1)
-    ax.set_aspect("equal")
-    fill_region(ax, free, FREE_COLOUR)
-    draw_walls(ax, walls.segments, walls.normals, walls.aux, 0.012 * max(w, h), 1.4)
-    spawns = np.asarray(spawns, dtype=np.float64)
-    spawns = spawns.reshape(len(spawns), -1)[:, :3] if spawns.size else np.zeros((0, 3))
-    arrow = 0.03 * max(w, h)
-    for k, (x, z, th) in enumerate(spawns, start=1):
-        _spawn_mark(ax, x, z, th, k, arrow, 0.4, zorder=4)
-    pad = 0.03 * max(w, h)
-    ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(zmin - pad, zmax + pad)
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("z (m)")
-    ax.set_title(title, fontsize=10)
-    ax.grid(True, lw=0.3, alpha=0.5)
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", metadata={"Software": None})
-    return buf.getvalue()
-
-
-def save_preview(path: str | os.PathLike, walls: WallList, spawns: np.ndarray, title: str, free: Any = None,
-                 levels: Any = None) -> None:
-    """Write :func:`render_preview` (or, given an ArenaLevels, :func:`render_levels`)
-    to ``path`` atomically."""
-    from ..formats.bundle import atomic_write_bytes
-
-    if levels is not None:
-        atomic_write_bytes(path, render_levels(levels, title))
-    else:
-        atomic_write_bytes(path, render_preview(walls, spawns, title, free))
-
 
 #: colours of what the walkable surface left out
 LEFT_OUT_COLOURS = {"unreachable": "#9a9a9a", "headroom": "#f0a030", "small": "#b060c0", "steep": "#d03030"}
