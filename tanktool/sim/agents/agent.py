@@ -228,6 +228,21 @@ class Agent(Pilot):
         g = view.map.ground
         return abs(g.height(x, z, view.me.level) - here) > EDGE_RISE + nav.grade * r  # type: ignore[union-attr]
 
+    def edge_free(self, view: "View", angle: float, length: float) -> float:
+        """Free distance along ``angle`` before an edge (``_trap``: a drop or a slope
+        it cannot climb), up to ``length``; ``length`` off relief."""
+        if not view.map.relief or self.nav is None:
+            return length
+        me = view.me
+        here = view.map.ground.height(me.x, me.z, me.level)
+        c, s = math.cos(angle), math.sin(angle)
+        r = me.vehicle.radius
+        while r < length:
+            r = min(r + EDGE_STEP, length)
+            if self._trap(view, me.x + c * r, me.z + s * r, here, r):
+                return r - EDGE_STEP
+        return length
+
     def drive(self, view: "View", forward: float, lateral: float, rotate: float, fire: bool = False) -> Command:
         """``Pilot.drive``; on relief, not towards an edge: a wanted forward or sideways
         speed whose way ahead (footprint radius + ``EDGE_AHEAD`` m + ``EDGE_TIME`` s of
@@ -244,9 +259,13 @@ class Agent(Pilot):
             for k, (speed, c, s) in enumerate(((forward, me.c, me.s), (lateral, -me.s, me.c))):
                 if abs(speed) < 0.3:
                     continue
-                # as far as it takes to stop from the speed it has that way, or wants
+                # as far as it takes to stop from the speed it has that way, or wants:
+                # sideways the tracks' grip kills a slide at ``grip``/s (v / grip m: 0.9 m
+                # from a full strafe; the engine's braking distance, 14 m, held normal's
+                # strafe a plateau's width from its edge, still in a quarter of its fights)
                 v = max(abs(speed), math.copysign(1.0, speed) * (me.vx * c + me.vz * s))
-                reach = min(me.vehicle.radius + EDGE_AHEAD + v * EDGE_TIME + v * v / (2.0 * brake), EDGE_MAX)
+                stop = v * v / (2.0 * brake) if k == 0 else v / max(me.vehicle.grip, 1.0)
+                reach = min(me.vehicle.radius + EDGE_AHEAD + v * EDGE_TIME + stop, EDGE_MAX)
                 r = me.vehicle.radius
                 while r < reach:
                     r = min(r + EDGE_STEP, reach)

@@ -208,7 +208,9 @@ class Attack(State["Agent"]):
         that way, then the side with more room."""
         me = view.me
         look = me.vehicle.radius + 2.0 * ROOM
-        room = {k: agent.free(view, me.heading + k * math.pi / 2, look, (0.0,)) - me.vehicle.radius
+        # walls and, on relief, edges (a plateau's: the pilot will not strafe off it)
+        room = {k: min(agent.free(view, me.heading + k * math.pi / 2, look, (0.0,)),
+                       agent.edge_free(view, me.heading + k * math.pi / 2, look)) - me.vehicle.radius
                 for k in (1.0, -1.0)}
         if view.t >= self.flip_at:
             self.flip_at = view.t + agent.rng.uniform(*FLIP)
